@@ -1,0 +1,33 @@
+#pragma once
+// Elementary measures of a mesh embedded by vertex positions (3 x N, double).
+#include <Eigen/Core>
+#include <limits>
+
+#include "pcl_ddg/mesh/mesh_topology.h"
+
+namespace pcl_ddg {
+
+/**
+ * A triangle is degenerate (treated as zero-area) when twice its area is at most this fraction of
+ * its longest squared edge, i.e. when its smallest angle is below about 1e-12 rad. Relative, so
+ * the guard means the same at any scale and far from the origin.
+ */
+constexpr double kDegenerateTriangleTolerance = 1e-12;
+
+/** True for a zero-area (collinear or repeated-corner) triangle, by the relative guard above. */
+bool isDegenerateTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                          const Eigen::Vector3d& c);
+
+/** Mean length of the unique edges whose end points are finite (0 if there are none). */
+double meanEdgeLength(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+
+struct BoundingBox {
+  Eigen::Vector3d min = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Eigen::Vector3d max = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  Eigen::Vector3d diagonal() const { return max - min; }
+};
+
+/** Box of the finite points (NaN corners if there are none). */
+BoundingBox boundingBox(const Eigen::Matrix3Xd& positions);
+
+}  // namespace pcl_ddg

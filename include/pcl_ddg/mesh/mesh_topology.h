@@ -1,0 +1,149 @@
+#pragma once
+// Connectivity of a polygon mesh, built once and shared by every operator.
+//
+// The input vertex numbering is kept, so per-vertex results align with the input cloud. Polygons
+// are fan-triangulated (corner 0 with every consecutive pair); triangles keep the input winding.
+// Triangle corner k faces edge k: edge k of triangle t joins corners k+1 and k+2 (mod 3).
+// Adjacency is stored in compressed rows (CSR): vertex -> sorted neighbours (with the edge id of
+// each), vertex -> incident triangles.
+#include <pcl/PolygonMesh.h>
+#include <pcl/Vertices.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+namespace pcl_ddg {
+
+/** What to do with a polygon that names a vertex that does not exist. */
+enum class OutOfRangeFacePolicy { Throw, Drop };
+
+/** A read-only view of a contiguous run of indices (one CSR row). */
+class IndexSpan {
+ public:
+  IndexSpan(const int* first, const int* last) : first_(first), last_(last) {}
+  const int* begin() const { return first_; }
+  const int* end() const { return last_; }
+  int size() const { return static_cast<int>(last_ - first_); }
+  bool empty() const { return first_ == last_; }
+  int operator[](int i) const { return first_[i]; }
+
+ private:
+  const int* first_;
+  const int* last_;
+};
+
+/** Topological defects and statistics, counted while the topology is built. */
+struct TopologyCounts {
+  /** polygons_by_valence[n] = number of input polygons with n corners (n = 0, 1, 2, ... ). */
+  std::vector<std::int64_t> polygons_by_valence;
+  std::int64_t input_polygons = 0;
+  std::int64_t out_of_range_polygons = 0;     ///< dropped (policy Drop)
+  std::int64_t repeated_index_polygons = 0;   ///< fewer than 3 distinct corners, or a repeated corner
+  std::int64_t duplicate_polygons = 0;        ///< same vertex set as an earlier polygon
+  std::int64_t triangulated_polygons = 0;     ///< polygons with more than three corners
+  std::int64_t boundary_edges = 0;            ///< edges of exactly one triangle
+  std::int64_t boundary_loops = 0;            ///< independent cycles of boundary edges
+  std::int64_t nonmanifold_edges = 0;         ///< edges of more than two triangles
+  std::int64_t nonmanifold_vertices = 0;      ///< vertices whose triangles form several fans
+  std::int64_t unreferenced_vertices = 0;     ///< vertices of no triangle
+  std::int64_t connected_components = 0;      ///< of the triangles (unreferenced vertices excluded)
+  bool orientable = true;                     ///< every component admits a consistent orientation
+  bool consistently_oriented = true;          ///< every manifold edge traversed once each way
+};
+
+/** Per-vertex flags, a bit set. */
+enum class VertexFlag : std::uint8_t {
+  Boundary = 1,           ///< on an edge of exactly one triangle
+  NonManifoldEdge = 2,    ///< on an edge of more than two triangles
+  NonManifoldVertex = 4,  ///< its triangles form more than one fan (bow-tie)
+  Isolated = 8,           ///< belongs to no triangle
+};
+
+class MeshTopology {
+ public:
+  /** Builds from a PCL mesh; the vertex count is the cloud's width x height. */
+  explicit MeshTopology(const pcl::PolygonMesh& mesh,
+                        OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw);
+
+  /** Builds from a vertex count and polygons (indices into 0..num_vertices-1). */
+  MeshTopology(int num_vertices, const std::vector<pcl::Vertices>& polygons,
+               OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw);
+
+  /** Builds from a vertex count and a 3 x T triangle index matrix. */
+  MeshTopology(int num_vertices, const Eigen::Matrix3Xi& triangles,
+               OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw);
+
+  int numVertices() const { return num_vertices_; }
+  int numTriangles() const { return static_cast<int>(triangles_.cols()); }
+  int numEdges() const { return static_cast<int>(edge_vertices_.cols()); }
+
+  /** 3 x T corner indices; triangle t comes from input polygon triangleSource()[t]. */
+  const Eigen::Matrix3Xi& triangles() const { return triangles_; }
+  const std::vector<int>& triangleSource() const { return triangle_source_; }
+  /** 3 x T edge ids; entry (k, t) is the edge opposite corner k. */
+  const Eigen::Matrix3Xi& triangleEdges() const { return triangle_edges_; }
+  /** 2 x E vertex pairs, first < second. */
+  const Eigen::Matrix2Xi& edgeVertices() const { return edge_vertices_; }
+  /** Number of triangles on each edge (1: boundary, 2: manifold interior, >2: non-manifold). */
+  const std::vector<int>& edgeTriangleCount() const { return edge_triangle_count_; }
+
+  /** Sorted distinct neighbours of v. */
+  IndexSpan neighbours(int v) const { return row(vv_offsets_, vv_neighbours_, v); }
+  /** Edge ids parallel to neighbours(v). */
+  IndexSpan neighbourEdges(int v) const { return row(vv_offsets_, vv_edges_, v); }
+  /** Triangles having v as a corner (a triangle repeats only if the input repeats it). */
+  IndexSpan incidentTriangles(int v) const { return row(vt_offsets_, vt_triangles_, v); }
+  /** The id of edge {a, b}, or -1 if no triangle has it. */
+  int findEdge(int a, int b) const;
+
+  bool hasFlag(int v, VertexFlag flag) const {
+    return (vertex_flags_[v] & static_cast<std::uint8_t>(flag)) != 0;
+  }
+  bool isBoundary(int v) const { return hasFlag(v, VertexFlag::Boundary); }
+  bool isIsolated(int v) const { return hasFlag(v, VertexFlag::Isolated); }
+  /** On a non-manifold edge or a bow-tie vertex. */
+  bool isNonManifold(int v) const {
+    return hasFlag(v, VertexFlag::NonManifoldEdge) || hasFlag(v, VertexFlag::NonManifoldVertex);
+  }
+  const std::vector<std::uint8_t>& vertexFlags() const { return vertex_flags_; }
+
+  /** Component id per vertex (0 .. components-1), -1 for an isolated vertex. */
+  const std::vector<int>& vertexComponent() const { return vertex_component_; }
+  const TopologyCounts& counts() const { return counts_; }
+
+  /** V - E + T over referenced vertices, unique edges and kept triangles. */
+  std::int64_t eulerCharacteristic() const;
+  /** Total genus when closed, edge-manifold and orientable; -1 otherwise. */
+  std::int64_t genus() const;
+
+ private:
+  static IndexSpan row(const std::vector<int>& offsets, const std::vector<int>& data, int v) {
+    return {data.data() + offsets[v], data.data() + offsets[v + 1]};
+  }
+  void build(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
+  void triangulate(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
+  void countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons);
+  void buildVertexTriangles();
+  void buildVertexNeighbours();
+  void buildEdges();
+  void classifyEdgesAndVertices();
+  void findBowTieVertices();
+  void findComponents();
+  void checkOrientation();
+  void countBoundaryLoops();
+
+  int num_vertices_ = 0;
+  Eigen::Matrix3Xi triangles_;
+  std::vector<int> triangle_source_;
+  Eigen::Matrix3Xi triangle_edges_;
+  Eigen::Matrix2Xi edge_vertices_;
+  std::vector<int> edge_triangle_count_;
+  std::vector<int> vv_offsets_, vv_neighbours_, vv_edges_;
+  std::vector<int> vt_offsets_, vt_triangles_;
+  std::vector<std::uint8_t> vertex_flags_;
+  std::vector<int> vertex_component_;
+  TopologyCounts counts_;
+};
+
+}  // namespace pcl_ddg

@@ -1,0 +1,32 @@
+#pragma once
+// Vertex coordinates between PCL clouds (float or double fields) and Eigen (double, 3 x N).
+#include <pcl/PCLPointCloud2.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+
+namespace pcl_ddg {
+
+/** What to do with a vertex whose coordinates are NaN or infinite. */
+enum class NonFinitePolicy { Throw, Keep };
+
+/** The first non-finite vertex (-1 if none) and how many there are. */
+struct NonFiniteVertices {
+  std::int64_t first = -1;
+  std::int64_t count = 0;
+};
+
+NonFiniteVertices findNonFiniteVertices(const Eigen::Matrix3Xd& positions);
+
+/**
+ * Reads the x, y, z fields (any numeric type) of every point into a 3 x N matrix in double.
+ * Throws InvalidMeshException if the cloud lacks x/y/z or, with NonFinitePolicy::Throw, if a
+ * coordinate is NaN or infinite (naming the first such vertex and the count).
+ */
+Eigen::Matrix3Xd vertexPositions(const pcl::PCLPointCloud2& cloud,
+                                 NonFinitePolicy policy = NonFinitePolicy::Throw);
+
+/** Throws InvalidMeshException naming the first non-finite vertex and the count, if any. */
+void requireFinite(const Eigen::Matrix3Xd& positions);
+
+}  // namespace pcl_ddg

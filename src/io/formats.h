@@ -1,0 +1,59 @@
+#pragma once
+// The mesh file formats, each parsed from the whole file in memory. Internal to pcl_ddg_io; use
+// loadMesh / saveMesh (pcl_ddg/io/mesh_io.h). Parsers throw FileFormatException on malformed or
+// truncated data and never return a partial mesh.
+#include <pcl/PolygonMesh.h>
+
+#include <limits>
+#include <ostream>
+#include <string_view>
+
+#include "pcl_ddg/io/mesh_io.h"
+
+namespace pcl_ddg {
+namespace detail {
+
+/** PLY, ascii or binary; faces from a `face` or a `tristrips` element; a `range_grid` element
+ *  turns a face-less scan into an organized cloud (NaN where the grid is empty). */
+pcl::PolygonMesh parsePLY(std::string_view data);
+/** OFF (also COFF/NOFF/CNOFF; extra per-vertex or per-face values ignored) and binary OFF. */
+pcl::PolygonMesh parseOFF(std::string_view data);
+/** Wavefront OBJ: `v` and `f` records (v, v/t, v//n, v/t/n, negative relative indices). */
+pcl::PolygonMesh parseOBJ(std::string_view data);
+/** STL, ascii or binary; identical corner coordinates are merged into one vertex. */
+pcl::PolygonMesh parseSTL(std::string_view data);
+/** Legacy VTK POLYDATA, ascii or binary, classic or 5.x (OFFSETS/CONNECTIVITY) cell layout;
+ *  POLYGONS and TRIANGLE_STRIPS become faces, other cells and attributes are ignored. */
+pcl::PolygonMesh parseVTK(std::string_view data);
+
+void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding);
+
+/** A corner index from a file; anything outside 0..INT_MAX becomes -1, which MeshTopology reports
+ *  as out of range. */
+inline pcl::index_t cornerIndex(std::int64_t i) {
+  return i < 0 || i > std::numeric_limits<pcl::index_t>::max() ? -1 : static_cast<pcl::index_t>(i);
+}
+
+/** Appends the triangles of a strip (alternating winding) to polygons, dropping the
+ *  zero-area triangles that repeated indices produce; a negative index restarts the strip. */
+template <typename Index>
+void appendTriangleStrip(const Index* strip, std::size_t n, std::vector<pcl::Vertices>& polygons) {
+  std::size_t start = 0;
+  for (std::size_t i = 0; i <= n; ++i) {
+    if (i < n && strip[i] >= 0) continue;
+    for (std::size_t k = start; k + 2 < i; ++k) {
+      const bool even = (k - start) % 2 == 0;
+      const auto a = cornerIndex(strip[k]);
+      const auto b = cornerIndex(strip[even ? k + 1 : k + 2]);
+      const auto c = cornerIndex(strip[even ? k + 2 : k + 1]);
+      if (a == b || b == c || a == c) continue;
+      pcl::Vertices triangle;
+      triangle.vertices = {a, b, c};
+      polygons.push_back(std::move(triangle));
+    }
+    start = i + 1;
+  }
+}
+
+}  // namespace detail
+}  // namespace pcl_ddg

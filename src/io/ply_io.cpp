@@ -1,0 +1,469 @@
+// PLY reader and writer. Our own because PCL's reader (and VTK's) silently return zero faces for
+// a `tristrips` face element; this one reads every element or fails with the reason.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <iomanip>
+#include <limits>
+#include <sstream>
+
+#include <pcl/common/io.h>
+
+#include "byte_cursor.h"
+#include "formats.h"
+
+namespace pcl_ddg {
+namespace detail {
+namespace {
+
+enum class PlyType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
+enum class PlyFormat { Ascii, BinaryLittleEndian, BinaryBigEndian };
+
+struct PlyProperty {
+  std::string name;
+  PlyType type = PlyType::Float32;
+  bool is_list = false;
+  PlyType count_type = PlyType::UInt8;
+};
+
+struct PlyElement {
+  std::string name;
+  std::int64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+struct PlyHeader {
+  PlyFormat format = PlyFormat::Ascii;
+  std::vector<PlyElement> elements;
+  std::int64_t grid_columns = 0;
+  std::int64_t grid_rows = 0;
+};
+
+PlyType parseType(std::string_view name, const ByteCursor& cursor) {
+  static const std::pair<const char*, PlyType> kNames[] = {
+      {"char", PlyType::Int8},     {"int8", PlyType::Int8},       {"uchar", PlyType::UInt8},
+      {"uint8", PlyType::UInt8},   {"short", PlyType::Int16},     {"int16", PlyType::Int16},
+      {"ushort", PlyType::UInt16}, {"uint16", PlyType::UInt16},   {"int", PlyType::Int32},
+      {"int32", PlyType::Int32},   {"uint", PlyType::UInt32},     {"uint32", PlyType::UInt32},
+      {"float", PlyType::Float32}, {"float32", PlyType::Float32}, {"double", PlyType::Float64},
+      {"float64", PlyType::Float64}};
+  for (const auto& [text, type] : kNames) {
+    if (name == text) return type;
+  }
+  cursor.fail("unknown PLY property type '" + std::string(name) + "'");
+}
+
+std::uint32_t typeSize(PlyType type) {
+  switch (type) {
+    case PlyType::Int8:
+    case PlyType::UInt8: return 1;
+    case PlyType::Int16:
+    case PlyType::UInt16: return 2;
+    case PlyType::Int32:
+    case PlyType::UInt32:
+    case PlyType::Float32: return 4;
+    case PlyType::Float64: return 8;
+  }
+  return 0;
+}
+
+std::uint8_t pclDatatype(PlyType type) {
+  switch (type) {
+    case PlyType::Int8: return pcl::PCLPointField::INT8;
+    case PlyType::UInt8: return pcl::PCLPointField::UINT8;
+    case PlyType::Int16: return pcl::PCLPointField::INT16;
+    case PlyType::UInt16: return pcl::PCLPointField::UINT16;
+    case PlyType::Int32: return pcl::PCLPointField::INT32;
+    case PlyType::UInt32: return pcl::PCLPointField::UINT32;
+    case PlyType::Float32: return pcl::PCLPointField::FLOAT32;
+    case PlyType::Float64: return pcl::PCLPointField::FLOAT64;
+  }
+  return 0;
+}
+
+PlyHeader parseHeader(ByteCursor& cursor) {
+  if (cursor.line() != "ply") cursor.fail("not a PLY file (first line is not 'ply')");
+  PlyHeader header;
+  bool has_format = false;
+  for (;;) {
+    if (cursor.atEnd()) cursor.fail("PLY header has no end_header");
+    std::istringstream words{std::string(cursor.line())};
+    std::string keyword;
+    words >> keyword;
+    if (keyword.empty() || keyword == "comment") continue;
+    if (keyword == "end_header") break;
+    if (keyword == "format") {
+      std::string format;
+      words >> format;
+      if (format == "ascii") {
+        header.format = PlyFormat::Ascii;
+      } else if (format == "binary_little_endian") {
+        header.format = PlyFormat::BinaryLittleEndian;
+      } else if (format == "binary_big_endian") {
+        header.format = PlyFormat::BinaryBigEndian;
+      } else {
+        cursor.fail("unknown PLY format '" + format + "'");
+      }
+      has_format = true;
+    } else if (keyword == "obj_info") {
+      std::string key;
+      std::int64_t value = 0;
+      words >> key >> value;
+      if (key == "num_cols") header.grid_columns = value;
+      if (key == "num_rows") header.grid_rows = value;
+    } else if (keyword == "element") {
+      PlyElement element;
+      if (!(words >> element.name >> element.count) || element.count < 0) {
+        cursor.fail("malformed PLY element line");
+      }
+      header.elements.push_back(element);
+    } else if (keyword == "property") {
+      if (header.elements.empty()) cursor.fail("PLY property before any element");
+      PlyProperty property;
+      std::string type;
+      words >> type;
+      if (type == "list") {
+        std::string count_type, item_type;
+        words >> count_type >> item_type;
+        property.is_list = true;
+        property.count_type = parseType(count_type, cursor);
+        property.type = parseType(item_type, cursor);
+      } else {
+        property.type = parseType(type, cursor);
+      }
+      if (!(words >> property.name)) cursor.fail("PLY property without a name");
+      header.elements.back().properties.push_back(property);
+    } else {
+      cursor.fail("unknown PLY header keyword '" + keyword + "'");
+    }
+  }
+  if (!has_format) cursor.fail("PLY header has no format line");
+  return header;
+}
+
+/** Reads the values of a PLY body in either encoding. */
+class PlyValueReader {
+ public:
+  PlyValueReader(ByteCursor& cursor, PlyFormat format)
+      : cursor_(cursor),
+        format_(format),
+        order_(format == PlyFormat::BinaryBigEndian ? ByteOrder::Big : ByteOrder::Little) {}
+
+  double number(PlyType type, const char* what) {
+    if (format_ == PlyFormat::Ascii) return cursor_.readDouble(what);
+    switch (type) {
+      case PlyType::Int8: return cursor_.readBinary<std::int8_t>(order_, what);
+      case PlyType::UInt8: return cursor_.readBinary<std::uint8_t>(order_, what);
+      case PlyType::Int16: return cursor_.readBinary<std::int16_t>(order_, what);
+      case PlyType::UInt16: return cursor_.readBinary<std::uint16_t>(order_, what);
+      case PlyType::Int32: return cursor_.readBinary<std::int32_t>(order_, what);
+      case PlyType::UInt32: return cursor_.readBinary<std::uint32_t>(order_, what);
+      case PlyType::Float32: return cursor_.readBinary<float>(order_, what);
+      case PlyType::Float64: return cursor_.readBinary<double>(order_, what);
+    }
+    return 0.0;
+  }
+
+  std::int64_t count(PlyType type, const char* what) {
+    const double n = number(type, what);
+    if (!(n >= 0.0) || n != std::floor(n) || n > 1e9) {
+      cursor_.fail(std::string("invalid list length in ") + what);
+    }
+    return static_cast<std::int64_t>(n);
+  }
+
+  /** Stores one scalar in its PLY type at dst (host byte order). */
+  void scalarInto(PlyType type, std::uint8_t* dst, const char* what) {
+    const std::uint32_t size = typeSize(type);
+    if (format_ != PlyFormat::Ascii) {
+      std::memcpy(dst, cursor_.take(size, what), size);
+      if (order_ == ByteOrder::Big) std::reverse(dst, dst + size);
+      return;
+    }
+    const double v = cursor_.readDouble(what);
+    switch (type) {
+      case PlyType::Int8: store<std::int8_t>(v, dst); break;
+      case PlyType::UInt8: store<std::uint8_t>(v, dst); break;
+      case PlyType::Int16: store<std::int16_t>(v, dst); break;
+      case PlyType::UInt16: store<std::uint16_t>(v, dst); break;
+      case PlyType::Int32: store<std::int32_t>(v, dst); break;
+      case PlyType::UInt32: store<std::uint32_t>(v, dst); break;
+      case PlyType::Float32: store<float>(v, dst); break;
+      case PlyType::Float64: store<double>(v, dst); break;
+    }
+  }
+
+  void skip(const PlyProperty& property, const char* what) {
+    const std::int64_t n = property.is_list ? count(property.count_type, what) : 1;
+    for (std::int64_t i = 0; i < n; ++i) number(property.type, what);
+  }
+
+ private:
+  template <typename T>
+  static void store(double v, std::uint8_t* dst) {
+    const T value = static_cast<T>(v);
+    std::memcpy(dst, &value, sizeof(T));
+  }
+  ByteCursor& cursor_;
+  PlyFormat format_;
+  ByteOrder order_;
+};
+
+void readVertices(const PlyElement& element, PlyValueReader& reader, pcl::PCLPointCloud2& cloud) {
+  std::uint32_t offset = 0;
+  for (const auto& p : element.properties) {
+    if (p.is_list) continue;  // per-vertex lists have no place in a point cloud
+    pcl::PCLPointField field;
+    field.name = p.name;
+    field.offset = offset;
+    field.datatype = pclDatatype(p.type);
+    field.count = 1;
+    cloud.fields.push_back(field);
+    offset += typeSize(p.type);
+  }
+  cloud.width = static_cast<std::uint32_t>(element.count);
+  cloud.height = 1;
+  cloud.point_step = offset;
+  cloud.row_step = offset * cloud.width;
+  cloud.data.resize(static_cast<std::size_t>(cloud.row_step));
+  for (std::int64_t i = 0; i < element.count; ++i) {
+    std::uint8_t* point = cloud.data.data() + i * offset;
+    std::size_t field = 0;
+    for (const auto& p : element.properties) {
+      if (p.is_list) {
+        reader.skip(p, "vertex list property");
+      } else {
+        reader.scalarInto(p.type, point + cloud.fields[field++].offset, "vertex");
+      }
+    }
+  }
+  cloud.is_dense = false;  // unknown until checked; consumers test finiteness themselves
+}
+
+const PlyProperty* indexList(const PlyElement& element) {
+  for (const auto& p : element.properties) {
+    if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) return &p;
+  }
+  return nullptr;
+}
+
+// Calls on_list(indices) for each row's index list; other properties are skipped.
+template <typename OnList>
+void readIndexLists(const PlyElement& element, PlyValueReader& reader, ByteCursor& cursor,
+                    OnList on_list) {
+  const PlyProperty* list = indexList(element);
+  if (list == nullptr) cursor.fail("PLY element '" + element.name + "' has no vertex_indices list");
+  std::vector<std::int64_t> indices;
+  for (std::int64_t row = 0; row < element.count; ++row) {
+    for (const auto& p : element.properties) {
+      if (&p != list) {
+        reader.skip(p, element.name.c_str());
+        continue;
+      }
+      const std::int64_t n = reader.count(p.count_type, element.name.c_str());
+      indices.resize(static_cast<std::size_t>(n));
+      for (auto& index : indices) {
+        index = static_cast<std::int64_t>(reader.number(p.type, element.name.c_str()));
+      }
+      on_list(indices);
+    }
+  }
+}
+
+// Lays the scan out on its range grid: row-major cells, a point where the grid names one, NaN
+// (non-float fields zero) where it is empty.
+pcl::PCLPointCloud2 organizeOnGrid(const pcl::PCLPointCloud2& points,
+                                   const std::vector<std::int64_t>& cell_point,
+                                   const PlyHeader& header, const ByteCursor& cursor) {
+  pcl::PCLPointCloud2 grid = points;
+  grid.width = static_cast<std::uint32_t>(header.grid_columns);
+  grid.height = static_cast<std::uint32_t>(header.grid_rows);
+  grid.row_step = grid.point_step * grid.width;
+  grid.data.assign(static_cast<std::size_t>(grid.row_step) * grid.height, 0);
+  grid.is_dense = false;
+  const float nan_f = std::numeric_limits<float>::quiet_NaN();
+  const double nan_d = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t cell = 0; cell < cell_point.size(); ++cell) {
+    std::uint8_t* dst = grid.data.data() + cell * grid.point_step;
+    const std::int64_t i = cell_point[cell];
+    if (i >= static_cast<std::int64_t>(points.width)) {
+      cursor.fail("range_grid names vertex " + std::to_string(i) + " of " +
+                  std::to_string(points.width));
+    }
+    if (i >= 0) {
+      std::memcpy(dst, points.data.data() + i * points.point_step, points.point_step);
+      continue;
+    }
+    for (const auto& f : grid.fields) {
+      if (f.datatype == pcl::PCLPointField::FLOAT32) std::memcpy(dst + f.offset, &nan_f, 4);
+      if (f.datatype == pcl::PCLPointField::FLOAT64) std::memcpy(dst + f.offset, &nan_d, 8);
+    }
+  }
+  return grid;
+}
+
+}  // namespace
+
+pcl::PolygonMesh parsePLY(std::string_view data) {
+  ByteCursor cursor(data);
+  const PlyHeader header = parseHeader(cursor);
+  PlyValueReader reader(cursor, header.format);
+  pcl::PolygonMesh mesh;
+  bool has_vertices = false;
+  std::vector<std::int64_t> grid_cells;
+  bool has_grid = false;
+  for (const PlyElement& element : header.elements) {
+    if (element.name == "vertex") {
+      readVertices(element, reader, mesh.cloud);
+      has_vertices = true;
+    } else if (element.name == "face") {
+      mesh.polygons.reserve(mesh.polygons.size() + static_cast<std::size_t>(element.count));
+      readIndexLists(element, reader, cursor, [&](const std::vector<std::int64_t>& indices) {
+        pcl::Vertices polygon;
+        polygon.vertices.reserve(indices.size());
+        for (std::int64_t i : indices) polygon.vertices.push_back(cornerIndex(i));
+        mesh.polygons.push_back(std::move(polygon));
+      });
+    } else if (element.name == "tristrips") {
+      readIndexLists(element, reader, cursor, [&](const std::vector<std::int64_t>& strip) {
+        appendTriangleStrip(strip.data(), strip.size(), mesh.polygons);
+      });
+    } else if (element.name == "range_grid") {
+      has_grid = true;
+      grid_cells.reserve(static_cast<std::size_t>(element.count));
+      readIndexLists(element, reader, cursor, [&](const std::vector<std::int64_t>& cell) {
+        grid_cells.push_back(cell.empty() ? -1 : cell.front());
+      });
+    } else {
+      for (std::int64_t row = 0; row < element.count; ++row) {
+        for (const auto& p : element.properties) reader.skip(p, element.name.c_str());
+      }
+    }
+  }
+  if (!has_vertices) cursor.fail("PLY file has no vertex element");
+  if (has_grid && mesh.polygons.empty()) {
+    if (header.grid_columns <= 0 || header.grid_rows <= 0 ||
+        header.grid_columns * header.grid_rows != static_cast<std::int64_t>(grid_cells.size())) {
+      cursor.fail("range_grid size does not match obj_info num_cols x num_rows");
+    }
+    mesh.cloud = organizeOnGrid(mesh.cloud, grid_cells, header, cursor);
+  }
+  return mesh;
+}
+
+namespace {
+
+const char* plyTypeName(std::uint8_t datatype) {
+  switch (datatype) {
+    case pcl::PCLPointField::INT8: return "char";
+    case pcl::PCLPointField::UINT8: return "uchar";
+    case pcl::PCLPointField::INT16: return "short";
+    case pcl::PCLPointField::UINT16: return "ushort";
+    case pcl::PCLPointField::INT32: return "int";
+    case pcl::PCLPointField::UINT32: return "uint";
+    case pcl::PCLPointField::FLOAT64: return "double";
+    default: return "float";
+  }
+}
+
+// One PLY scalar property to write: a cloud field, or one channel of a packed rgb(a) field.
+struct OutputProperty {
+  std::string name;
+  std::uint8_t datatype;
+  std::uint32_t offset;
+};
+
+std::vector<OutputProperty> outputProperties(const pcl::PCLPointCloud2& cloud) {
+  std::vector<OutputProperty> properties;
+  for (const auto& f : cloud.fields) {
+    if (f.name == "rgb" || f.name == "rgba") {
+      // PCL packs colour as BGRA bytes in a 4-byte field; PLY viewers expect uchar channels.
+      properties.push_back({"red", pcl::PCLPointField::UINT8, f.offset + 2});
+      properties.push_back({"green", pcl::PCLPointField::UINT8, f.offset + 1});
+      properties.push_back({"blue", pcl::PCLPointField::UINT8, f.offset + 0});
+      if (f.name == "rgba") properties.push_back({"alpha", pcl::PCLPointField::UINT8, f.offset + 3});
+    } else if (f.count == 1 && !f.name.empty() && f.name != "_") {
+      properties.push_back({f.name, f.datatype, f.offset});
+    }
+  }
+  return properties;
+}
+
+template <typename T>
+void printValue(std::ostream& out, const std::uint8_t* p) {
+  T v;
+  std::memcpy(&v, p, sizeof(T));
+  if constexpr (sizeof(T) == 1) {
+    out << static_cast<int>(v);
+  } else {
+    out << v;
+  }
+}
+
+void printScalar(std::ostream& out, const std::uint8_t* p, std::uint8_t datatype) {
+  switch (datatype) {
+    case pcl::PCLPointField::INT8: printValue<std::int8_t>(out, p); break;
+    case pcl::PCLPointField::UINT8: printValue<std::uint8_t>(out, p); break;
+    case pcl::PCLPointField::INT16: printValue<std::int16_t>(out, p); break;
+    case pcl::PCLPointField::UINT16: printValue<std::uint16_t>(out, p); break;
+    case pcl::PCLPointField::INT32: printValue<std::int32_t>(out, p); break;
+    case pcl::PCLPointField::UINT32: printValue<std::uint32_t>(out, p); break;
+    case pcl::PCLPointField::FLOAT64:
+      out << std::setprecision(std::numeric_limits<double>::max_digits10);
+      printValue<double>(out, p);
+      break;
+    default:
+      out << std::setprecision(std::numeric_limits<float>::max_digits10);
+      printValue<float>(out, p);
+  }
+}
+
+}  // namespace
+
+// Binary output is little-endian: the byte order of every platform PCL supports.
+void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding) {
+  const pcl::PCLPointCloud2& cloud = mesh.cloud;
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  const std::vector<OutputProperty> properties = outputProperties(cloud);
+  const bool binary = encoding == PlyEncoding::Binary;
+  out << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\n"
+      << "comment written by pcl_ddg\n"
+      << "element vertex " << n << "\n";
+  for (const auto& p : properties) out << "property " << plyTypeName(p.datatype) << " " << p.name << "\n";
+  out << "element face " << mesh.polygons.size() << "\n"
+      << "property list uchar int vertex_indices\nend_header\n";
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
+    for (std::size_t k = 0; k < properties.size(); ++k) {
+      const OutputProperty& p = properties[k];
+      if (binary) {
+        out.write(reinterpret_cast<const char*>(point + p.offset),
+                  pcl::getFieldSize(p.datatype));
+      } else {
+        if (k) out << ' ';
+        printScalar(out, point + p.offset, p.datatype);
+      }
+    }
+    if (!binary) out << '\n';
+  }
+  for (const auto& polygon : mesh.polygons) {
+    if (polygon.vertices.size() > 255) {
+      throw FileFormatException("a face with more than 255 corners cannot be written to PLY");
+    }
+    const auto corners = static_cast<std::uint8_t>(polygon.vertices.size());
+    if (binary) {
+      out.put(static_cast<char>(corners));
+      for (const pcl::index_t v : polygon.vertices) {
+        const auto index = static_cast<std::int32_t>(v);
+        out.write(reinterpret_cast<const char*>(&index), 4);
+      }
+    } else {
+      out << static_cast<int>(corners);
+      for (const pcl::index_t v : polygon.vertices) out << ' ' << v;
+      out << '\n';
+    }
+  }
+}
+
+}  // namespace detail
+}  // namespace pcl_ddg

@@ -1,0 +1,382 @@
+#include "pcl_ddg/mesh/mesh_topology.h"
+
+#include <algorithm>
+#include <numeric>
+#include <sstream>
+
+#include "disjoint_sets.h"
+#include "pcl_ddg/exceptions.h"
+
+namespace pcl_ddg {
+namespace {
+
+std::vector<pcl::Vertices> trianglesAsPolygons(const Eigen::Matrix3Xi& triangles) {
+  std::vector<pcl::Vertices> polygons(triangles.cols());
+  for (Eigen::Index t = 0; t < triangles.cols(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      polygons[t].vertices.push_back(triangles(k, t));
+    }
+  }
+  return polygons;
+}
+
+bool hasRepeatedCorner(const pcl::Indices& corners) {
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    for (std::size_t j = i + 1; j < corners.size(); ++j) {
+      if (corners[i] == corners[j]) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+MeshTopology::MeshTopology(const pcl::PolygonMesh& mesh, OutOfRangeFacePolicy policy)
+    : num_vertices_(static_cast<int>(mesh.cloud.width * mesh.cloud.height)) {
+  build(mesh.polygons, policy);
+}
+
+MeshTopology::MeshTopology(int num_vertices, const std::vector<pcl::Vertices>& polygons,
+                           OutOfRangeFacePolicy policy)
+    : num_vertices_(num_vertices) {
+  build(polygons, policy);
+}
+
+MeshTopology::MeshTopology(int num_vertices, const Eigen::Matrix3Xi& triangles,
+                           OutOfRangeFacePolicy policy)
+    : num_vertices_(num_vertices) {
+  build(trianglesAsPolygons(triangles), policy);
+}
+
+void MeshTopology::build(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy) {
+  if (num_vertices_ <= 0) throw InvalidMeshException("mesh has no vertices");
+  triangulate(polygons, policy);
+  countDuplicatePolygons(polygons);
+  buildVertexTriangles();
+  buildVertexNeighbours();
+  buildEdges();
+  classifyEdgesAndVertices();
+  findBowTieVertices();
+  findComponents();
+  checkOrientation();
+  countBoundaryLoops();
+}
+
+void MeshTopology::triangulate(const std::vector<pcl::Vertices>& polygons,
+                               OutOfRangeFacePolicy policy) {
+  auto invalid = [&](pcl::index_t i) { return i < 0 || i >= num_vertices_; };
+  auto out_of_range = [&](const pcl::Vertices& p) {
+    return std::any_of(p.vertices.begin(), p.vertices.end(), invalid);
+  };
+  std::int64_t first_bad = -1;
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    if (!out_of_range(polygons[i])) continue;
+    if (first_bad < 0) first_bad = static_cast<std::int64_t>(i);
+    ++counts_.out_of_range_polygons;
+  }
+  if (first_bad >= 0 && policy == OutOfRangeFacePolicy::Throw) {
+    const auto& corners = polygons[first_bad].vertices;
+    const auto bad = *std::find_if(corners.begin(), corners.end(), invalid);
+    std::ostringstream msg;
+    msg << "face " << first_bad << " refers to vertex " << bad
+        << " but the mesh has " << num_vertices_ << " vertices (" << counts_.out_of_range_polygons
+        << " faces out of range)";
+    throw InvalidMeshException(msg.str());
+  }
+
+  counts_.input_polygons = static_cast<std::int64_t>(polygons.size());
+  std::size_t num_triangles = 0;
+  for (const auto& p : polygons) {
+    const std::size_t n = p.vertices.size();
+    if (counts_.polygons_by_valence.size() <= n) counts_.polygons_by_valence.resize(n + 1, 0);
+    ++counts_.polygons_by_valence[n];
+    if (n >= 3) num_triangles += n - 2;
+  }
+
+  triangles_.resize(3, static_cast<Eigen::Index>(num_triangles));
+  triangle_source_.clear();
+  triangle_source_.reserve(num_triangles);
+  Eigen::Index t = 0;
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    const auto& c = polygons[i].vertices;
+    if (first_bad >= 0 && out_of_range(polygons[i])) continue;
+    if (c.size() < 3 || hasRepeatedCorner(c)) ++counts_.repeated_index_polygons;
+    if (c.size() > 3) ++counts_.triangulated_polygons;
+    for (std::size_t k = 1; k + 1 < c.size(); ++k) {
+      if (c[0] == c[k] || c[k] == c[k + 1] || c[0] == c[k + 1]) continue;
+      triangles_.col(t++) << c[0], c[k], c[k + 1];
+      triangle_source_.push_back(static_cast<int>(i));
+    }
+  }
+  triangles_.conservativeResize(3, t);
+}
+
+void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons) {
+  // Sort each polygon's corner set into one flat buffer, then sort polygons by that key.
+  std::vector<std::size_t> offsets(polygons.size() + 1, 0);
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    offsets[i + 1] = offsets[i] + polygons[i].vertices.size();
+  }
+  std::vector<pcl::index_t> keys(offsets.back());
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    std::copy(polygons[i].vertices.begin(), polygons[i].vertices.end(), keys.begin() + offsets[i]);
+    std::sort(keys.begin() + offsets[i], keys.begin() + offsets[i + 1]);
+  }
+  auto key_less = [&](std::size_t a, std::size_t b) {
+    return std::lexicographical_compare(keys.begin() + offsets[a], keys.begin() + offsets[a + 1],
+                                        keys.begin() + offsets[b], keys.begin() + offsets[b + 1]);
+  };
+  std::vector<std::size_t> order(polygons.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), key_less);
+  for (std::size_t i = 1; i < order.size(); ++i) {
+    if (polygons[order[i]].vertices.size() >= 3 && !key_less(order[i - 1], order[i])) {
+      ++counts_.duplicate_polygons;
+    }
+  }
+}
+
+void MeshTopology::buildVertexTriangles() {
+  vt_offsets_.assign(num_vertices_ + 1, 0);
+  for (Eigen::Index t = 0; t < triangles_.cols(); ++t) {
+    for (int k = 0; k < 3; ++k) ++vt_offsets_[triangles_(k, t) + 1];
+  }
+  std::partial_sum(vt_offsets_.begin(), vt_offsets_.end(), vt_offsets_.begin());
+  vt_triangles_.resize(vt_offsets_.back());
+  std::vector<int> cursor(vt_offsets_.begin(), vt_offsets_.end() - 1);
+  for (Eigen::Index t = 0; t < triangles_.cols(); ++t) {
+    for (int k = 0; k < 3; ++k) vt_triangles_[cursor[triangles_(k, t)]++] = static_cast<int>(t);
+  }
+}
+
+void MeshTopology::buildVertexNeighbours() {
+  // Each incident triangle offers two neighbours; gather them into a row of twice the triangle
+  // count, sort and deduplicate it in place, then compact the rows.
+  std::vector<int> scratch(2 * vt_triangles_.size());
+  std::vector<int> row_size(num_vertices_, 0);
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < num_vertices_; ++v) {
+    int* out = scratch.data() + 2 * vt_offsets_[v];
+    int n = 0;
+    for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
+      const int t = vt_triangles_[i];
+      for (int k = 0; k < 3; ++k) {
+        const int w = triangles_(k, t);
+        if (w != v) out[n++] = w;
+      }
+    }
+    std::sort(out, out + n);
+    row_size[v] = static_cast<int>(std::unique(out, out + n) - out);
+  }
+  vv_offsets_.assign(num_vertices_ + 1, 0);
+  for (int v = 0; v < num_vertices_; ++v) vv_offsets_[v + 1] = vv_offsets_[v] + row_size[v];
+  vv_neighbours_.resize(vv_offsets_.back());
+  for (int v = 0; v < num_vertices_; ++v) {
+    const int* in = scratch.data() + 2 * vt_offsets_[v];
+    std::copy(in, in + row_size[v], vv_neighbours_.begin() + vv_offsets_[v]);
+  }
+}
+
+int MeshTopology::findEdge(int a, int b) const {
+  const IndexSpan row_a = neighbours(a);
+  const int* it = std::lower_bound(row_a.begin(), row_a.end(), b);
+  if (it == row_a.end() || *it != b) return -1;
+  return vv_edges_[vv_offsets_[a] + static_cast<int>(it - row_a.begin())];
+}
+
+void MeshTopology::buildEdges() {
+  // Edge ids are assigned in order of (smaller vertex, larger vertex).
+  vv_edges_.assign(vv_neighbours_.size(), -1);
+  int num_edges = 0;
+  for (int v = 0; v < num_vertices_; ++v) {
+    for (int i = vv_offsets_[v]; i < vv_offsets_[v + 1]; ++i) {
+      if (vv_neighbours_[i] > v) vv_edges_[i] = num_edges++;
+    }
+  }
+  edge_vertices_.resize(2, num_edges);
+  for (int v = 0; v < num_vertices_; ++v) {
+    for (int i = vv_offsets_[v]; i < vv_offsets_[v + 1]; ++i) {
+      const int w = vv_neighbours_[i];
+      if (w > v) {
+        edge_vertices_.col(vv_edges_[i]) << v, w;
+      } else {
+        vv_edges_[i] = findEdge(w, v);
+      }
+    }
+  }
+  triangle_edges_.resize(3, triangles_.cols());
+  edge_triangle_count_.assign(num_edges, 0);
+  for (Eigen::Index t = 0; t < triangles_.cols(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const int e = findEdge(triangles_((k + 1) % 3, t), triangles_((k + 2) % 3, t));
+      triangle_edges_(k, t) = e;
+      ++edge_triangle_count_[e];
+    }
+  }
+}
+
+void MeshTopology::classifyEdgesAndVertices() {
+  vertex_flags_.assign(num_vertices_, 0);
+  for (int e = 0; e < numEdges(); ++e) {
+    const int count = edge_triangle_count_[e];
+    VertexFlag flag;
+    if (count == 1) {
+      ++counts_.boundary_edges;
+      flag = VertexFlag::Boundary;
+    } else if (count > 2) {
+      ++counts_.nonmanifold_edges;
+      flag = VertexFlag::NonManifoldEdge;
+    } else {
+      continue;
+    }
+    vertex_flags_[edge_vertices_(0, e)] |= static_cast<std::uint8_t>(flag);
+    vertex_flags_[edge_vertices_(1, e)] |= static_cast<std::uint8_t>(flag);
+  }
+  for (int v = 0; v < num_vertices_; ++v) {
+    if (vt_offsets_[v] == vt_offsets_[v + 1]) {
+      vertex_flags_[v] |= static_cast<std::uint8_t>(VertexFlag::Isolated);
+      ++counts_.unreferenced_vertices;
+    }
+  }
+}
+
+void MeshTopology::findBowTieVertices() {
+  // The triangles around v form fans: two are in one fan when they share an edge at v.
+  // More than one fan means the surface is pinched at v.
+  int max_valence = 0;
+  for (int v = 0; v < num_vertices_; ++v) {
+    max_valence = std::max(max_valence, vt_offsets_[v + 1] - vt_offsets_[v]);
+  }
+  std::vector<int> parent(max_valence);
+  std::vector<int> first_triangle_at_neighbour(max_valence * 2);
+  auto find = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (int v = 0; v < num_vertices_; ++v) {
+    const IndexSpan tris = incidentTriangles(v);
+    const IndexSpan ring = neighbours(v);
+    if (tris.size() < 2) continue;
+    std::iota(parent.begin(), parent.begin() + tris.size(), 0);
+    std::fill(first_triangle_at_neighbour.begin(), first_triangle_at_neighbour.begin() + ring.size(),
+              -1);
+    int fans = tris.size();
+    for (int i = 0; i < tris.size(); ++i) {
+      for (int k = 0; k < 3; ++k) {
+        const int w = triangles_(k, tris[i]);
+        if (w == v) continue;
+        const int slot = static_cast<int>(std::lower_bound(ring.begin(), ring.end(), w) - ring.begin());
+        int& first = first_triangle_at_neighbour[slot];
+        if (first < 0) {
+          first = i;
+        } else {
+          const int a = find(first), b = find(i);
+          if (a != b) {
+            parent[a] = b;
+            --fans;
+          }
+        }
+      }
+    }
+    if (fans > 1) {
+      vertex_flags_[v] |= static_cast<std::uint8_t>(VertexFlag::NonManifoldVertex);
+      ++counts_.nonmanifold_vertices;
+    }
+  }
+}
+
+void MeshTopology::findComponents() {
+  detail::DisjointSets sets(num_vertices_);
+  for (Eigen::Index t = 0; t < triangles_.cols(); ++t) {
+    sets.unite(triangles_(0, t), triangles_(1, t));
+    sets.unite(triangles_(0, t), triangles_(2, t));
+  }
+  vertex_component_.assign(num_vertices_, -1);
+  std::vector<int> component_of_root(num_vertices_, -1);
+  int components = 0;
+  for (int v = 0; v < num_vertices_; ++v) {
+    if (isIsolated(v)) continue;
+    int& id = component_of_root[sets.find(v)];
+    if (id < 0) id = components++;
+    vertex_component_[v] = id;
+  }
+  counts_.connected_components = components;
+}
+
+void MeshTopology::checkOrientation() {
+  // Union-find over triangles that also tracks, for each triangle, whether it must be flipped
+  // relative to its root. A manifold edge traversed the same way by both of its triangles asks
+  // for a relative flip; a contradiction means the component is not orientable.
+  const int num_triangles = numTriangles();
+  std::vector<int> parent(num_triangles);
+  std::vector<char> flip_to_parent(num_triangles, 0);
+  std::iota(parent.begin(), parent.end(), 0);
+  auto find = [&](int t, char& flip) {
+    flip = 0;
+    while (parent[t] != t) {
+      flip ^= flip_to_parent[t];
+      t = parent[t];
+    }
+    return t;
+  };
+  std::vector<int> first_triangle(numEdges(), -1);
+  std::vector<char> first_forward(numEdges(), 0);
+  for (int t = 0; t < num_triangles; ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const int e = triangle_edges_(k, t);
+      if (edge_triangle_count_[e] != 2) continue;
+      const char forward = triangles_((k + 1) % 3, t) < triangles_((k + 2) % 3, t);
+      if (first_triangle[e] < 0) {
+        first_triangle[e] = t;
+        first_forward[e] = forward;
+        continue;
+      }
+      const char relative_flip = forward == first_forward[e];
+      if (relative_flip) counts_.consistently_oriented = false;
+      char flip_a, flip_b;
+      const int a = find(first_triangle[e], flip_a);
+      const int b = find(t, flip_b);
+      if (a == b) {
+        if ((flip_a ^ flip_b) != relative_flip) counts_.orientable = false;
+      } else {
+        parent[b] = a;
+        flip_to_parent[b] = flip_a ^ flip_b ^ relative_flip;
+      }
+    }
+  }
+}
+
+void MeshTopology::countBoundaryLoops() {
+  // Each connected piece of the boundary-edge graph holds E - V + 1 independent cycles (at least
+  // one): a simple hole is one loop, two holes touching at a vertex are two.
+  detail::DisjointSets sets(num_vertices_);
+  for (int e = 0; e < numEdges(); ++e) {
+    if (edge_triangle_count_[e] == 1) sets.unite(edge_vertices_(0, e), edge_vertices_(1, e));
+  }
+  std::vector<std::int64_t> edges_of_root(num_vertices_, 0), vertices_of_root(num_vertices_, 0);
+  for (int e = 0; e < numEdges(); ++e) {
+    if (edge_triangle_count_[e] == 1) ++edges_of_root[sets.find(edge_vertices_(0, e))];
+  }
+  for (int v = 0; v < num_vertices_; ++v) {
+    if (isBoundary(v)) ++vertices_of_root[sets.find(v)];
+  }
+  for (int r = 0; r < num_vertices_; ++r) {
+    if (edges_of_root[r] > 0) {
+      counts_.boundary_loops += std::max<std::int64_t>(1, edges_of_root[r] - vertices_of_root[r] + 1);
+    }
+  }
+}
+
+std::int64_t MeshTopology::eulerCharacteristic() const {
+  return static_cast<std::int64_t>(num_vertices_) - counts_.unreferenced_vertices - numEdges() +
+         numTriangles();
+}
+
+std::int64_t MeshTopology::genus() const {
+  const bool closed_manifold = counts_.boundary_edges == 0 && counts_.nonmanifold_edges == 0 &&
+                               counts_.nonmanifold_vertices == 0 && counts_.orientable;
+  if (!closed_manifold || counts_.connected_components == 0) return -1;
+  return (2 * counts_.connected_components - eulerCharacteristic()) / 2;
+}
+
+}  // namespace pcl_ddg

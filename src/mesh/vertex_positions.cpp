@@ -1,0 +1,83 @@
+#include "pcl_ddg/mesh/vertex_positions.h"
+
+#include <pcl/PCLPointField.h>
+
+#include <cstring>
+#include <sstream>
+#include <string>
+
+#include "pcl_ddg/exceptions.h"
+
+namespace pcl_ddg {
+namespace {
+
+template <typename T>
+double load(const std::uint8_t* p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  return static_cast<double>(value);
+}
+
+double readScalar(const std::uint8_t* p, std::uint8_t datatype) {
+  switch (datatype) {
+    case pcl::PCLPointField::INT8: return load<std::int8_t>(p);
+    case pcl::PCLPointField::UINT8: return load<std::uint8_t>(p);
+    case pcl::PCLPointField::INT16: return load<std::int16_t>(p);
+    case pcl::PCLPointField::UINT16: return load<std::uint16_t>(p);
+    case pcl::PCLPointField::INT32: return load<std::int32_t>(p);
+    case pcl::PCLPointField::UINT32: return load<std::uint32_t>(p);
+    case pcl::PCLPointField::FLOAT32: return load<float>(p);
+    case pcl::PCLPointField::FLOAT64: return load<double>(p);
+    default: throw InvalidMeshException("unsupported coordinate field type");
+  }
+}
+
+const pcl::PCLPointField& coordinateField(const pcl::PCLPointCloud2& cloud, const char* name) {
+  for (const auto& f : cloud.fields) {
+    if (f.name == name) return f;
+  }
+  throw InvalidMeshException(std::string("vertex data has no '") + name + "' field");
+}
+
+}  // namespace
+
+NonFiniteVertices findNonFiniteVertices(const Eigen::Matrix3Xd& positions) {
+  NonFiniteVertices result;
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+    if (positions.col(i).allFinite()) continue;
+    if (result.first < 0) result.first = i;
+    ++result.count;
+  }
+  return result;
+}
+
+void requireFinite(const Eigen::Matrix3Xd& positions) {
+  const NonFiniteVertices bad = findNonFiniteVertices(positions);
+  if (bad.count == 0) return;
+  std::ostringstream msg;
+  msg << "vertex " << bad.first << " has a non-finite coordinate (" << bad.count
+      << " such vertices)";
+  throw InvalidMeshException(msg.str());
+}
+
+Eigen::Matrix3Xd vertexPositions(const pcl::PCLPointCloud2& cloud, NonFinitePolicy policy) {
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  if (n == 0) throw InvalidMeshException("mesh has no vertices");
+  if (cloud.data.size() < n * cloud.point_step) {
+    throw InvalidMeshException("vertex data is shorter than width x height x point_step");
+  }
+  const pcl::PCLPointField* fields[3] = {&coordinateField(cloud, "x"), &coordinateField(cloud, "y"),
+                                         &coordinateField(cloud, "z")};
+  Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
+    for (int d = 0; d < 3; ++d) {
+      positions(d, static_cast<Eigen::Index>(i)) =
+          readScalar(point + fields[d]->offset, fields[d]->datatype);
+    }
+  }
+  if (policy == NonFinitePolicy::Throw) requireFinite(positions);
+  return positions;
+}
+
+}  // namespace pcl_ddg

@@ -1,0 +1,125 @@
+#include "common/tool_common.h"
+
+#include <pcl/console/print.h>
+#include <pcl/exceptions.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+
+namespace pcl_ddg {
+namespace tools {
+namespace {
+
+bool isOption(const std::string& arg) {
+  // "-k" is an option; "-1.5" is a (negative) number.
+  return arg.size() > 1 && arg[0] == '-' && !std::isdigit(static_cast<unsigned char>(arg[1])) &&
+         arg[1] != '.';
+}
+
+}  // namespace
+
+ToolArguments::ToolArguments(int argc, char** argv, const std::set<std::string>& value_options,
+                             const std::set<std::string>& switches) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (!isOption(arg)) {
+      positional_.push_back(arg);
+      continue;
+    }
+    const std::string name = arg.substr(arg.find_first_not_of('-'));
+    if (name == "h" || name == "help") {
+      throw HelpRequested();
+    } else if (value_options.count(name)) {
+      if (i + 1 >= argc) throw UsageError("option -" + name + " needs a value");
+      values_[name] = argv[++i];
+    } else if (switches.count(name)) {
+      switches_.insert(name);
+    } else {
+      throw UsageError("unknown option " + arg);
+    }
+  }
+}
+
+bool ToolArguments::has(const std::string& option) const {
+  return switches_.count(option) > 0 || values_.count(option) > 0;
+}
+
+std::optional<std::string> ToolArguments::value(const std::string& option) const {
+  const auto it = values_.find(option);
+  if (it == values_.end()) return std::nullopt;
+  return it->second;
+}
+
+std::string ToolArguments::text(const std::string& option, const std::string& fallback) const {
+  return value(option).value_or(fallback);
+}
+
+std::string ToolArguments::choice(const std::string& option, const std::vector<std::string>& choices,
+                                  const std::string& fallback) const {
+  const std::string chosen = text(option, fallback);
+  for (const auto& c : choices) {
+    if (c == chosen) return chosen;
+  }
+  std::string list;
+  for (const auto& c : choices) list += (list.empty() ? "" : "|") + c;
+  throw UsageError("-" + option + " must be one of " + list + ", not '" + chosen + "'");
+}
+
+double ToolArguments::number(const std::string& option, double fallback) const {
+  const auto v = value(option);
+  if (!v) return fallback;
+  char* end = nullptr;
+  const double x = std::strtod(v->c_str(), &end);
+  if (end == v->c_str() || *end != '\0' || !std::isfinite(x)) {
+    throw UsageError("-" + option + " needs a number, not '" + *v + "'");
+  }
+  return x;
+}
+
+int ToolArguments::integer(const std::string& option, int fallback) const {
+  const auto v = value(option);
+  if (!v) return fallback;
+  char* end = nullptr;
+  const long x = std::strtol(v->c_str(), &end, 10);
+  if (end == v->c_str() || *end != '\0' || x < -1000000000L || x > 1000000000L) {
+    throw UsageError("-" + option + " needs an integer, not '" + *v + "'");
+  }
+  return static_cast<int>(x);
+}
+
+int runTool(const char* name, const char* description, const char* syntax,
+            const std::function<int()>& body) {
+  try {
+    return body();
+  } catch (const HelpRequested&) {
+    std::cout << description << "\nSyntax is: " << name << " " << syntax << "\n";
+    return 0;
+  } catch (const UsageError& e) {
+    std::cerr << name << ": error: " << e.what() << "\n"
+              << description << "\nSyntax is: " << name << " " << syntax << "\n";
+    return 2;
+  } catch (const pcl::BadArgumentException& e) {
+    std::cerr << name << ": error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << name << ": error: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+Timer::Timer(const std::string& what) {
+  pcl::console::print_highlight(stderr, "%s ", what.c_str());
+  clock_.tic();
+}
+
+void Timer::done(std::size_t points) {
+  pcl::console::print_info(stderr, "[done, ");
+  pcl::console::print_value(stderr, "%g", clock_.toc());
+  pcl::console::print_info(stderr, " ms : ");
+  pcl::console::print_value(stderr, "%zu", points);
+  pcl::console::print_info(stderr, " points]\n");
+}
+
+}  // namespace tools
+}  // namespace pcl_ddg

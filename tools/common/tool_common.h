@@ -1,0 +1,66 @@
+#pragma once
+// What every pcl_ddg_* tool shares: PCL-style single-dash options (unknown ones rejected), one-line
+// errors ("pcl_ddg_x: error: ...") with exit codes 0 ok / 1 failure / 2 usage, and timing lines.
+#include <pcl/console/time.h>
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pcl_ddg {
+namespace tools {
+
+/** A command line that does not follow the tool's syntax (exit code 2). */
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/** -h or -help was given: print the description and syntax, exit 0. */
+class HelpRequested : public std::exception {};
+
+class ToolArguments {
+ public:
+  /** Options taking a value and switches are given without the dash: {"k", "method"}. */
+  ToolArguments(int argc, char** argv, const std::set<std::string>& value_options,
+                const std::set<std::string>& switches);
+
+  const std::vector<std::string>& positional() const { return positional_; }
+  bool has(const std::string& option) const;
+  std::optional<std::string> value(const std::string& option) const;
+  std::string text(const std::string& option, const std::string& fallback) const;
+  /** One of `choices`, or a UsageError naming them. */
+  std::string choice(const std::string& option, const std::vector<std::string>& choices,
+                     const std::string& fallback) const;
+  double number(const std::string& option, double fallback) const;
+  int integer(const std::string& option, int fallback) const;
+
+ private:
+  std::vector<std::string> positional_;
+  std::map<std::string, std::string> values_;
+  std::set<std::string> switches_;
+};
+
+/**
+ * Runs a tool body: prints the one-line description and syntax on -h or a usage error, and turns
+ * every exception into one line on stderr and an exit code.
+ */
+int runTool(const char* name, const char* description, const char* syntax,
+            const std::function<int()>& body);
+
+/** Prints "[done, 12 ms : 35947 points]" style lines, as PCL's tools do. */
+class Timer {
+ public:
+  explicit Timer(const std::string& what);
+  void done(std::size_t points);
+
+ private:
+  pcl::console::TicToc clock_;
+};
+
+}  // namespace tools
+}  // namespace pcl_ddg

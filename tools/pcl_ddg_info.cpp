@@ -1,0 +1,45 @@
+// pcl_ddg_info: what a mesh or cloud file holds, defects included. It never refuses a file it can
+// parse: out-of-range faces, non-finite vertices and the like are counted, not fatal.
+#include <iostream>
+
+#include "common/tool_common.h"
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/cloud_report.h"
+#include "pcl_ddg/mesh/mesh_report.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+
+namespace {
+
+constexpr const char* kName = "pcl_ddg_info";
+constexpr const char* kDescription =
+    "Reports the topology and defects of a mesh (or the layout of a point cloud).";
+constexpr const char* kSyntax = "input.{ply,obj,off,stl,vtk,pcd} [-json]";
+
+int run(int argc, char** argv) {
+  using namespace pcl_ddg;
+  const tools::ToolArguments args(argc, argv, {}, {"json"});
+  if (args.positional().size() != 1) throw tools::UsageError("expected one input file");
+  const std::string& path = args.positional()[0];
+
+  tools::Timer load_timer("Loading " + path);
+  const pcl::PolygonMesh mesh = loadMesh(path);
+  load_timer.done(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height);
+
+  const bool json = args.has("json");
+  if (mesh.polygons.empty()) {
+    const CloudReport report = makeCloudReport(mesh.cloud);
+    std::cout << (json ? report.toJson() + "\n" : report.toText());
+    return 0;
+  }
+  const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);
+  const MeshReport report =
+      makeMeshReport(topology, vertexPositions(mesh.cloud, NonFinitePolicy::Keep));
+  std::cout << (json ? report.toJson() + "\n" : report.toText());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return pcl_ddg::tools::runTool(kName, kDescription, kSyntax, [&] { return run(argc, argv); });
+}
