@@ -1,0 +1,53 @@
+#include "test_data.h"
+
+#include <gtest/gtest.h>
+#include <pcl/conversions.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace pcl_ddg {
+namespace test {
+
+std::string sharedData(const std::string& relative_path) {
+  const std::string root = PCL_DDG_SHARED_DATA_DIR;
+  if (root.empty() || !std::filesystem::exists(root + "/CATALOG.md")) {
+    ADD_FAILURE() << "shared data folder not found (configure with -DPCL_DDG_SHARED_DATA_DIR=...)";
+    throw std::runtime_error("shared data missing");
+  }
+  return root + "/" + relative_path;
+}
+
+std::string scratchFolder(const std::string& name) {
+  const auto path = std::filesystem::temp_directory_path() / ("pcl_ddg_test_" + name);
+  std::filesystem::remove_all(path);
+  std::filesystem::create_directories(path);
+  return path.string();
+}
+
+void writeText(const std::string& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+pcl::PolygonMesh makeMesh(const Eigen::Matrix3Xd& positions,
+                          const std::vector<std::vector<int>>& polygons) {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+    cloud.push_back(pcl::PointXYZ(static_cast<float>(positions(0, i)),
+                                  static_cast<float>(positions(1, i)),
+                                  static_cast<float>(positions(2, i))));
+  }
+  pcl::PolygonMesh mesh;
+  pcl::toPCLPointCloud2(cloud, mesh.cloud);
+  for (const auto& p : polygons) {
+    pcl::Vertices v;
+    v.vertices.assign(p.begin(), p.end());
+    mesh.polygons.push_back(v);
+  }
+  return mesh;
+}
+
+}  // namespace test
+}  // namespace pcl_ddg

@@ -1,0 +1,213 @@
+// Every loader on every file of the shared data, round trips, and broken files.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/io/vertex_fields.h"
+#include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+#include "test_data.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+struct CatalogEntry {
+  const char* file;
+  int vertices;
+  int faces;
+};
+
+// Counts from ../shared/data/CATALOG.md.
+const CatalogEntry kCatalog[] = {
+    {"meshes/bumpy.off", 1250, 2496},         {"meshes/bun045_rangegrid_tri.ply", 40097, 79057},
+    {"meshes/bun_zipper.ply", 35947, 69451},  {"meshes/bun_zipper_res3.ply", 1889, 3851},
+    {"meshes/bun_zipper_res4.ply", 453, 948}, {"meshes/bunny.off", 3485, 6966},
+    {"meshes/cow.off", 2762, 5520},           {"meshes/horse.ply", 48485, 96966},
+    {"meshes/igea.ply", 134345, 268686},      {"meshes/rocker-arm.off", 10044, 20088},
+    {"meshes/tum_rabbit.vtk", 10429, 20715},  {"clouds/bun0.pcd", 397, 0},
+    {"clouds/milk.pcd", 13704, 0},            {"clouds/office1.pcd", 307200, 0},
+    {"clouds/rs1.pcd", 289541, 0},            {"clouds/terrain_CSite1_red2-utm.pcd", 131622, 0},
+    {"clouds/table_scene_mug_stereo_textured.pcd", 307200, 0},
+    {"clouds/tutorials_room_scan1.pcd", 112586, 0}};
+
+TEST(MeshIO, EverySharedFileLoadsWithItsCatalogCounts) {
+  for (const CatalogEntry& e : kCatalog) {
+    SCOPED_TRACE(e.file);
+    const pcl::PolygonMesh mesh = loadMesh(sharedData(e.file));
+    EXPECT_EQ(static_cast<int>(mesh.cloud.width * mesh.cloud.height), e.vertices);
+    EXPECT_EQ(static_cast<int>(mesh.polygons.size()), e.faces);
+  }
+}
+
+TEST(MeshIO, RangeGridBecomesAnOrganizedCloudWithHoles) {
+  const pcl::PolygonMesh scan = loadMesh(sharedData("range/bun000.ply"));
+  EXPECT_EQ(scan.cloud.width, 512u);
+  EXPECT_EQ(scan.cloud.height, 400u);
+  const Eigen::Matrix3Xd p = vertexPositions(scan.cloud, NonFinitePolicy::Keep);
+  EXPECT_EQ(p.cols() - findNonFiniteVertices(p).count, 40256);  // the file's vertex count
+}
+
+TEST(MeshIO, TristripsGiveTheSameSurfaceAsFaces) {
+  // igea.ply stores its faces as one strip: the result must be a closed, consistently
+  // oriented surface (a wrong strip winding would break the orientation).
+  const pcl::PolygonMesh igea = loadMesh(sharedData("meshes/igea.ply"));
+  const MeshTopology t(igea);
+  EXPECT_EQ(t.counts().boundary_edges, 0);
+  EXPECT_TRUE(t.counts().consistently_oriented);
+  EXPECT_EQ(t.eulerCharacteristic(), 2);
+}
+
+TEST(MeshIO, CrlfOffAndExtraVertexFieldsAreRead) {
+  const pcl::PolygonMesh rocker = loadMesh(sharedData("meshes/rocker-arm.off"));
+  EXPECT_EQ(MeshTopology(rocker).genus(), 1);
+  const pcl::PolygonMesh zipper = loadMesh(sharedData("meshes/bun_zipper.ply"));
+  std::vector<std::string> names;
+  for (const auto& f : zipper.cloud.fields) names.push_back(f.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"x", "y", "z", "confidence", "intensity"}));
+}
+
+class MeshIOFiles : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = scratchFolder(::testing::UnitTest::GetInstance()->current_test_info()->name()); }
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+  std::string dir_;
+};
+
+TEST_F(MeshIOFiles, PlyRoundTripKeepsDoublesFieldsAndFaces) {
+  Eigen::Matrix3Xd p(3, 4);
+  p << 100000.123456789012, 1, 1, 0,  //
+      0, 0, 1, 1,                     //
+      0, 0, 0, 1e-300;
+  pcl::PolygonMesh mesh = makeMesh(Eigen::Matrix3Xd::Zero(3, 4), {{0, 1, 2, 3}});
+  // Replace float x/y/z by doubles and add a scalar field and colours.
+  for (const char* axis : {"x", "y", "z"}) removeVertexField(mesh.cloud, axis);
+  setVertexField(mesh.cloud, "x", p.row(0).transpose(), FieldPrecision::Double);
+  setVertexField(mesh.cloud, "y", p.row(1).transpose(), FieldPrecision::Double);
+  setVertexField(mesh.cloud, "z", p.row(2).transpose(), FieldPrecision::Double);
+  setVertexField(mesh.cloud, "mean_curvature", Eigen::Vector4d(1, 2, 3, 4));
+  Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> rgb(3, 4);
+  rgb.setConstant(7);
+  setVertexColors(mesh.cloud, rgb);
+  for (PlyEncoding encoding : {PlyEncoding::Binary, PlyEncoding::Ascii}) {
+    saveMesh(path("out.ply"), mesh, {encoding});
+    const pcl::PolygonMesh back = loadMesh(path("out.ply"));
+    EXPECT_EQ(vertexPositions(back.cloud), p);  // bit-exact, both encodings
+    ASSERT_EQ(back.polygons.size(), 1u);
+    EXPECT_EQ(back.polygons[0].vertices.size(), 4u);
+    std::vector<std::string> names;
+    for (const auto& f : back.cloud.fields) names.push_back(f.name);
+    EXPECT_EQ(names, (std::vector<std::string>{"x", "y", "z", "mean_curvature", "red", "green",
+                                               "blue"}));
+  }
+}
+
+TEST_F(MeshIOFiles, PcdRoundTrip) {
+  const pcl::PolygonMesh cloud = loadMesh(sharedData("clouds/milk.pcd"));
+  saveMesh(path("milk.pcd"), cloud);
+  const pcl::PolygonMesh back = loadMesh(path("milk.pcd"));
+  EXPECT_EQ(vertexPositions(back.cloud), vertexPositions(cloud.cloud));
+}
+
+TEST_F(MeshIOFiles, HandWrittenObjOffStlVtk) {
+  writeText(path("quad.obj"),
+            "# comment\no quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
+            "f 1/1/1 2/1/1 3/1/1\nf -4//1 -2//1 -1//1\n");
+  writeText(path("quad.off"), "OFF\r\n# c\r\n4 2 0\r\n0 0 0\r\n1 0 0\r\n1 1 0\r\n0 1 0\r\n"
+                              "3 0 1 2 255 0 0\r\n3 0 2 3\r\n");
+  writeText(path("quad.stl"),
+            "solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\n"
+            "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 1 0\n"
+            "vertex 0 1 0\nendloop\nendfacet\nendsolid q\n");
+  writeText(path("quad.vtk"),
+            "# vtk DataFile Version 3.0\nquad\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n"
+            "0 0 0 1 0 0 1 1 0 0 1 0\nPOLYGONS 2 8\n3 0 1 2\n3 0 2 3\nPOINT_DATA 4\n");
+  writeText(path("quad51.vtk"),
+            "# vtk DataFile Version 5.1\nquad\nASCII\nDATASET POLYDATA\nPOINTS 4 float\n"
+            "0 0 0 1 0 0 1 1 0 0 1 0\nPOLYGONS 3 6\nOFFSETS vtktypeint64\n0 3 6\n"
+            "CONNECTIVITY vtktypeint64\n0 1 2 0 2 3\n");
+  for (const char* name : {"quad.obj", "quad.off", "quad.stl", "quad.vtk", "quad51.vtk"}) {
+    SCOPED_TRACE(name);
+    const pcl::PolygonMesh mesh = loadMesh(path(name));
+    ASSERT_EQ(mesh.cloud.width, 4u);
+    ASSERT_EQ(mesh.polygons.size(), 2u);
+    const MeshTopology t(mesh);
+    EXPECT_EQ(t.numEdges(), 5);
+    EXPECT_TRUE(t.counts().consistently_oriented);
+    EXPECT_EQ(vertexPositions(mesh.cloud).col(2), Eigen::Vector3d(1, 1, 0));
+  }
+}
+
+TEST_F(MeshIOFiles, BinaryStlMergesSharedCorners) {
+  {
+    std::ofstream stl(path("tri.stl"), std::ios::binary);
+    stl << std::string(80, ' ');
+    const std::uint32_t n = 2;
+    stl.write(reinterpret_cast<const char*>(&n), 4);
+    const float facets[2][12] = {{0, 0, 1, 0, 0, 0, 1, 0, 0, 1, 1, 0},
+                                 {0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 1, 0}};
+    for (const auto& f : facets) {
+      stl.write(reinterpret_cast<const char*>(f), sizeof(f));
+      stl.write("\0\0", 2);
+    }
+  }
+  const pcl::PolygonMesh stl = loadMesh(path("tri.stl"));
+  EXPECT_EQ(stl.cloud.width, 4u);  // shared corners merged
+  EXPECT_EQ(stl.polygons.size(), 2u);
+}
+
+TEST_F(MeshIOFiles, TruncatedFilesFailWithAMessage) {
+  for (const char* file : {"meshes/bun_zipper_res4.ply", "meshes/horse.ply", "meshes/igea.ply",
+                           "meshes/cow.off", "meshes/tum_rabbit.vtk"}) {
+    SCOPED_TRACE(file);
+    const std::string data = [&] {
+      std::ifstream in(sharedData(file), std::ios::binary);
+      return std::string(std::istreambuf_iterator<char>(in), {});
+    }();
+    const std::string name = std::filesystem::path(file).filename().string();
+    for (double fraction : {0.05, 0.5, 0.97}) {
+      writeText(path(name), data.substr(0, static_cast<std::size_t>(data.size() * fraction)));
+      try {
+        loadMesh(path(name));
+        ADD_FAILURE() << "truncated at " << fraction << " loaded without error";
+      } catch (const FileFormatException& e) {
+        EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+      }
+    }
+  }
+}
+
+TEST_F(MeshIOFiles, GarbageAndEmptyFilesFail) {
+  std::string garbage;
+  for (int i = 0; i < 4096; ++i) garbage.push_back(static_cast<char>((i * 7919) % 251));
+  for (const char* ext : {"ply", "off", "obj", "stl", "vtk", "pcd"}) {
+    SCOPED_TRACE(ext);
+    for (const std::string& content : {garbage, std::string()}) {
+      writeText(path(std::string("bad.") + ext), content);
+      EXPECT_THROW(loadMesh(path(std::string("bad.") + ext)), FileFormatException);
+    }
+  }
+  EXPECT_THROW(loadMesh(path("missing.ply")), FileFormatException);
+  EXPECT_THROW(loadMesh(path("file.xyz")), FileFormatException);
+  writeText(path("bad_header.ply"), "ply\nformat ascii 1.0\nelement vertex 1\nproperty quux x\nend_header\n1\n");
+  EXPECT_THROW(loadMesh(path("bad_header.ply")), FileFormatException);
+}
+
+TEST_F(MeshIOFiles, FailedSaveLeavesNoFile) {
+  pcl::PolygonMesh mesh = makeMesh(Eigen::Matrix3Xd::Zero(3, 300), {});
+  pcl::Vertices huge;
+  for (int i = 0; i < 300; ++i) huge.vertices.push_back(i);
+  mesh.polygons.push_back(huge);  // more corners than PLY's uchar count can hold
+  EXPECT_THROW(saveMesh(path("out.ply"), mesh), FileFormatException);
+  EXPECT_TRUE(std::filesystem::is_empty(dir_));
+  EXPECT_THROW(saveMesh(path("out.xyz"), mesh), FileFormatException);
+  EXPECT_THROW(saveMesh(path("no/such/folder/out.ply"), mesh), FileFormatException);
+  EXPECT_TRUE(std::filesystem::is_empty(dir_));
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg

@@ -1,0 +1,195 @@
+// MeshTopology on hand-made dirty meshes (each defect alone) and on analytic meshes.
+#include <gtest/gtest.h>
+
+#include <limits>
+
+#include "analytic_surfaces.h"
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/mesh/mesh_topology.h"
+#include "test_data.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+// Two triangles sharing edge 1-2: a unit square split along its diagonal.
+const std::vector<std::vector<int>> kSquare = {{0, 1, 2}, {0, 2, 3}};
+
+Eigen::Matrix3Xd gridPoints(int n) {
+  Eigen::Matrix3Xd p(3, n);
+  for (int i = 0; i < n; ++i) p.col(i) << i % 4, i / 4, 0.1 * i;
+  return p;
+}
+
+MeshTopology topologyOf(int num_vertices, const std::vector<std::vector<int>>& polygons,
+                        OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw) {
+  return MeshTopology(makeMesh(gridPoints(num_vertices), polygons), policy);
+}
+
+TEST(MeshTopology, EmptyMeshThrows) {
+  pcl::PolygonMesh empty;
+  EXPECT_THROW(MeshTopology{empty}, InvalidMeshException);
+}
+
+TEST(MeshTopology, OutOfRangeIndexThrowsNamingFaceAndCount) {
+  try {
+    topologyOf(4, {{0, 1, 2}, {0, 2, 7}, {0, 9, 1}});
+    FAIL() << "no exception";
+  } catch (const InvalidMeshException& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("face 1"), std::string::npos) << what;
+    EXPECT_NE(what.find("vertex 7"), std::string::npos) << what;
+    EXPECT_NE(what.find("2 faces out of range"), std::string::npos) << what;
+  }
+}
+
+TEST(MeshTopology, NegativeIndexIsOutOfRange) {
+  EXPECT_THROW(MeshTopology(4, Eigen::Matrix3Xi(Eigen::Vector3i(0, 1, -1))), InvalidMeshException);
+}
+
+TEST(MeshTopology, OutOfRangeFacesCanBeDroppedAndCounted) {
+  const MeshTopology t = topologyOf(4, {{0, 1, 2}, {0, 2, 7}}, OutOfRangeFacePolicy::Drop);
+  EXPECT_EQ(t.numTriangles(), 1);
+  EXPECT_EQ(t.counts().out_of_range_polygons, 1);
+  EXPECT_EQ(t.triangleSource()[0], 0);
+}
+
+TEST(MeshTopology, SquareAdjacency) {
+  const MeshTopology t = topologyOf(4, kSquare);
+  EXPECT_EQ(t.numEdges(), 5);
+  EXPECT_EQ(t.neighbours(0).size(), 3);
+  EXPECT_EQ(t.neighbours(1).size(), 2);
+  EXPECT_EQ(t.incidentTriangles(0).size(), 2);
+  EXPECT_EQ(t.counts().boundary_edges, 4);
+  EXPECT_EQ(t.counts().boundary_loops, 1);
+  EXPECT_EQ(t.eulerCharacteristic(), 1);
+  EXPECT_EQ(t.edgeTriangleCount()[t.findEdge(2, 0)], 2);
+  EXPECT_EQ(t.findEdge(1, 3), -1);
+  for (int v = 0; v < 4; ++v) EXPECT_TRUE(t.isBoundary(v));
+  // Edge k of a triangle is opposite corner k.
+  for (int k = 0; k < 3; ++k) {
+    const int e = t.triangleEdges()(k, 0);
+    const int a = t.edgeVertices()(0, e), b = t.edgeVertices()(1, e);
+    EXPECT_NE(a, t.triangles()(k, 0));
+    EXPECT_NE(b, t.triangles()(k, 0));
+  }
+}
+
+TEST(MeshTopology, RepeatedIndexFaceIsCountedAndDropped) {
+  const MeshTopology t = topologyOf(4, {{0, 1, 2}, {0, 0, 3}, {1, 2}});
+  EXPECT_EQ(t.counts().repeated_index_polygons, 2);
+  EXPECT_EQ(t.numTriangles(), 1);
+}
+
+TEST(MeshTopology, BowTieVertexIsNonManifold) {
+  // Two triangles touching only at vertex 2.
+  const MeshTopology t = topologyOf(5, {{0, 1, 2}, {2, 3, 4}});
+  EXPECT_EQ(t.counts().nonmanifold_vertices, 1);
+  EXPECT_TRUE(t.hasFlag(2, VertexFlag::NonManifoldVertex));
+  EXPECT_FALSE(t.hasFlag(0, VertexFlag::NonManifoldVertex));
+  EXPECT_EQ(t.counts().boundary_loops, 2);
+  EXPECT_EQ(t.counts().connected_components, 1);
+}
+
+TEST(MeshTopology, ThreeFacesOnOneEdgeAreNonManifold) {
+  const MeshTopology t = topologyOf(5, {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}});
+  EXPECT_EQ(t.counts().nonmanifold_edges, 1);
+  EXPECT_EQ(t.edgeTriangleCount()[t.findEdge(0, 1)], 3);
+  EXPECT_TRUE(t.hasFlag(0, VertexFlag::NonManifoldEdge));
+  EXPECT_TRUE(t.isNonManifold(1));
+  EXPECT_FALSE(t.isNonManifold(2));
+}
+
+TEST(MeshTopology, DuplicateFaceIsCountedAndKept) {
+  const MeshTopology t = topologyOf(4, {{0, 1, 2}, {1, 2, 0}, {0, 2, 3}});
+  EXPECT_EQ(t.counts().duplicate_polygons, 1);
+  EXPECT_EQ(t.numTriangles(), 3);
+}
+
+TEST(MeshTopology, QuadAndPentagonAreFanTriangulated) {
+  const MeshTopology t = topologyOf(9, {{0, 1, 2, 3}, {4, 5, 6, 7, 8}});
+  EXPECT_EQ(t.numTriangles(), 2 + 3);
+  EXPECT_EQ(t.counts().triangulated_polygons, 2);
+  EXPECT_EQ(t.counts().polygons_by_valence[4], 1);
+  EXPECT_EQ(t.counts().polygons_by_valence[5], 1);
+  EXPECT_EQ(t.triangleSource()[4], 1);
+  EXPECT_EQ(t.eulerCharacteristic(), 2);  // two discs
+  EXPECT_EQ(t.counts().connected_components, 2);
+  // Fan from corner 0 keeps the winding: (4,5,6), (4,6,7), (4,7,8).
+  EXPECT_EQ(t.triangles().col(3), Eigen::Vector3i(4, 6, 7));
+}
+
+TEST(MeshTopology, IsolatedVertexIsFlaggedAndNotAComponent) {
+  const MeshTopology t = topologyOf(5, kSquare);
+  EXPECT_TRUE(t.isIsolated(4));
+  EXPECT_EQ(t.counts().unreferenced_vertices, 1);
+  EXPECT_EQ(t.counts().connected_components, 1);
+  EXPECT_EQ(t.vertexComponent()[4], -1);
+  EXPECT_EQ(t.neighbours(4).size(), 0);
+}
+
+TEST(MeshTopology, TwoComponents) {
+  const MeshTopology t = topologyOf(6, {{0, 1, 2}, {3, 4, 5}});
+  EXPECT_EQ(t.counts().connected_components, 2);
+  EXPECT_NE(t.vertexComponent()[0], t.vertexComponent()[3]);
+  EXPECT_EQ(t.vertexComponent()[0], t.vertexComponent()[2]);
+}
+
+TEST(MeshTopology, InconsistentWindingIsDetectedButOrientable) {
+  const MeshTopology t = topologyOf(4, {{0, 1, 2}, {0, 3, 2}});
+  EXPECT_FALSE(t.counts().consistently_oriented);
+  EXPECT_TRUE(t.counts().orientable);
+}
+
+TEST(MeshTopology, MoebiusStripIsNotOrientable) {
+  // A strip of 6 quads closed with a half twist.
+  const int n = 6;
+  std::vector<std::vector<int>> faces;
+  for (int i = 0; i < n; ++i) {
+    const int a = 2 * i, b = 2 * i + 1;
+    const bool last = i == n - 1;
+    const int c = last ? 1 : 2 * i + 3, d = last ? 0 : 2 * i + 2;
+    faces.push_back({a, b, c});
+    faces.push_back({a, c, d});
+  }
+  const MeshTopology t = topologyOf(2 * n, faces);
+  EXPECT_FALSE(t.counts().orientable);
+  EXPECT_EQ(t.genus(), -1);
+  EXPECT_EQ(t.eulerCharacteristic(), 0);
+  EXPECT_EQ(t.counts().boundary_loops, 1);  // the Moebius strip has one boundary circle
+}
+
+TEST(MeshTopology, ClosedSurfacesHaveTheirGenus) {
+  const SurfaceSample sphere = makeIcosphere(2);
+  EXPECT_EQ(MeshTopology(static_cast<int>(sphere.points.cols()), sphere.triangles).genus(), 0);
+  const SurfaceSample torus = makeTorus({24, 0.0, 1});
+  EXPECT_EQ(MeshTopology(static_cast<int>(torus.points.cols()), torus.triangles).genus(), 1);
+}
+
+TEST(MeshTopology, CylinderHasTwoBoundaryLoops) {
+  const SurfaceSample cylinder = makeCylinder({24, 0.0, 1});
+  const MeshTopology t(static_cast<int>(cylinder.points.cols()), cylinder.triangles);
+  EXPECT_EQ(t.counts().boundary_loops, 2);
+  EXPECT_EQ(t.counts().boundary_edges, 2 * 24);
+}
+
+TEST(MeshTopology, NeighbourRowsAreSortedSymmetricAndMatchEdges) {
+  const SurfaceSample torus = makeTorus({20, 0.3, 2});
+  const MeshTopology t(static_cast<int>(torus.points.cols()), torus.triangles);
+  for (int v = 0; v < t.numVertices(); ++v) {
+    const IndexSpan row = t.neighbours(v);
+    EXPECT_EQ(row.size(), 6);  // regular grid triangulation of a torus
+    for (int i = 0; i < row.size(); ++i) {
+      if (i) ASSERT_LT(row[i - 1], row[i]);
+      ASSERT_GE(t.findEdge(row[i], v), 0);
+      const int e = t.neighbourEdges(v)[i];
+      ASSERT_EQ(std::min(v, row[i]), t.edgeVertices()(0, e));
+      ASSERT_EQ(std::max(v, row[i]), t.edgeVertices()(1, e));
+    }
+  }
+  EXPECT_EQ(t.numEdges(), 3 * t.numVertices());
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg

@@ -1,0 +1,121 @@
+// pcl_ddg_info -json on every shared mesh against the catalogue, exit codes and error lines.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <boost/property_tree/json_parser.hpp>
+#include <boost/property_tree/ptree.hpp>
+#include <cstdio>
+#include <sstream>
+
+#include "test_data.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+struct ToolRun {
+  int exit_code;
+  std::string out;
+};
+
+ToolRun runInfo(const std::string& arguments) {
+  const std::string command = std::string(PCL_DDG_INFO_TOOL) + " " + arguments + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ToolRun run{-1, ""};
+  std::array<char, 4096> buffer;
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) run.out += buffer.data();
+  const int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+boost::property_tree::ptree json(const std::string& file) {
+  const std::string command = std::string(PCL_DDG_INFO_TOOL) + " " + file + " -json 2>/dev/null";
+  FILE* pipe = popen(command.c_str(), "r");
+  std::string text;
+  std::array<char, 4096> buffer;
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) text += buffer.data();
+  EXPECT_EQ(pclose(pipe), 0) << file;
+  std::istringstream in(text);
+  boost::property_tree::ptree tree;
+  boost::property_tree::read_json(in, tree);
+  return tree;
+}
+
+struct CatalogRow {
+  const char* file;
+  int vertices, faces, boundary_edges, nonmanifold_edges, duplicate_faces, unused_vertices;
+};
+
+// ../shared/data/CATALOG.md, measured independently of this project.
+const CatalogRow kCatalog[] = {
+    {"bumpy.off", 1250, 2496, 0, 0, 0, 0},
+    {"bun045_rangegrid_tri.ply", 40097, 79057, 1137, 0, 0, 6},
+    {"bun_zipper.ply", 35947, 69451, 223, 0, 0, 1113},
+    {"bun_zipper_res3.ply", 1889, 3851, 60, 141, 83, 2},
+    {"bun_zipper_res4.ply", 453, 948, 26, 70, 40, 0},
+    {"bunny.off", 3485, 6966, 0, 0, 0, 0},
+    {"cow.off", 2762, 5520, 0, 0, 0, 0},
+    {"horse.ply", 48485, 96966, 0, 0, 0, 0},
+    {"igea.ply", 134345, 268686, 0, 0, 0, 0},
+    {"rocker-arm.off", 10044, 20088, 0, 0, 0, 0},
+    {"tum_rabbit.vtk", 10429, 20715, 141, 0, 0, 0},
+};
+
+TEST(PclDdgInfo, JsonMatchesTheCatalogOnEverySharedMesh) {
+  for (const CatalogRow& row : kCatalog) {
+    SCOPED_TRACE(row.file);
+    const auto j = json(sharedData(std::string("meshes/") + row.file));
+    EXPECT_EQ(j.get<int>("vertices"), row.vertices);
+    EXPECT_EQ(j.get<int>("faces"), row.faces);
+    EXPECT_EQ(j.get<int>("boundary_edges"), row.boundary_edges);
+    EXPECT_EQ(j.get<int>("nonmanifold_edges"), row.nonmanifold_edges);
+    EXPECT_EQ(j.get<int>("duplicate_faces"), row.duplicate_faces);
+    EXPECT_EQ(j.get<int>("unreferenced_vertices"), row.unused_vertices);
+    EXPECT_EQ(j.get<int>("out_of_range_faces"), 0);
+    EXPECT_GT(j.get<double>("mean_edge_length"), 0.0);
+    if (row.boundary_edges == 0 && row.nonmanifold_edges == 0) {
+      // Closed scans: chi = 2 - 2g, and the catalogue names rocker-arm as the genus-1 model.
+      const int genus = std::string(row.file) == "rocker-arm.off" ? 1 : 0;
+      EXPECT_EQ(j.get<int>("genus"), genus);
+      EXPECT_EQ(j.get<int>("euler_characteristic"), 2 - 2 * genus);
+    }
+  }
+}
+
+TEST(PclDdgInfo, ReportsCloudLayout) {
+  const auto office = json(sharedData("clouds/office1.pcd"));
+  EXPECT_EQ(office.get<int>("width"), 640);
+  EXPECT_EQ(office.get<int>("height"), 480);
+  EXPECT_GT(office.get<int>("nan_points"), 0);
+  const auto room = json(sharedData("clouds/tutorials_room_scan1.pcd"));
+  // "about half the points are exact duplicates"
+  EXPECT_NEAR(room.get<double>("duplicate_points") / room.get<double>("points"), 0.5, 0.05);
+}
+
+TEST(PclDdgInfo, CountsDefectsInsteadOfRefusing) {
+  const std::string dir = scratchFolder("info_defects");
+  writeText(dir + "/dirty.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 0 0\nf 1 2 3\nf 1 2 9\nf 1 1 2\n");
+  const auto j = json(dir + "/dirty.obj");
+  EXPECT_EQ(j.get<int>("out_of_range_faces"), 1);
+  EXPECT_EQ(j.get<int>("degenerate_faces"), 1);
+  EXPECT_EQ(j.get<int>("nonfinite_vertices"), 1);
+}
+
+TEST(PclDdgInfo, ExitCodesAndOneLineErrors) {
+  EXPECT_EQ(runInfo("-h").exit_code, 0);
+  const ToolRun usage = runInfo("");
+  EXPECT_EQ(usage.exit_code, 2);
+  EXPECT_EQ(usage.out.rfind("pcl_ddg_info: error: ", 0), 0u) << usage.out;
+  EXPECT_EQ(runInfo(sharedData("meshes/cow.off") + " -bogus").exit_code, 2);
+  const std::string dir = scratchFolder("info_errors");
+  writeText(dir + "/broken.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n");
+  const ToolRun broken = runInfo(dir + "/broken.ply");
+  EXPECT_EQ(broken.exit_code, 1);
+  EXPECT_NE(broken.out.find("pcl_ddg_info: error: "), std::string::npos) << broken.out;
+  EXPECT_NE(broken.out.find("end_header"), std::string::npos) << broken.out;
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
