@@ -148,7 +148,8 @@ TEST(MeshTopology, MoebiusStripIsNotOrientable) {
   for (int i = 0; i < n; ++i) {
     const int a = 2 * i, b = 2 * i + 1;
     const bool last = i == n - 1;
-    const int c = last ? 1 : 2 * i + 3, d = last ? 0 : 2 * i + 2;
+    // The last quad closes the strip with a half twist: top meets bottom.
+    const int c = last ? 0 : 2 * i + 3, d = last ? 1 : 2 * i + 2;
     faces.push_back({a, b, c});
     faces.push_back({a, c, d});
   }

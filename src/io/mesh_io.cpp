@@ -14,7 +14,50 @@
 namespace pcl_ddg {
 namespace {
 
+// PCL's PCD reader crashes on empty, garbage or truncated files, so the header and the data size
+// are checked here first.
+void checkPCD(const std::string& data) {
+  detail::ByteCursor cursor(data);
+  std::int64_t points = -1, point_size = 0;
+  for (;;) {
+    if (cursor.atEnd()) cursor.fail("not a PCD file (no DATA line)");
+    detail::ByteCursor line = cursor.within(cursor.line());
+    const std::string_view key = line.token();
+    if (key.empty() || key.front() == '#' || key == "VERSION" || key == "FIELDS" ||
+        key == "TYPE" || key == "WIDTH" || key == "HEIGHT" || key == "VIEWPOINT") {
+      continue;
+    }
+    if (key == "SIZE" || key == "COUNT") {
+      std::vector<std::int64_t> values;
+      for (std::string_view t = line.token(); !t.empty(); t = line.token()) {
+        values.push_back(line.parseInt(t, "SIZE/COUNT"));
+      }
+      if (key == "SIZE") {
+        point_size = 0;
+        for (std::int64_t v : values) point_size += v;
+      }
+    } else if (key == "POINTS") {
+      points = line.readInt("POINTS");
+    } else if (key == "DATA") {
+      const std::string_view kind = line.requireToken("DATA kind");
+      if (points <= 0) cursor.fail("PCD file has no points");
+      if (kind == "binary" && cursor.remaining() < static_cast<std::size_t>(points * point_size)) {
+        cursor.fail("PCD data shorter than POINTS x point size (truncated?)");
+      }
+      if (kind == "ascii") {
+        std::int64_t rows = 0;
+        while (!cursor.atEnd()) rows += !cursor.line().empty();
+        if (rows < points) cursor.fail("PCD data has fewer rows than POINTS (truncated?)");
+      }
+      return;
+    } else {
+      cursor.fail("not a PCD file (unknown header line '" + std::string(key.substr(0, 20)) + "')");
+    }
+  }
+}
+
 pcl::PolygonMesh loadPCD(const std::string& path) {
+  checkPCD(detail::readWholeFile(path));
   pcl::PolygonMesh mesh;
   pcl::PCDReader reader;
   if (reader.read(path, mesh.cloud) < 0) throw FileFormatException("not a readable PCD file");
@@ -49,8 +92,6 @@ pcl::PolygonMesh loadMesh(const std::string& path) {
   const std::string ext = fileExtension(path);
   try {
     if (ext == "pcd") {
-      // PCL's reader prints its own diagnostics; make sure the file exists for a clear message.
-      if (!std::ifstream(path)) throw FileFormatException("cannot open file");
       return loadPCD(path);
     }
     using Parser = pcl::PolygonMesh (*)(std::string_view);
