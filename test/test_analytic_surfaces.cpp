@@ -15,13 +15,21 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 // Implicit equation residual of each surface (zero on the surface).
-double planeResidual(const Eigen::Vector3d& p) { return p.z(); }
-double sphereResidual(const Eigen::Vector3d& p) { return p.norm() - 1.0; }
-double cylinderResidual(const Eigen::Vector3d& p) { return std::hypot(p.x(), p.y()) - 1.0; }
+double planeResidual(const Eigen::Vector3d& p) {
+  return p.z();
+}
+double sphereResidual(const Eigen::Vector3d& p) {
+  return p.norm() - 1.0;
+}
+double cylinderResidual(const Eigen::Vector3d& p) {
+  return std::hypot(p.x(), p.y()) - 1.0;
+}
 double torusResidual(const Eigen::Vector3d& p) {
   return std::hypot(std::hypot(p.x(), p.y()) - 1.0, p.z()) - 0.4;
 }
-double saddleResidual(const Eigen::Vector3d& p) { return p.z() - 0.5 * (p.x() * p.x() - p.y() * p.y()); }
+double saddleResidual(const Eigen::Vector3d& p) {
+  return p.z() - 0.5 * (p.x() * p.x() - p.y() * p.y());
+}
 double paraboloidResidual(const Eigen::Vector3d& p) {
   return p.z() - 0.5 * (p.x() * p.x() + p.y() * p.y());
 }
@@ -133,7 +141,8 @@ TEST(AnalyticSurfaces, TriangleWindingFollowsTheNormal) {
     SCOPED_TRACE(c.name);
     const SurfaceSample& s = c.sample;
     for (Eigen::Index t = 0; t < s.triangles.cols(); ++t) {
-      const Eigen::Vector3d a = s.points.col(s.triangles(0, t)), b = s.points.col(s.triangles(1, t)),
+      const Eigen::Vector3d a = s.points.col(s.triangles(0, t)),
+                            b = s.points.col(s.triangles(1, t)),
                             d = s.points.col(s.triangles(2, t));
       ASSERT_GT((b - a).cross(d - a).dot(s.normals.col(s.triangles(0, t))), 0.0);
     }

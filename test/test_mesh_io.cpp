@@ -22,17 +22,24 @@ struct CatalogEntry {
 };
 
 // Counts from ../shared/data/CATALOG.md.
-const CatalogEntry kCatalog[] = {
-    {"meshes/bumpy.off", 1250, 2496},         {"meshes/bun045_rangegrid_tri.ply", 40097, 79057},
-    {"meshes/bun_zipper.ply", 35947, 69451},  {"meshes/bun_zipper_res3.ply", 1889, 3851},
-    {"meshes/bun_zipper_res4.ply", 453, 948}, {"meshes/bunny.off", 3485, 6966},
-    {"meshes/cow.off", 2762, 5520},           {"meshes/horse.ply", 48485, 96966},
-    {"meshes/igea.ply", 134345, 268686},      {"meshes/rocker-arm.off", 10044, 20088},
-    {"meshes/tum_rabbit.vtk", 10429, 20715},  {"clouds/bun0.pcd", 397, 0},
-    {"clouds/milk.pcd", 13704, 0},            {"clouds/office1.pcd", 307200, 0},
-    {"clouds/rs1.pcd", 289541, 0},            {"clouds/terrain_CSite1_red2-utm.pcd", 131622, 0},
-    {"clouds/table_scene_mug_stereo_textured.pcd", 307200, 0},
-    {"clouds/tutorials_room_scan1.pcd", 112586, 0}};
+const CatalogEntry kCatalog[] = {{"meshes/bumpy.off", 1250, 2496},
+                                 {"meshes/bun045_rangegrid_tri.ply", 40097, 79057},
+                                 {"meshes/bun_zipper.ply", 35947, 69451},
+                                 {"meshes/bun_zipper_res3.ply", 1889, 3851},
+                                 {"meshes/bun_zipper_res4.ply", 453, 948},
+                                 {"meshes/bunny.off", 3485, 6966},
+                                 {"meshes/cow.off", 2762, 5520},
+                                 {"meshes/horse.ply", 48485, 96966},
+                                 {"meshes/igea.ply", 134345, 268686},
+                                 {"meshes/rocker-arm.off", 10044, 20088},
+                                 {"meshes/tum_rabbit.vtk", 10429, 20715},
+                                 {"clouds/bun0.pcd", 397, 0},
+                                 {"clouds/milk.pcd", 13704, 0},
+                                 {"clouds/office1.pcd", 307200, 0},
+                                 {"clouds/rs1.pcd", 289541, 0},
+                                 {"clouds/terrain_CSite1_red2-utm.pcd", 131622, 0},
+                                 {"clouds/table_scene_mug_stereo_textured.pcd", 307200, 0},
+                                 {"clouds/tutorials_room_scan1.pcd", 112586, 0}};
 
 TEST(MeshIO, EverySharedFileLoadsWithItsCatalogCounts) {
   for (const CatalogEntry& e : kCatalog) {
@@ -72,7 +79,9 @@ TEST(MeshIO, CrlfOffAndExtraVertexFieldsAreRead) {
 
 class MeshIOFiles : public ::testing::Test {
  protected:
-  void SetUp() override { dir_ = scratchFolder(::testing::UnitTest::GetInstance()->current_test_info()->name()); }
+  void SetUp() override {
+    dir_ = scratchFolder(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
   std::string path(const std::string& name) const { return dir_ + "/" + name; }
   std::string dir_;
 };
@@ -100,8 +109,8 @@ TEST_F(MeshIOFiles, PlyRoundTripKeepsDoublesFieldsAndFaces) {
     EXPECT_EQ(back.polygons[0].vertices.size(), 4u);
     std::vector<std::string> names;
     for (const auto& f : back.cloud.fields) names.push_back(f.name);
-    EXPECT_EQ(names, (std::vector<std::string>{"x", "y", "z", "mean_curvature", "red", "green",
-                                               "blue"}));
+    EXPECT_EQ(names,
+              (std::vector<std::string>{"x", "y", "z", "mean_curvature", "red", "green", "blue"}));
   }
 }
 
@@ -116,8 +125,9 @@ TEST_F(MeshIOFiles, HandWrittenObjOffStlVtk) {
   writeText(path("quad.obj"),
             "# comment\no quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvn 0 0 1\n"
             "f 1/1/1 2/1/1 3/1/1\nf -4//1 -2//1 -1//1\n");
-  writeText(path("quad.off"), "OFF\r\n# c\r\n4 2 0\r\n0 0 0\r\n1 0 0\r\n1 1 0\r\n0 1 0\r\n"
-                              "3 0 1 2 255 0 0\r\n3 0 2 3\r\n");
+  writeText(path("quad.off"),
+            "OFF\r\n# c\r\n4 2 0\r\n0 0 0\r\n1 0 0\r\n1 1 0\r\n0 1 0\r\n"
+            "3 0 1 2 255 0 0\r\n3 0 2 3\r\n");
   writeText(path("quad.stl"),
             "solid q\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\n"
             "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 1 0\n"
@@ -160,9 +170,9 @@ TEST_F(MeshIOFiles, BinaryStlMergesSharedCorners) {
 }
 
 TEST_F(MeshIOFiles, TruncatedFilesFailWithAMessage) {
-  for (const char* file : {"meshes/bun_zipper_res4.ply", "meshes/horse.ply", "meshes/igea.ply",
-                           "meshes/cow.off", "meshes/tum_rabbit.vtk", "clouds/milk.pcd",
-                           "clouds/office1.pcd"}) {
+  for (const char* file :
+       {"meshes/bun_zipper_res4.ply", "meshes/horse.ply", "meshes/igea.ply", "meshes/cow.off",
+        "meshes/tum_rabbit.vtk", "clouds/milk.pcd", "clouds/office1.pcd"}) {
     SCOPED_TRACE(file);
     const std::string data = [&] {
       std::ifstream in(sharedData(file), std::ios::binary);
@@ -193,7 +203,8 @@ TEST_F(MeshIOFiles, GarbageAndEmptyFilesFail) {
   }
   EXPECT_THROW(loadMesh(path("missing.ply")), FileFormatException);
   EXPECT_THROW(loadMesh(path("file.xyz")), FileFormatException);
-  writeText(path("bad_header.ply"), "ply\nformat ascii 1.0\nelement vertex 1\nproperty quux x\nend_header\n1\n");
+  writeText(path("bad_header.ply"),
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty quux x\nend_header\n1\n");
   EXPECT_THROW(loadMesh(path("bad_header.ply")), FileFormatException);
 }
 

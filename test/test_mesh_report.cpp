@@ -71,15 +71,13 @@ TEST(MeshReport, MeasuresOfARegularPlaneGrid) {
 
 TEST(MeshReport, JsonHasEveryDocumentedKey) {
   const SurfaceSample sphere = makeIcosphere(1);
-  const MeshReport r =
-      makeMeshReport(MeshTopology(static_cast<int>(sphere.points.cols()), sphere.triangles),
-                     sphere.points);
+  const MeshReport r = makeMeshReport(
+      MeshTopology(static_cast<int>(sphere.points.cols()), sphere.triangles), sphere.points);
   const std::string json = r.toJson();
-  for (const char* key :
-       {"vertices", "faces", "out_of_range_faces", "degenerate_faces", "duplicate_faces",
-        "boundary_edges", "boundary_loops", "nonmanifold_edges", "nonmanifold_vertices",
-        "unreferenced_vertices", "connected_components", "euler_characteristic",
-        "mean_edge_length"}) {
+  for (const char* key : {"vertices", "faces", "out_of_range_faces", "degenerate_faces",
+                          "duplicate_faces", "boundary_edges", "boundary_loops",
+                          "nonmanifold_edges", "nonmanifold_vertices", "unreferenced_vertices",
+                          "connected_components", "euler_characteristic", "mean_edge_length"}) {
     EXPECT_NE(json.find(std::string("\"") + key + "\": "), std::string::npos) << key;
   }
   EXPECT_NE(json.find("\"genus\": 0"), std::string::npos);

@@ -95,7 +95,8 @@ TEST(PclDdgInfo, ReportsCloudLayout) {
 
 TEST(PclDdgInfo, CountsDefectsInsteadOfRefusing) {
   const std::string dir = scratchFolder("info_defects");
-  writeText(dir + "/dirty.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 0 0\nf 1 2 3\nf 1 2 9\nf 1 1 2\n");
+  writeText(dir + "/dirty.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 0 0\nf 1 2 3\nf 1 2 9\nf 1 1 2\n");
   const auto j = json(dir + "/dirty.obj");
   EXPECT_EQ(j.get<int>("out_of_range_faces"), 1);
   EXPECT_EQ(j.get<int>("degenerate_faces"), 1);

@@ -21,7 +21,8 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path) {
   buffer.push_back('\0');
   const int fd = mkstemp(buffer.data());
   if (fd < 0) {
-    throw FileFormatException("cannot create a file next to '" + path + "': " + std::strerror(errno));
+    throw FileFormatException("cannot create a file next to '" + path +
+                              "': " + std::strerror(errno));
   }
   close(fd);
   temporary_path_ = buffer.data();

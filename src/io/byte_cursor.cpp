@@ -10,7 +10,9 @@ namespace pcl_ddg {
 namespace detail {
 namespace {
 
-bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v'; }
+bool isSpace(char c) {
+  return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\f' || c == '\v';
+}
 
 }  // namespace
 
@@ -91,16 +93,20 @@ const char* ByteCursor::take(std::size_t n, const char* what) {
 }
 
 std::size_t ByteCursor::lineNumber(std::size_t offset) const {
-  if (outer_ != nullptr) return outer_->lineNumber(static_cast<std::size_t>(data_.data() - outer_->data_.data()));
+  if (outer_ != nullptr)
+    return outer_->lineNumber(static_cast<std::size_t>(data_.data() - outer_->data_.data()));
   const std::size_t upto = std::min(offset, data_.size());
-  return 1 + static_cast<std::size_t>(std::count(data_.begin(), data_.begin() + static_cast<std::ptrdiff_t>(upto), '\n'));
+  return 1 + static_cast<std::size_t>(std::count(
+                 data_.begin(), data_.begin() + static_cast<std::ptrdiff_t>(upto), '\n'));
 }
 
 void ByteCursor::fail(const std::string& message) const {
   throw FileFormatException("line " + std::to_string(lineNumber(pos_)) + ": " + message);
 }
 
-void ByteCursor::reverse(char* bytes, std::size_t n) { std::reverse(bytes, bytes + n); }
+void ByteCursor::reverse(char* bytes, std::size_t n) {
+  std::reverse(bytes, bytes + n);
+}
 
 }  // namespace detail
 }  // namespace pcl_ddg

@@ -23,8 +23,8 @@ void checkPCD(const std::string& data) {
     if (cursor.atEnd()) cursor.fail("not a PCD file (no DATA line)");
     detail::ByteCursor line = cursor.within(cursor.line());
     const std::string_view key = line.token();
-    if (key.empty() || key.front() == '#' || key == "VERSION" || key == "FIELDS" ||
-        key == "TYPE" || key == "WIDTH" || key == "HEIGHT" || key == "VIEWPOINT") {
+    if (key.empty() || key.front() == '#' || key == "VERSION" || key == "FIELDS" || key == "TYPE" ||
+        key == "WIDTH" || key == "HEIGHT" || key == "VIEWPOINT") {
       continue;
     }
     if (key == "SIZE" || key == "COUNT") {
@@ -107,7 +107,8 @@ pcl::PolygonMesh loadMesh(const std::string& path) {
     }
     const std::string data = detail::readWholeFile(path);
     pcl::PolygonMesh mesh = parse(data);
-    if (mesh.cloud.width * mesh.cloud.height == 0) throw FileFormatException("file has no vertices");
+    if (mesh.cloud.width * mesh.cloud.height == 0)
+      throw FileFormatException("file has no vertices");
     return mesh;
   } catch (const FileFormatException& e) {
     throw FileFormatException(path + ": " + e.what());

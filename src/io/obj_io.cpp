@@ -25,14 +25,16 @@ pcl::PolygonMesh parseOBJ(std::string_view data) {
       pcl::Vertices polygon;
       const auto vertex_count = static_cast<std::int64_t>(xyz.size() / 3);
       for (std::string_view corner = record.token(); !corner.empty(); corner = record.token()) {
-        const std::int64_t index = record.parseInt(corner.substr(0, corner.find('/')), "face index");
+        const std::int64_t index =
+            record.parseInt(corner.substr(0, corner.find('/')), "face index");
         // 1-based, or negative relative to the latest vertex.
         const std::int64_t zero_based = index < 0 ? vertex_count + index : index - 1;
         polygon.vertices.push_back(cornerIndex(zero_based));
       }
       mesh.polygons.push_back(std::move(polygon));
       any_record = true;
-    } else if (keyword.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ_") != std::string_view::npos) {
+    } else if (keyword.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ_") !=
+               std::string_view::npos) {
       record.fail("not an OBJ record: '" + std::string(keyword.substr(0, 40)) + "'");
     }
   }

@@ -41,11 +41,11 @@ struct PlyHeader {
 
 PlyType parseType(std::string_view name, const ByteCursor& cursor) {
   static const std::pair<const char*, PlyType> kNames[] = {
-      {"char", PlyType::Int8},     {"int8", PlyType::Int8},       {"uchar", PlyType::UInt8},
-      {"uint8", PlyType::UInt8},   {"short", PlyType::Int16},     {"int16", PlyType::Int16},
-      {"ushort", PlyType::UInt16}, {"uint16", PlyType::UInt16},   {"int", PlyType::Int32},
-      {"int32", PlyType::Int32},   {"uint", PlyType::UInt32},     {"uint32", PlyType::UInt32},
-      {"float", PlyType::Float32}, {"float32", PlyType::Float32}, {"double", PlyType::Float64},
+      {"char", PlyType::Int8},      {"int8", PlyType::Int8},       {"uchar", PlyType::UInt8},
+      {"uint8", PlyType::UInt8},    {"short", PlyType::Int16},     {"int16", PlyType::Int16},
+      {"ushort", PlyType::UInt16},  {"uint16", PlyType::UInt16},   {"int", PlyType::Int32},
+      {"int32", PlyType::Int32},    {"uint", PlyType::UInt32},     {"uint32", PlyType::UInt32},
+      {"float", PlyType::Float32},  {"float32", PlyType::Float32}, {"double", PlyType::Float64},
       {"float64", PlyType::Float64}};
   for (const auto& [text, type] : kNames) {
     if (name == text) return type;
@@ -56,27 +56,39 @@ PlyType parseType(std::string_view name, const ByteCursor& cursor) {
 std::uint32_t typeSize(PlyType type) {
   switch (type) {
     case PlyType::Int8:
-    case PlyType::UInt8: return 1;
+    case PlyType::UInt8:
+      return 1;
     case PlyType::Int16:
-    case PlyType::UInt16: return 2;
+    case PlyType::UInt16:
+      return 2;
     case PlyType::Int32:
     case PlyType::UInt32:
-    case PlyType::Float32: return 4;
-    case PlyType::Float64: return 8;
+    case PlyType::Float32:
+      return 4;
+    case PlyType::Float64:
+      return 8;
   }
   return 0;
 }
 
 std::uint8_t pclDatatype(PlyType type) {
   switch (type) {
-    case PlyType::Int8: return pcl::PCLPointField::INT8;
-    case PlyType::UInt8: return pcl::PCLPointField::UINT8;
-    case PlyType::Int16: return pcl::PCLPointField::INT16;
-    case PlyType::UInt16: return pcl::PCLPointField::UINT16;
-    case PlyType::Int32: return pcl::PCLPointField::INT32;
-    case PlyType::UInt32: return pcl::PCLPointField::UINT32;
-    case PlyType::Float32: return pcl::PCLPointField::FLOAT32;
-    case PlyType::Float64: return pcl::PCLPointField::FLOAT64;
+    case PlyType::Int8:
+      return pcl::PCLPointField::INT8;
+    case PlyType::UInt8:
+      return pcl::PCLPointField::UINT8;
+    case PlyType::Int16:
+      return pcl::PCLPointField::INT16;
+    case PlyType::UInt16:
+      return pcl::PCLPointField::UINT16;
+    case PlyType::Int32:
+      return pcl::PCLPointField::INT32;
+    case PlyType::UInt32:
+      return pcl::PCLPointField::UINT32;
+    case PlyType::Float32:
+      return pcl::PCLPointField::FLOAT32;
+    case PlyType::Float64:
+      return pcl::PCLPointField::FLOAT64;
   }
   return 0;
 }
@@ -152,14 +164,22 @@ class PlyValueReader {
   double number(PlyType type, const char* what) {
     if (format_ == PlyFormat::Ascii) return cursor_.readDouble(what);
     switch (type) {
-      case PlyType::Int8: return cursor_.readBinary<std::int8_t>(order_, what);
-      case PlyType::UInt8: return cursor_.readBinary<std::uint8_t>(order_, what);
-      case PlyType::Int16: return cursor_.readBinary<std::int16_t>(order_, what);
-      case PlyType::UInt16: return cursor_.readBinary<std::uint16_t>(order_, what);
-      case PlyType::Int32: return cursor_.readBinary<std::int32_t>(order_, what);
-      case PlyType::UInt32: return cursor_.readBinary<std::uint32_t>(order_, what);
-      case PlyType::Float32: return cursor_.readBinary<float>(order_, what);
-      case PlyType::Float64: return cursor_.readBinary<double>(order_, what);
+      case PlyType::Int8:
+        return cursor_.readBinary<std::int8_t>(order_, what);
+      case PlyType::UInt8:
+        return cursor_.readBinary<std::uint8_t>(order_, what);
+      case PlyType::Int16:
+        return cursor_.readBinary<std::int16_t>(order_, what);
+      case PlyType::UInt16:
+        return cursor_.readBinary<std::uint16_t>(order_, what);
+      case PlyType::Int32:
+        return cursor_.readBinary<std::int32_t>(order_, what);
+      case PlyType::UInt32:
+        return cursor_.readBinary<std::uint32_t>(order_, what);
+      case PlyType::Float32:
+        return cursor_.readBinary<float>(order_, what);
+      case PlyType::Float64:
+        return cursor_.readBinary<double>(order_, what);
     }
     return 0.0;
   }
@@ -182,14 +202,30 @@ class PlyValueReader {
     }
     const double v = cursor_.readDouble(what);
     switch (type) {
-      case PlyType::Int8: store<std::int8_t>(v, dst); break;
-      case PlyType::UInt8: store<std::uint8_t>(v, dst); break;
-      case PlyType::Int16: store<std::int16_t>(v, dst); break;
-      case PlyType::UInt16: store<std::uint16_t>(v, dst); break;
-      case PlyType::Int32: store<std::int32_t>(v, dst); break;
-      case PlyType::UInt32: store<std::uint32_t>(v, dst); break;
-      case PlyType::Float32: store<float>(v, dst); break;
-      case PlyType::Float64: store<double>(v, dst); break;
+      case PlyType::Int8:
+        store<std::int8_t>(v, dst);
+        break;
+      case PlyType::UInt8:
+        store<std::uint8_t>(v, dst);
+        break;
+      case PlyType::Int16:
+        store<std::int16_t>(v, dst);
+        break;
+      case PlyType::UInt16:
+        store<std::uint16_t>(v, dst);
+        break;
+      case PlyType::Int32:
+        store<std::int32_t>(v, dst);
+        break;
+      case PlyType::UInt32:
+        store<std::uint32_t>(v, dst);
+        break;
+      case PlyType::Float32:
+        store<float>(v, dst);
+        break;
+      case PlyType::Float64:
+        store<double>(v, dst);
+        break;
     }
   }
 
@@ -355,14 +391,22 @@ namespace {
 
 const char* plyTypeName(std::uint8_t datatype) {
   switch (datatype) {
-    case pcl::PCLPointField::INT8: return "char";
-    case pcl::PCLPointField::UINT8: return "uchar";
-    case pcl::PCLPointField::INT16: return "short";
-    case pcl::PCLPointField::UINT16: return "ushort";
-    case pcl::PCLPointField::INT32: return "int";
-    case pcl::PCLPointField::UINT32: return "uint";
-    case pcl::PCLPointField::FLOAT64: return "double";
-    default: return "float";
+    case pcl::PCLPointField::INT8:
+      return "char";
+    case pcl::PCLPointField::UINT8:
+      return "uchar";
+    case pcl::PCLPointField::INT16:
+      return "short";
+    case pcl::PCLPointField::UINT16:
+      return "ushort";
+    case pcl::PCLPointField::INT32:
+      return "int";
+    case pcl::PCLPointField::UINT32:
+      return "uint";
+    case pcl::PCLPointField::FLOAT64:
+      return "double";
+    default:
+      return "float";
   }
 }
 
@@ -381,7 +425,8 @@ std::vector<OutputProperty> outputProperties(const pcl::PCLPointCloud2& cloud) {
       properties.push_back({"red", pcl::PCLPointField::UINT8, f.offset + 2});
       properties.push_back({"green", pcl::PCLPointField::UINT8, f.offset + 1});
       properties.push_back({"blue", pcl::PCLPointField::UINT8, f.offset + 0});
-      if (f.name == "rgba") properties.push_back({"alpha", pcl::PCLPointField::UINT8, f.offset + 3});
+      if (f.name == "rgba")
+        properties.push_back({"alpha", pcl::PCLPointField::UINT8, f.offset + 3});
     } else if (f.count == 1 && !f.name.empty() && f.name != "_") {
       properties.push_back({f.name, f.datatype, f.offset});
     }
@@ -402,12 +447,24 @@ void printValue(std::ostream& out, const std::uint8_t* p) {
 
 void printScalar(std::ostream& out, const std::uint8_t* p, std::uint8_t datatype) {
   switch (datatype) {
-    case pcl::PCLPointField::INT8: printValue<std::int8_t>(out, p); break;
-    case pcl::PCLPointField::UINT8: printValue<std::uint8_t>(out, p); break;
-    case pcl::PCLPointField::INT16: printValue<std::int16_t>(out, p); break;
-    case pcl::PCLPointField::UINT16: printValue<std::uint16_t>(out, p); break;
-    case pcl::PCLPointField::INT32: printValue<std::int32_t>(out, p); break;
-    case pcl::PCLPointField::UINT32: printValue<std::uint32_t>(out, p); break;
+    case pcl::PCLPointField::INT8:
+      printValue<std::int8_t>(out, p);
+      break;
+    case pcl::PCLPointField::UINT8:
+      printValue<std::uint8_t>(out, p);
+      break;
+    case pcl::PCLPointField::INT16:
+      printValue<std::int16_t>(out, p);
+      break;
+    case pcl::PCLPointField::UINT16:
+      printValue<std::uint16_t>(out, p);
+      break;
+    case pcl::PCLPointField::INT32:
+      printValue<std::int32_t>(out, p);
+      break;
+    case pcl::PCLPointField::UINT32:
+      printValue<std::uint32_t>(out, p);
+      break;
     case pcl::PCLPointField::FLOAT64:
       out << std::setprecision(std::numeric_limits<double>::max_digits10);
       printValue<double>(out, p);
@@ -429,7 +486,8 @@ void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encod
   out << "ply\nformat " << (binary ? "binary_little_endian" : "ascii") << " 1.0\n"
       << "comment written by pcl_ddg\n"
       << "element vertex " << n << "\n";
-  for (const auto& p : properties) out << "property " << plyTypeName(p.datatype) << " " << p.name << "\n";
+  for (const auto& p : properties)
+    out << "property " << plyTypeName(p.datatype) << " " << p.name << "\n";
   out << "element face " << mesh.polygons.size() << "\n"
       << "property list uchar int vertex_indices\nend_header\n";
   for (std::size_t i = 0; i < n; ++i) {
@@ -437,8 +495,7 @@ void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encod
     for (std::size_t k = 0; k < properties.size(); ++k) {
       const OutputProperty& p = properties[k];
       if (binary) {
-        out.write(reinterpret_cast<const char*>(point + p.offset),
-                  pcl::getFieldSize(p.datatype));
+        out.write(reinterpret_cast<const char*>(point + p.offset), pcl::getFieldSize(p.datatype));
       } else {
         if (k) out << ' ';
         printScalar(out, point + p.offset, p.datatype);

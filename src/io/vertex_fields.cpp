@@ -14,8 +14,8 @@ std::size_t pointCount(const pcl::PCLPointCloud2& cloud) {
 }
 
 // Appends an uninitialised scalar field of `size` bytes and returns its offset.
-std::uint32_t appendField(pcl::PCLPointCloud2& cloud, const std::string& name, std::uint8_t datatype,
-                          std::uint32_t size) {
+std::uint32_t appendField(pcl::PCLPointCloud2& cloud, const std::string& name,
+                          std::uint8_t datatype, std::uint32_t size) {
   const std::size_t n = pointCount(cloud);
   const std::uint32_t old_step = cloud.point_step;
   const std::uint32_t new_step = old_step + size;
@@ -42,7 +42,8 @@ bool removeVertexField(pcl::PCLPointCloud2& cloud, const std::string& name) {
                                [&](const pcl::PCLPointField& f) { return f.name == name; });
   if (it == cloud.fields.end()) return false;
   const std::uint32_t begin = it->offset;
-  const std::uint32_t size = pcl::getFieldSize(it->datatype) * std::max<std::uint32_t>(1, it->count);
+  const std::uint32_t size =
+      pcl::getFieldSize(it->datatype) * std::max<std::uint32_t>(1, it->count);
   const std::uint32_t old_step = cloud.point_step;
   const std::uint32_t new_step = old_step - size;
   const std::size_t n = pointCount(cloud);
@@ -72,9 +73,9 @@ void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
   }
   removeVertexField(cloud, name);
   const bool as_double = precision == FieldPrecision::Double;
-  const std::uint32_t offset =
-      appendField(cloud, name, as_double ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32,
-                  as_double ? 8 : 4);
+  const std::uint32_t offset = appendField(
+      cloud, name, as_double ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32,
+      as_double ? 8 : 4);
   for (std::size_t i = 0; i < n; ++i) {
     std::uint8_t* dst = cloud.data.data() + i * cloud.point_step + offset;
     if (as_double) {

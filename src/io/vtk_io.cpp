@@ -36,7 +36,9 @@ class VtkReader {
  private:
   std::function<double()> binaryReader(std::string_view type, const char* what) {
     auto as = [this, what](auto zero) {
-      return [this, what] { return static_cast<double>(cursor_.readBinary<decltype(zero)>(ByteOrder::Big, what)); };
+      return [this, what] {
+        return static_cast<double>(cursor_.readBinary<decltype(zero)>(ByteOrder::Big, what));
+      };
     };
     if (type == "float") return as(float{});
     if (type == "double") return as(double{});
@@ -63,7 +65,8 @@ void readCells(ByteCursor& cursor, VtkReader& reader,
   const std::size_t mark = cursor.position();
   std::vector<std::int64_t> indices;
   if (cursor.token() == "OFFSETS") {
-    const std::vector<double> offsets = reader.values(first, cursor.requireToken("offset type"), "offsets");
+    const std::vector<double> offsets =
+        reader.values(first, cursor.requireToken("offset type"), "offsets");
     if (cursor.token() != "CONNECTIVITY") cursor.fail("VTK OFFSETS without CONNECTIVITY");
     const std::vector<double> connectivity =
         reader.values(second, cursor.requireToken("connectivity type"), "connectivity");
@@ -109,7 +112,8 @@ pcl::PolygonMesh parseVTK(std::string_view data) {
   } else {
     cursor.fail("VTK encoding must be ASCII or BINARY");
   }
-  if (cursor.requireToken("DATASET") != "DATASET" || cursor.requireToken("dataset type") != "POLYDATA") {
+  if (cursor.requireToken("DATASET") != "DATASET" ||
+      cursor.requireToken("dataset type") != "POLYDATA") {
     cursor.fail("only VTK POLYDATA is supported");
   }
   VtkReader reader(cursor, encoding);
@@ -118,7 +122,8 @@ pcl::PolygonMesh parseVTK(std::string_view data) {
   for (std::string_view keyword = cursor.token(); !keyword.empty(); keyword = cursor.token()) {
     if (keyword == "POINTS") {
       const std::int64_t n = cursor.readInt("point count");
-      const std::vector<double> xyz = reader.values(3 * n, cursor.requireToken("point type"), "points");
+      const std::vector<double> xyz =
+          reader.values(3 * n, cursor.requireToken("point type"), "points");
       mesh.cloud = makeXYZCloud(xyz);
       has_points = true;
     } else if (keyword == "POLYGONS" || keyword == "TRIANGLE_STRIPS" || keyword == "VERTICES" ||

@@ -31,8 +31,8 @@ CloudReport makeCloudReport(const pcl::PCLPointCloud2& cloud) {
 std::string CloudReport::toJson() const {
   std::ostringstream out;
   out << "{\"points\": " << points << ", \"width\": " << width << ", \"height\": " << height
-      << ", \"organized\": " << (organized() ? "true" : "false") << ", \"nan_points\": " << nan_points
-      << ", \"duplicate_points\": " << duplicate_points;
+      << ", \"organized\": " << (organized() ? "true" : "false")
+      << ", \"nan_points\": " << nan_points << ", \"duplicate_points\": " << duplicate_points;
   out << ", \"bounding_box_min\": " << detail::jsonArray(bounding_box.min)
       << ", \"bounding_box_max\": " << detail::jsonArray(bounding_box.max) << "}";
   return out.str();

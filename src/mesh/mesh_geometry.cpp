@@ -9,8 +9,7 @@ namespace pcl_ddg {
 bool isDegenerateTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                           const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, ac = c - a, bc = c - b;
-  const double longest_squared =
-      std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
+  const double longest_squared = std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
   return ab.cross(ac).norm() <= kDegenerateTriangleTolerance * longest_squared;
 }
 

@@ -119,8 +119,7 @@ std::string MeshReport::toText() const {
       << "Euler characteristic:  " << euler_characteristic << "\n"
       << "genus:                 " << (genus >= 0 ? std::to_string(genus) : "n/a") << "\n"
       << "orientable:            " << (orientable ? "yes" : "no")
-      << (consistently_oriented ? ", consistently oriented" : ", NOT consistently oriented")
-      << "\n"
+      << (consistently_oriented ? ", consistently oriented" : ", NOT consistently oriented") << "\n"
       << "mean edge length:      " << mean_edge_length << "\n"
       << "bounding box:          [" << bounding_box.min.transpose() << "] .. ["
       << bounding_box.max.transpose() << "]\n";

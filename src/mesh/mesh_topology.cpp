@@ -78,8 +78,8 @@ void MeshTopology::triangulate(const std::vector<pcl::Vertices>& polygons,
     const auto& corners = polygons[first_bad].vertices;
     const auto bad = *std::find_if(corners.begin(), corners.end(), invalid);
     std::ostringstream msg;
-    msg << "face " << first_bad << " refers to vertex " << bad
-        << " but the mesh has " << num_vertices_ << " vertices (" << counts_.out_of_range_polygons
+    msg << "face " << first_bad << " refers to vertex " << bad << " but the mesh has "
+        << num_vertices_ << " vertices (" << counts_.out_of_range_polygons
         << " faces out of range)";
     throw InvalidMeshException(msg.str());
   }
@@ -258,14 +258,15 @@ void MeshTopology::findBowTieVertices() {
     const IndexSpan ring = neighbours(v);
     if (tris.size() < 2) continue;
     std::iota(parent.begin(), parent.begin() + tris.size(), 0);
-    std::fill(first_triangle_at_neighbour.begin(), first_triangle_at_neighbour.begin() + ring.size(),
-              -1);
+    std::fill(first_triangle_at_neighbour.begin(),
+              first_triangle_at_neighbour.begin() + ring.size(), -1);
     int fans = tris.size();
     for (int i = 0; i < tris.size(); ++i) {
       for (int k = 0; k < 3; ++k) {
         const int w = triangles_(k, tris[i]);
         if (w == v) continue;
-        const int slot = static_cast<int>(std::lower_bound(ring.begin(), ring.end(), w) - ring.begin());
+        const int slot =
+            static_cast<int>(std::lower_bound(ring.begin(), ring.end(), w) - ring.begin());
         int& first = first_triangle_at_neighbour[slot];
         if (first < 0) {
           first = i;
@@ -362,7 +363,8 @@ void MeshTopology::countBoundaryLoops() {
   }
   for (int r = 0; r < num_vertices_; ++r) {
     if (edges_of_root[r] > 0) {
-      counts_.boundary_loops += std::max<std::int64_t>(1, edges_of_root[r] - vertices_of_root[r] + 1);
+      counts_.boundary_loops +=
+          std::max<std::int64_t>(1, edges_of_root[r] - vertices_of_root[r] + 1);
     }
   }
 }

@@ -20,23 +20,32 @@ double load(const std::uint8_t* p) {
 
 double readScalar(const std::uint8_t* p, std::uint8_t datatype) {
   switch (datatype) {
-    case pcl::PCLPointField::INT8: return load<std::int8_t>(p);
-    case pcl::PCLPointField::UINT8: return load<std::uint8_t>(p);
-    case pcl::PCLPointField::INT16: return load<std::int16_t>(p);
-    case pcl::PCLPointField::UINT16: return load<std::uint16_t>(p);
-    case pcl::PCLPointField::INT32: return load<std::int32_t>(p);
-    case pcl::PCLPointField::UINT32: return load<std::uint32_t>(p);
-    case pcl::PCLPointField::FLOAT32: return load<float>(p);
-    case pcl::PCLPointField::FLOAT64: return load<double>(p);
-    default: throw InvalidMeshException("unsupported coordinate field type");
+    case pcl::PCLPointField::INT8:
+      return load<std::int8_t>(p);
+    case pcl::PCLPointField::UINT8:
+      return load<std::uint8_t>(p);
+    case pcl::PCLPointField::INT16:
+      return load<std::int16_t>(p);
+    case pcl::PCLPointField::UINT16:
+      return load<std::uint16_t>(p);
+    case pcl::PCLPointField::INT32:
+      return load<std::int32_t>(p);
+    case pcl::PCLPointField::UINT32:
+      return load<std::uint32_t>(p);
+    case pcl::PCLPointField::FLOAT32:
+      return load<float>(p);
+    case pcl::PCLPointField::FLOAT64:
+      return load<double>(p);
+    default:
+      throw InvalidMeshException("unsupported vertex field type");
   }
 }
 
-const pcl::PCLPointField& coordinateField(const pcl::PCLPointCloud2& cloud, const char* name) {
+const pcl::PCLPointField& namedField(const pcl::PCLPointCloud2& cloud, const std::string& name) {
   for (const auto& f : cloud.fields) {
     if (f.name == name) return f;
   }
-  throw InvalidMeshException(std::string("vertex data has no '") + name + "' field");
+  throw InvalidMeshException("vertex data has no '" + name + "' field");
 }
 
 }  // namespace
@@ -60,22 +69,33 @@ void requireFinite(const Eigen::Matrix3Xd& positions) {
   throw InvalidMeshException(msg.str());
 }
 
-Eigen::Matrix3Xd vertexPositions(const pcl::PCLPointCloud2& cloud, NonFinitePolicy policy) {
+bool hasVertexField(const pcl::PCLPointCloud2& cloud, const std::string& name) {
+  for (const auto& f : cloud.fields) {
+    if (f.name == name) return true;
+  }
+  return false;
+}
+
+Eigen::VectorXd vertexScalarField(const pcl::PCLPointCloud2& cloud, const std::string& name) {
   const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
-  if (n == 0) throw InvalidMeshException("mesh has no vertices");
   if (cloud.data.size() < n * cloud.point_step) {
     throw InvalidMeshException("vertex data is shorter than width x height x point_step");
   }
-  const pcl::PCLPointField* fields[3] = {&coordinateField(cloud, "x"), &coordinateField(cloud, "y"),
-                                         &coordinateField(cloud, "z")};
-  Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(n));
+  const pcl::PCLPointField& field = namedField(cloud, name);
+  Eigen::VectorXd values(static_cast<Eigen::Index>(n));
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
-    for (int d = 0; d < 3; ++d) {
-      positions(d, static_cast<Eigen::Index>(i)) =
-          readScalar(point + fields[d]->offset, fields[d]->datatype);
-    }
+    values[static_cast<Eigen::Index>(i)] =
+        readScalar(cloud.data.data() + i * cloud.point_step + field.offset, field.datatype);
   }
+  return values;
+}
+
+Eigen::Matrix3Xd vertexPositions(const pcl::PCLPointCloud2& cloud, NonFinitePolicy policy) {
+  if (cloud.width * cloud.height == 0) throw InvalidMeshException("mesh has no vertices");
+  Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(cloud.width) * cloud.height);
+  positions.row(0) = vertexScalarField(cloud, "x").transpose();
+  positions.row(1) = vertexScalarField(cloud, "y").transpose();
+  positions.row(2) = vertexScalarField(cloud, "z").transpose();
   if (policy == NonFinitePolicy::Throw) requireFinite(positions);
   return positions;
 }

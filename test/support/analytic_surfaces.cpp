@@ -44,7 +44,8 @@ void store(SurfaceSample& s, Eigen::Index i, const PointQuantities& q) {
 
 // Any unit tangent pair at an umbilic.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> tangentFrame(const Eigen::Vector3d& n) {
-  const Eigen::Vector3d a = std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d a =
+      std::abs(n.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY();
   const Eigen::Vector3d t1 = (a - a.dot(n) * n).normalized();
   return {t1, n.cross(t1)};
 }
@@ -112,8 +113,9 @@ PointQuantities graphPoint(double x, double y, double z, double p, double q, dou
 }
 
 // Midpoint-rule integrals of the area element and of K dA of a graph over [-1,1]^2.
-std::pair<double, double> graphIntegrals(const std::function<PointQuantities(double, double)>& f,
-                                         const std::function<double(double, double)>& area_element) {
+std::pair<double, double> graphIntegrals(
+    const std::function<PointQuantities(double, double)>& f,
+    const std::function<double(double, double)>& area_element) {
   const int n = 1000;
   const double h = 2.0 / n;
   double area = 0.0, total_k = 0.0;
@@ -134,8 +136,8 @@ SurfaceSample graphSurface(const Sampling& sampling, double a, double sign_y) {
     return graphPoint(x, y, a * (x * x + sign_y * y * y), 2 * a * x, 2 * a * sign_y * y, 2 * a, 0,
                       2 * a * sign_y);
   };
-  SurfaceSample s = gridSurface(sampling.resolution, sampling.resolution, false, false, -1, 1, -1, 1,
-                                sampling, f);
+  SurfaceSample s = gridSurface(sampling.resolution, sampling.resolution, false, false, -1, 1, -1,
+                                1, sampling, f);
   std::tie(s.area, s.total_gauss_curvature) = graphIntegrals(f, [a, sign_y](double x, double y) {
     return std::sqrt(1 + 4 * a * a * (x * x + y * y * sign_y * sign_y));
   });
@@ -156,7 +158,8 @@ SurfaceSample& SurfaceSample::transform(const Eigen::Isometry3d& motion) {
 
 SurfaceSample& SurfaceSample::rotateAndShiftFar() {
   Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
-  motion.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  motion.linear() =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
   motion.translation() = Eigen::Vector3d(1.0e5, -2.0e5, 0.5e5);
   return transform(motion);
 }
@@ -176,8 +179,8 @@ SurfaceSample makePlane(const Sampling& sampling) {
     q.dir2 = Eigen::Vector3d::UnitY();
     return q;
   };
-  SurfaceSample s =
-      gridSurface(sampling.resolution, sampling.resolution, false, false, -1, 1, -1, 1, sampling, f);
+  SurfaceSample s = gridSurface(sampling.resolution, sampling.resolution, false, false, -1, 1, -1,
+                                1, sampling, f);
   s.area = 4.0;
   s.euler_characteristic = 1;
   return s;
@@ -195,8 +198,8 @@ SurfaceSample makeCylinder(const Sampling& sampling, double radius, double heigh
   };
   const int around = sampling.resolution;
   const int rows = std::max(1, sampling.resolution / 2);
-  SurfaceSample s = gridSurface(around, rows, true, false, 0, 2 * kPi, -height / 2, height / 2,
-                                sampling, f);
+  SurfaceSample s =
+      gridSurface(around, rows, true, false, 0, 2 * kPi, -height / 2, height / 2, sampling, f);
   s.area = 2 * kPi * radius * height;
   s.euler_characteristic = 0;
   return s;
@@ -208,8 +211,8 @@ SurfaceSample makeTorus(const Sampling& sampling, double major, double minor) {
     const double cu = std::cos(u), su = std::sin(u), cv = std::cos(v), sv = std::sin(v);
     q.normal = {cv * cu, cv * su, sv};
     q.point = Eigen::Vector3d((major + minor * cv) * cu, (major + minor * cv) * su, minor * sv);
-    q.kappa1 = 1.0 / minor;                        // around the tube (meridian)
-    q.kappa2 = cv / (major + minor * cv);          // along the parallel
+    q.kappa1 = 1.0 / minor;                // around the tube (meridian)
+    q.kappa2 = cv / (major + minor * cv);  // along the parallel
     q.dir1 = {-sv * cu, -sv * su, cv};
     q.dir2 = {-su, cu, 0};
     return q;
@@ -222,7 +225,9 @@ SurfaceSample makeTorus(const Sampling& sampling, double major, double minor) {
   return s;
 }
 
-SurfaceSample makeSaddle(const Sampling& sampling, double a) { return graphSurface(sampling, a, -1); }
+SurfaceSample makeSaddle(const Sampling& sampling, double a) {
+  return graphSurface(sampling, a, -1);
+}
 
 SurfaceSample makeParaboloid(const Sampling& sampling, double a) {
   return graphSurface(sampling, a, 1);
@@ -230,9 +235,9 @@ SurfaceSample makeParaboloid(const Sampling& sampling, double a) {
 
 SurfaceSample makeIcosphere(int level, double radius, double jitter, std::uint32_t seed) {
   const double g = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0},   {-1, -g, 0}, {1, -g, 0},
-                                    {0, -1, g}, {0, 1, g},   {0, -1, -g}, {0, 1, -g},
-                                    {g, 0, -1}, {g, 0, 1},   {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},
+                                    {0, -1, g}, {0, 1, g}, {0, -1, -g}, {0, 1, -g},
+                                    {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
   for (auto& p : v) p.normalize();
   std::vector<Eigen::Vector3i> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                                     {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},

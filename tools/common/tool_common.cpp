@@ -55,7 +55,8 @@ std::string ToolArguments::text(const std::string& option, const std::string& fa
   return value(option).value_or(fallback);
 }
 
-std::string ToolArguments::choice(const std::string& option, const std::vector<std::string>& choices,
+std::string ToolArguments::choice(const std::string& option,
+                                  const std::vector<std::string>& choices,
                                   const std::string& fallback) const {
   const std::string chosen = text(option, fallback);
   for (const auto& c : choices) {

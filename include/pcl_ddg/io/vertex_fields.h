@@ -13,7 +13,8 @@ enum class FieldPrecision { Float, Double };
 
 /** Adds the field, or replaces a field of the same name; values.size() must be the point count. */
 void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
-                    const Eigen::VectorXd& values, FieldPrecision precision = FieldPrecision::Float);
+                    const Eigen::VectorXd& values,
+                    FieldPrecision precision = FieldPrecision::Float);
 
 /** Sets uchar fields red, green, blue (replacing any colour fields, packed rgb/rgba included). */
 void setVertexColors(pcl::PCLPointCloud2& cloud,

@@ -12,9 +12,10 @@ namespace pcl_ddg {
 struct CloudReport {
   std::int64_t points = 0;
   std::int64_t width = 0;
-  std::int64_t height = 0;  ///< > 1 for an organized cloud (image grid)
-  std::int64_t nan_points = 0;        ///< points with a NaN or infinite coordinate
-  std::int64_t duplicate_points = 0;  ///< finite points with exactly the coordinates of an earlier one
+  std::int64_t height = 0;      ///< > 1 for an organized cloud (image grid)
+  std::int64_t nan_points = 0;  ///< points with a NaN or infinite coordinate
+  std::int64_t duplicate_points =
+      0;  ///< finite points with exactly the coordinates of an earlier one
   BoundingBox bounding_box;
 
   bool organized() const { return height > 1; }

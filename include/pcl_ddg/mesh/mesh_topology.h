@@ -38,18 +38,19 @@ struct TopologyCounts {
   /** polygons_by_valence[n] = number of input polygons with n corners (n = 0, 1, 2, ... ). */
   std::vector<std::int64_t> polygons_by_valence;
   std::int64_t input_polygons = 0;
-  std::int64_t out_of_range_polygons = 0;     ///< dropped (policy Drop)
-  std::int64_t repeated_index_polygons = 0;   ///< fewer than 3 distinct corners, or a repeated corner
-  std::int64_t duplicate_polygons = 0;        ///< same vertex set as an earlier polygon
-  std::int64_t triangulated_polygons = 0;     ///< polygons with more than three corners
-  std::int64_t boundary_edges = 0;            ///< edges of exactly one triangle
-  std::int64_t boundary_loops = 0;            ///< independent cycles of boundary edges
-  std::int64_t nonmanifold_edges = 0;         ///< edges of more than two triangles
-  std::int64_t nonmanifold_vertices = 0;      ///< vertices whose triangles form several fans
-  std::int64_t unreferenced_vertices = 0;     ///< vertices of no triangle
-  std::int64_t connected_components = 0;      ///< of the triangles (unreferenced vertices excluded)
-  bool orientable = true;                     ///< every component admits a consistent orientation
-  bool consistently_oriented = true;          ///< every manifold edge traversed once each way
+  std::int64_t out_of_range_polygons = 0;  ///< dropped (policy Drop)
+  std::int64_t repeated_index_polygons =
+      0;                                   ///< fewer than 3 distinct corners, or a repeated corner
+  std::int64_t duplicate_polygons = 0;     ///< same vertex set as an earlier polygon
+  std::int64_t triangulated_polygons = 0;  ///< polygons with more than three corners
+  std::int64_t boundary_edges = 0;         ///< edges of exactly one triangle
+  std::int64_t boundary_loops = 0;         ///< independent cycles of boundary edges
+  std::int64_t nonmanifold_edges = 0;      ///< edges of more than two triangles
+  std::int64_t nonmanifold_vertices = 0;   ///< vertices whose triangles form several fans
+  std::int64_t unreferenced_vertices = 0;  ///< vertices of no triangle
+  std::int64_t connected_components = 0;   ///< of the triangles (unreferenced vertices excluded)
+  bool orientable = true;                  ///< every component admits a consistent orientation
+  bool consistently_oriented = true;       ///< every manifold edge traversed once each way
 };
 
 /** Per-vertex flags, a bit set. */

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <string>
 
 namespace pcl_ddg {
 
@@ -25,6 +26,12 @@ NonFiniteVertices findNonFiniteVertices(const Eigen::Matrix3Xd& positions);
  */
 Eigen::Matrix3Xd vertexPositions(const pcl::PCLPointCloud2& cloud,
                                  NonFinitePolicy policy = NonFinitePolicy::Throw);
+
+/** One numeric field of every point, in double; throws InvalidMeshException if it is missing. */
+Eigen::VectorXd vertexScalarField(const pcl::PCLPointCloud2& cloud, const std::string& name);
+
+/** True if the cloud has a field of that name. */
+bool hasVertexField(const pcl::PCLPointCloud2& cloud, const std::string& name);
 
 /** Throws InvalidMeshException naming the first non-finite vertex and the count, if any. */
 void requireFinite(const Eigen::Matrix3Xd& positions);

@@ -1,0 +1,24 @@
+#pragma once
+// Scalar fields to colours, for MeshLab (per-vertex RGB) and for pictures.
+#include <Eigen/Core>
+#include <cstdint>
+
+namespace pcl_ddg {
+
+enum class ColorMap {
+  Diverging,   ///< blue - white - red, symmetric about zero (signed curvatures)
+  Sequential,  ///< dark blue - green - yellow (magnitudes, areas, errors)
+};
+
+struct ColorScale {
+  /** Values are clamped at these percentiles of the finite values, so outliers do not wash out
+   *  the picture. */
+  double low_percentile = 2.0;
+  double high_percentile = 98.0;
+};
+
+/** One RGB colour per value; NaN values are grey. */
+Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorize(const Eigen::VectorXd& values, ColorMap map,
+                                                        const ColorScale& scale = {});
+
+}  // namespace pcl_ddg

@@ -1,0 +1,122 @@
+#include "pcl_ddg/io/mesh_render.h"
+
+#include <stb_image_write.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/atomic_file.h"
+
+namespace pcl_ddg {
+namespace {
+
+// Camera frame: rows are screen right, screen up, towards the viewer.
+Eigen::Matrix3d viewRotation(const RenderOptions& o) {
+  const double deg = 3.14159265358979323846 / 180.0;
+  const Eigen::Vector3d up = o.up.normalized();
+  const Eigen::Vector3d side =
+      std::abs(up.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d front0 = (side - side.dot(up) * up).normalized();
+  const Eigen::Vector3d towards_viewer =
+      Eigen::AngleAxisd(o.azimuth_degrees * deg, up) *
+      (std::cos(o.elevation_degrees * deg) * front0 + std::sin(o.elevation_degrees * deg) * up);
+  const Eigen::Vector3d right = up.cross(towards_viewer).normalized();
+  const Eigen::Vector3d screen_up = towards_viewer.cross(right);
+  Eigen::Matrix3d r;
+  r.row(0) = right;
+  r.row(1) = screen_up;
+  r.row(2) = towards_viewer;
+  return r;
+}
+
+}  // namespace
+
+Image renderMesh(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xi& triangles,
+                 const Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic>& colors,
+                 const RenderOptions& options) {
+  Image image;
+  image.width = options.width;
+  image.height = options.height;
+  image.rgb.assign(static_cast<std::size_t>(image.width) * image.height * 3, 255);
+  if (triangles.cols() == 0) return image;
+
+  // View coordinates, centred and scaled to fit the image with a margin.
+  const Eigen::Matrix3d rotation = viewRotation(options);
+  Eigen::Matrix3Xd view = rotation * positions;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (Eigen::Index i = 0; i < view.cols(); ++i) {
+    if (!view.col(i).allFinite()) continue;
+    lo = lo.cwiseMin(view.col(i));
+    hi = hi.cwiseMax(view.col(i));
+  }
+  const double scale = 0.9 * std::min(image.width / std::max(hi.x() - lo.x(), 1e-300),
+                                      image.height / std::max(hi.y() - lo.y(), 1e-300));
+  const Eigen::Vector2d centre = 0.5 * (lo.head<2>() + hi.head<2>());
+  const Eigen::Vector3d light = Eigen::Vector3d(-0.3, 0.5, 1.0).normalized();
+
+  std::vector<double> depth(static_cast<std::size_t>(image.width) * image.height,
+                            -std::numeric_limits<double>::infinity());
+  for (Eigen::Index t = 0; t < triangles.cols(); ++t) {
+    Eigen::Vector3d p[3];
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d v = view.col(triangles(k, t));
+      p[k] = {image.width / 2.0 + scale * (v.x() - centre.x()),
+              image.height / 2.0 - scale * (v.y() - centre.y()), v.z()};
+    }
+    if (!(p[0].allFinite() && p[1].allFinite() && p[2].allFinite())) continue;
+    const Eigen::Vector3d normal =
+        (view.col(triangles(1, t)) - view.col(triangles(0, t)))
+            .cross(view.col(triangles(2, t)) - view.col(triangles(0, t)));
+    if (normal.norm() == 0.0) continue;
+    const double shade = 0.25 + 0.75 * std::abs(normal.normalized().dot(light));
+    const double area = (p[1].x() - p[0].x()) * (p[2].y() - p[0].y()) -
+                        (p[2].x() - p[0].x()) * (p[1].y() - p[0].y());
+    if (area == 0.0) continue;
+    const int x0 =
+        std::max(0, static_cast<int>(std::floor(std::min({p[0].x(), p[1].x(), p[2].x()}))));
+    const int x1 = std::min(image.width - 1,
+                            static_cast<int>(std::ceil(std::max({p[0].x(), p[1].x(), p[2].x()}))));
+    const int y0 =
+        std::max(0, static_cast<int>(std::floor(std::min({p[0].y(), p[1].y(), p[2].y()}))));
+    const int y1 = std::min(image.height - 1,
+                            static_cast<int>(std::ceil(std::max({p[0].y(), p[1].y(), p[2].y()}))));
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        const double px = x + 0.5, py = y + 0.5;
+        double w[3];
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3d& a = p[(k + 1) % 3];
+          const Eigen::Vector3d& b = p[(k + 2) % 3];
+          w[k] = ((b.x() - a.x()) * (py - a.y()) - (px - a.x()) * (b.y() - a.y())) / area;
+        }
+        if (w[0] < 0 || w[1] < 0 || w[2] < 0) continue;
+        const double z = w[0] * p[0].z() + w[1] * p[1].z() + w[2] * p[2].z();
+        const std::size_t pixel = static_cast<std::size_t>(y) * image.width + x;
+        if (z <= depth[pixel]) continue;
+        depth[pixel] = z;
+        for (int c = 0; c < 3; ++c) {
+          double value = 0.0;
+          for (int k = 0; k < 3; ++k) value += w[k] * colors(c, triangles(k, t));
+          image.rgb[3 * pixel + c] =
+              static_cast<std::uint8_t>(std::clamp(shade * value, 0.0, 255.0));
+        }
+      }
+    }
+  }
+  return image;
+}
+
+void savePNG(const std::string& path, const Image& image) {
+  AtomicFile file(path);
+  if (!stbi_write_png(file.temporaryPath().c_str(), image.width, image.height, 3, image.rgb.data(),
+                      image.width * 3)) {
+    throw FileFormatException(path + ": PNG write failed");
+  }
+  file.commit();
+}
+
+}  // namespace pcl_ddg

@@ -1,0 +1,79 @@
+// The renderer and colour maps behind the README pictures.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <filesystem>
+#include <limits>
+
+#include "analytic_surfaces.h"
+#include "pcl_ddg/io/color_map.h"
+#include "pcl_ddg/io/mesh_render.h"
+#include "test_data.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+std::array<int, 3> pixel(const Image& image, int x, int y) {
+  const std::size_t i = 3 * (static_cast<std::size_t>(y) * image.width + x);
+  return {image.rgb[i], image.rgb[i + 1], image.rgb[i + 2]};
+}
+
+TEST(MeshRender, NearerSurfaceHidesFartherOne) {
+  // Two unit squares facing the camera (view along -z: azimuth 0, elevation 0, up y puts the
+  // viewer on +z); the red one is nearer and smaller, the blue one behind and larger.
+  Eigen::Matrix3Xd p(3, 8);
+  p << -1, 1, 1, -1, -0.5, 0.5, 0.5, -0.5,  //
+      -1, -1, 1, 1, -0.5, -0.5, 0.5, 0.5,   //
+      0, 0, 0, 0, 1, 1, 1, 1;
+  Eigen::Matrix3Xi t(3, 4);
+  t << 0, 0, 4, 4, 1, 2, 5, 6, 2, 3, 6, 7;
+  Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> c(3, 8);
+  c.leftCols(4).colwise() = Eigen::Matrix<std::uint8_t, 3, 1>(0, 0, 255);
+  c.rightCols(4).colwise() = Eigen::Matrix<std::uint8_t, 3, 1>(255, 0, 0);
+  RenderOptions o;
+  o.width = o.height = 100;
+  o.azimuth_degrees = 0;
+  o.elevation_degrees = 0;
+  const Image image = renderMesh(p, t, c, o);
+  const auto centre = pixel(image, 50, 50);
+  EXPECT_GT(centre[0], 100);
+  EXPECT_EQ(centre[2], 0);
+  const auto side = pixel(image, 15, 50);
+  EXPECT_EQ(side[0], 0);
+  EXPECT_GT(side[2], 100);
+  EXPECT_EQ(pixel(image, 1, 1), (std::array<int, 3>{255, 255, 255}));  // margin stays background
+}
+
+TEST(MeshRender, SavesAPngAtomically) {
+  const SurfaceSample sphere = makeIcosphere(2);
+  Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> c(3, sphere.points.cols());
+  c.setConstant(200);
+  const std::string dir = scratchFolder("render");
+  savePNG(dir + "/sphere.png", renderMesh(sphere.points, sphere.triangles, c));
+  EXPECT_GT(std::filesystem::file_size(dir + "/sphere.png"), 1000u);
+  EXPECT_THROW(savePNG(dir + "/missing/sphere.png", Image{}), std::exception);
+}
+
+TEST(ColorMap, DivergingIsSymmetricAboutZeroAndNaNIsGrey) {
+  Eigen::VectorXd v(5);
+  v << -2, 0, 1, std::numeric_limits<double>::quiet_NaN(), 2;
+  const auto rgb = colorize(v, ColorMap::Diverging, {0.0, 100.0});
+  EXPECT_GT(rgb(2, 0), rgb(0, 0));  // negative: blue
+  EXPECT_GT(rgb(0, 4), rgb(2, 4));  // positive: red
+  EXPECT_EQ(rgb(0, 1), rgb(2, 1));  // zero: neutral
+  EXPECT_EQ(rgb.col(3), (Eigen::Matrix<std::uint8_t, 3, 1>(128, 128, 128)));
+}
+
+TEST(ColorMap, PercentilesClampOutliers) {
+  Eigen::VectorXd v = Eigen::VectorXd::LinSpaced(101, 0.0, 100.0);
+  v[100] = 1e9;  // one outlier must not flatten the rest of the scale
+  const auto rgb = colorize(v, ColorMap::Sequential, {0.0, 98.0});
+  EXPECT_EQ(rgb.col(98), rgb.col(100));
+  EXPECT_NE(rgb.col(0), rgb.col(50));
+  EXPECT_NE(rgb.col(50), rgb.col(98));
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
