@@ -1,6 +1,7 @@
 // Every loader on every file of the shared data, round trips, and broken files.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
@@ -167,6 +168,30 @@ TEST_F(MeshIOFiles, BinaryStlMergesSharedCorners) {
   const pcl::PolygonMesh stl = loadMesh(path("tri.stl"));
   EXPECT_EQ(stl.cloud.width, 4u);  // shared corners merged
   EXPECT_EQ(stl.polygons.size(), 2u);
+}
+
+TEST_F(MeshIOFiles, BinaryOffIsBigEndian) {
+  std::string data = "OFF BINARY\n";
+  auto put = [&](auto value) {
+    std::string bytes(sizeof(value), '\0');
+    std::memcpy(bytes.data(), &value, sizeof(value));
+    data.append(bytes.rbegin(), bytes.rend());
+  };
+  for (std::int32_t count : {3, 1, 0}) put(count);
+  for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 2.f, 0.f}) put(v);
+  for (std::int32_t v : {3, 0, 1, 2, 0}) put(v);  // corners, then no colour values
+  writeText(path("tri.off"), data);
+  const pcl::PolygonMesh mesh = loadMesh(path("tri.off"));
+  ASSERT_EQ(mesh.polygons.size(), 1u);
+  EXPECT_EQ(vertexPositions(mesh.cloud).col(2), Eigen::Vector3d(0, 2, 0));
+  writeText(path("tri.off"), data.substr(0, data.size() - 6));
+  EXPECT_THROW(loadMesh(path("tri.off")), FileFormatException);
+}
+
+TEST_F(MeshIOFiles, SavedFilesHaveOrdinaryPermissions) {
+  saveMesh(path("p.ply"), makeMesh(Eigen::Matrix3Xd::Zero(3, 3), {{0, 1, 2}}));
+  const auto perms = std::filesystem::status(path("p.ply")).permissions();
+  EXPECT_NE(perms & std::filesystem::perms::group_read, std::filesystem::perms::none);
 }
 
 TEST_F(MeshIOFiles, TruncatedFilesFailWithAMessage) {

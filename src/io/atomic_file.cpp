@@ -1,6 +1,7 @@
 #include "pcl_ddg/io/atomic_file.h"
 
 #include <stdlib.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -24,6 +25,10 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path) {
     throw FileFormatException("cannot create a file next to '" + path +
                               "': " + std::strerror(errno));
   }
+  // mkstemp creates the file private (0600); give the result the permissions of a plain new file.
+  const mode_t mask = umask(0);
+  umask(mask);
+  fchmod(fd, 0666 & ~mask);
   close(fd);
   temporary_path_ = buffer.data();
 }
