@@ -63,7 +63,7 @@ Eigen::Vector3d residualGradient(double (*f)(const Eigen::Vector3d&), const Eige
 }
 
 TEST(AnalyticSurfaces, PointsOnSurfaceWithUnitNormalsOrthogonalToIt) {
-  for (double jitter : {0.0, 0.3}) {
+  for (double jitter : {0.0, 0.1}) {
     for (const Case& c : allSurfaces(jitter)) {
       SCOPED_TRACE(c.name);
       for (Eigen::Index i = 0; i < c.sample.points.cols(); ++i) {
@@ -77,7 +77,7 @@ TEST(AnalyticSurfaces, PointsOnSurfaceWithUnitNormalsOrthogonalToIt) {
 }
 
 TEST(AnalyticSurfaces, PrincipalFrameIsOrthonormalTangentAndOrdered) {
-  for (const Case& c : allSurfaces(0.2)) {
+  for (const Case& c : allSurfaces(0.08)) {
     SCOPED_TRACE(c.name);
     const SurfaceSample& s = c.sample;
     for (Eigen::Index i = 0; i < s.points.cols(); ++i) {
@@ -125,7 +125,7 @@ TEST(AnalyticSurfaces, PrincipalCurvaturesMatchNormalCurvatureOfTheSurface) {
 }
 
 TEST(AnalyticSurfaces, MeshesHaveTheTopologyOfTheSurface) {
-  for (const Case& c : allSurfaces(0.3)) {
+  for (const Case& c : allSurfaces(0.1)) {
     SCOPED_TRACE(c.name);
     const MeshTopology topology(static_cast<int>(c.sample.points.cols()), c.sample.triangles);
     EXPECT_EQ(topology.eulerCharacteristic(), c.sample.euler_characteristic);
@@ -185,7 +185,7 @@ TEST(AnalyticSurfaces, TorusQuadratureOfExactCurvature) {
 }
 
 TEST(AnalyticSurfaces, RigidMotionMovesEveryQuantity) {
-  SurfaceSample torus = makeTorus({16, 0.2, 3});
+  SurfaceSample torus = makeTorus({16, 0.08, 3});
   const SurfaceSample original = torus;
   torus.rotateAndShiftFar();
   EXPECT_GT(torus.points.col(0).norm(), 1e5);

@@ -175,7 +175,7 @@ TEST(MeshTopology, CylinderHasTwoBoundaryLoops) {
 }
 
 TEST(MeshTopology, NeighbourRowsAreSortedSymmetricAndMatchEdges) {
-  const SurfaceSample torus = makeTorus({20, 0.3, 2});
+  const SurfaceSample torus = makeTorus({20, 0.1, 2});
   const MeshTopology t(static_cast<int>(torus.points.cols()), torus.triangles);
   for (int v = 0; v < t.numVertices(); ++v) {
     const IndexSpan row = t.neighbours(v);

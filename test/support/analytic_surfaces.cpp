@@ -58,7 +58,7 @@ SurfaceSample gridSurface(int nu, int nv, bool periodic_u, bool periodic_v, doub
   const int rows = periodic_v ? nv : nv + 1;
   const double du = (u1 - u0) / nu, dv = (v1 - v0) / nv;
   std::mt19937 rng(sampling.seed);
-  std::uniform_real_distribution<double> unit(-0.5, 0.5);
+  std::normal_distribution<double> unit(0.0, 1.0);
   SurfaceSample s;
   resize(s, static_cast<Eigen::Index>(cols) * rows);
   for (int j = 0; j < rows; ++j) {
@@ -264,13 +264,14 @@ SurfaceSample makeIcosphere(int level, double radius, double jitter, std::uint32
     f.swap(next);
   }
   if (jitter > 0.0) {
-    // Tangential jitter of jitter * (mean edge length), then back onto the sphere.
+    // Gaussian jitter (standard deviation jitter * edge length per coordinate), then back onto
+    // the sphere.
     const double h = (v[f[0][0]] - v[f[0][1]]).norm();
     std::mt19937 rng(seed);
-    std::uniform_real_distribution<double> unit(-0.5, 0.5);
+    std::normal_distribution<double> unit(0.0, 1.0);
     for (auto& p : v) {
       const Eigen::Vector3d d(unit(rng), unit(rng), unit(rng));
-      p = (p + jitter * h * (d - d.dot(p) * p)).normalized();
+      p = (p + jitter * h * d).normalized();
     }
   }
   SurfaceSample s;

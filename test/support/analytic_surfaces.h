@@ -33,7 +33,8 @@ struct SurfaceSample {
   SurfaceSample asCloud() const;
 };
 
-/** Parameter jitter as a fraction of the grid spacing (0 = regular). */
+/** Gaussian parameter jitter, standard deviation as a fraction of the grid spacing (0 = regular);
+ *  boundary rows of an open direction stay on the boundary. */
 struct Sampling {
   int resolution = 16;
   double jitter = 0.0;
@@ -42,7 +43,8 @@ struct Sampling {
 
 /** Square [-1,1]^2 in z = 0, (resolution+1)^2 vertices. Open (chi = 1). */
 SurfaceSample makePlane(const Sampling& sampling);
-/** Icosphere of radius r: level L has 10*4^L + 2 vertices; jitter is tangential, reprojected. */
+/** Icosphere of radius r: level L has 10*4^L + 2 vertices; jitter is Gaussian
+ *  (standard deviation jitter x edge length per coordinate), reprojected onto the sphere. */
 SurfaceSample makeIcosphere(int level, double radius = 1.0, double jitter = 0.0,
                             std::uint32_t seed = 1);
 /** Open cylinder x^2 + y^2 = r^2, |z| <= height/2 (resolution around, resolution/2 rows). */

@@ -1,0 +1,46 @@
+#pragma once
+// Discrete curvatures at the vertices of a triangle mesh.
+//
+// Sign convention: with the mesh oriented outward, H > 0 and K > 0 on a sphere (kappa > 0 where
+// the surface bends away from the normal).
+//   Gaussian   angle defect: 2 pi - sum of corner angles at an interior vertex, pi - sum at a
+//              boundary vertex (the geodesic turning of the boundary), so that the integrated
+//              values sum to 2 pi chi (Gauss-Bonnet) on every mesh. As a density, divided by the
+//              vertex area (mixed Voronoi by default; barycentric areas do not converge).
+//   Mean       Hn = -1/2 M^-1 L x with the cotangent L; H = |Hn| signed by the area-weighted
+//              vertex normal. On a boundary vertex Hn carries the boundary's curvature too and
+//              is not a surface curvature.
+//   Principal  kappa_{1,2} = H +- sqrt(max(H^2 - K, 0)); vertices where H^2 < K were clamped.
+// Vertices without area (isolated, or only on degenerate triangles) get NaN and valid = 0.
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/operators/mass_matrix.h"
+
+namespace pcl_ddg {
+
+/** Integrated Gaussian curvature (angle defect) per vertex; 0 for an isolated vertex. */
+Eigen::VectorXd angleDefect(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+
+/** The mean-curvature normal Hn = -1/2 M^-1 L x (zero at zero-mass vertices). */
+Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+                                     MassType mass = MassType::MixedVoronoi);
+
+struct VertexCurvatures {
+  Eigen::VectorXd mean;         ///< H, signed
+  Eigen::VectorXd gauss;        ///< K density (angle defect / vertex area)
+  Eigen::VectorXd kappa1;       ///< kappa1 >= kappa2
+  Eigen::VectorXd kappa2;
+  Eigen::VectorXd vertex_area;  ///< the mass used
+  std::vector<std::uint8_t> valid;
+  std::int64_t clamped_vertices = 0;  ///< H^2 < K: kappa1 = kappa2 = H there
+  std::int64_t invalid_vertices = 0;
+};
+
+/** All curvatures at once, sharing the triangle quantities (OpenMP over vertices). */
+VertexCurvatures computeCurvatures(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+                                   MassType mass = MassType::MixedVoronoi);
+
+}  // namespace pcl_ddg

@@ -1,0 +1,49 @@
+#pragma once
+// Discrete Laplace-Beltrami operators on a triangle mesh.
+//
+// Convention: L is NEGATIVE semi-definite. Off-diagonal L_ij = w_ij for every mesh edge ij, the
+// diagonal L_ii = -sum_j w_ij, so L * 1 = 0 and (L x)_i = sum_j w_ij (x_j - x_i).
+//   Uniform (umbrella)  w_ij = 1 (diagonal -|N(i)|), purely topological.
+//   Cotangent           w_ij = (cot a_ij + cot b_ij) / 2 over the angles opposite edge ij; a
+//                       boundary edge has one cotangent, a non-manifold edge one per triangle.
+//                       Exact on linear functions over planar meshes (linear precision).
+// Forms:
+//   Summed    L itself: symmetric (the weak / stiffness form used with a mass matrix).
+//   Averaged  M^-1 L (a pointwise Laplacian, M a lumped mass matrix): for the cotangent weights
+//             M^-1 L x approximates the Laplace-Beltrami of the coordinates, -2 H n. Rows of
+//             zero-mass vertices (isolated, or only on degenerate triangles) are zero.
+// Degenerate (zero-area) triangles contribute no weight; isolated vertices have an empty row.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+
+#include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/operators/mass_matrix.h"
+
+namespace pcl_ddg {
+
+enum class LaplacianWeights { Uniform, Cotangent };
+enum class LaplacianForm { Summed, Averaged };
+
+/**
+ * Assembles L (pattern: the mesh graph plus the diagonal, built straight into compressed storage;
+ * OpenMP over rows). Throws InvalidMeshException on non-finite or mismatched positions.
+ */
+Eigen::SparseMatrix<double> laplacian(const MeshTopology& topology,
+                                      const Eigen::Matrix3Xd& positions,
+                                      LaplacianWeights weights = LaplacianWeights::Cotangent,
+                                      LaplacianForm form = LaplacianForm::Summed,
+                                      MassType mass = MassType::MixedVoronoi);
+
+struct TriangleQuantities;
+
+/** The summed cotangent Laplacian from precomputed triangle quantities. */
+Eigen::SparseMatrix<double> cotangentLaplacian(const MeshTopology& topology,
+                                               const TriangleQuantities& triangles);
+
+/** The summed uniform Laplacian (positions are not needed). */
+Eigen::SparseMatrix<double> uniformLaplacian(const MeshTopology& topology);
+
+/** M^-1 L in place: row i divided by mass_i, zero where mass_i is zero. */
+void divideRowsByMass(Eigen::SparseMatrix<double>& matrix, const Eigen::VectorXd& mass);
+
+}  // namespace pcl_ddg

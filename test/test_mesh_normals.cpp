@@ -1,0 +1,131 @@
+// Vertex normals against exact normals, and how the weightings differ.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "analytic_surfaces.h"
+#include <pcl/exceptions.h>
+
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/surface/mesh_normals.h"
+#include "test_data.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+const NormalWeighting kAll[] = {NormalWeighting::Uniform, NormalWeighting::Area,
+                                NormalWeighting::Angle, NormalWeighting::MeanCurvature};
+
+double maxAngleDegrees(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < a.cols(); ++i) {
+    worst = std::max(worst, std::acos(std::clamp(a.col(i).dot(b.col(i)), -1.0, 1.0)));
+  }
+  return worst * 180.0 / 3.14159265358979323846;
+}
+
+MeshTopology topologyOf(const SurfaceSample& s) {
+  return MeshTopology(static_cast<int>(s.points.cols()), s.triangles);
+}
+
+TEST(MeshNormals, EveryWeightingMatchesTheExactNormalOnRegularMeshes) {
+  for (const SurfaceSample& s : {makeTorus({128, 0.0, 1}).rotateAndShiftFar(), makeIcosphere(4),
+                                 makeSaddle({64, 0.0, 1})}) {
+    const MeshTopology t = topologyOf(s);
+    for (auto w : kAll) {
+      const MeshNormals n = computeMeshNormals(t, s.points, {w});
+      EXPECT_EQ(n.invalid_vertices, 0);
+      EXPECT_LT(maxAngleDegrees(n.normals, s.normals), 1.0) << static_cast<int>(w);
+    }
+  }
+}
+
+// On irregular meshes the face-based weightings stay within a few degrees, while the
+// mean-curvature direction inherits the pointwise non-convergence of the cotangent Laplacian
+// (ACCURACY.md): where |H| is moderate its tangential noise tilts the normal by many degrees.
+TEST(MeshNormals, JitteredMeshesFaceWeightingsStayCloseMeanCurvatureDoesNot) {
+  const SurfaceSample s = makeTorus({128, 0.1, 1}).rotateAndShiftFar();
+  const MeshTopology t = topologyOf(s);
+  for (auto w : {NormalWeighting::Uniform, NormalWeighting::Area, NormalWeighting::Angle}) {
+    EXPECT_LT(maxAngleDegrees(computeMeshNormals(t, s.points, {w}).normals, s.normals), 3.0);
+  }
+  const double mean_curvature_error = maxAngleDegrees(
+      computeMeshNormals(t, s.points, {NormalWeighting::MeanCurvature}).normals, s.normals);
+  std::printf("jittered torus, mean-curvature normals: max error %.1f deg\n", mean_curvature_error);
+  EXPECT_GT(mean_curvature_error, 5.0);
+  EXPECT_LT(mean_curvature_error, 45.0);
+}
+
+TEST(MeshNormals, MeanCurvatureNormalsEqualAreaNormalsOnAPlane) {
+  SurfaceSample plane = makePlane({16, 0.1, 5});
+  plane.rotateAndShiftFar();
+  const MeshTopology t = topologyOf(plane);
+  const MeshNormals mc = computeMeshNormals(t, plane.points, {NormalWeighting::MeanCurvature});
+  const MeshNormals area = computeMeshNormals(t, plane.points, {NormalWeighting::Area});
+  EXPECT_EQ(mc.fallback_vertices, t.numVertices());
+  EXPECT_EQ(mc.normals, area.normals);
+  // 1e5 from the origin the vertices are planar only to their rounding.
+  EXPECT_LT(maxAngleDegrees(area.normals, plane.normals), 1e-5);
+}
+
+TEST(MeshNormals, EachWeightingChangesTheResultOnAnIrregularMesh) {
+  const SurfaceSample s = makeTorus({32, 0.12, 7});
+  const MeshTopology t = topologyOf(s);
+  std::vector<Eigen::Matrix3Xd> results;
+  for (auto w : kAll) results.push_back(computeMeshNormals(t, s.points, {w}).normals);
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    for (std::size_t j = i + 1; j < results.size(); ++j) {
+      EXPECT_GT(maxAngleDegrees(results[i], results[j]), 0.05) << i << " vs " << j;
+    }
+  }
+}
+
+TEST(MeshNormals, IsolatedAndSliverOnlyVerticesAreNaNAndMasked) {
+  Eigen::Matrix3Xd p(3, 5);
+  p << 0, 1, 0, 2, 7,  //
+      0, 0, 1, 0, 7,   //
+      0, 0, 0, 0, 7;
+  Eigen::Matrix3Xi tris(3, 2);
+  tris << 0, 0, 1, 1, 2, 3;
+  const MeshTopology t(5, tris);
+  for (auto w : kAll) {
+    const MeshNormals n = computeMeshNormals(t, p, {w});
+    EXPECT_EQ(n.invalid_vertices, 2);
+    EXPECT_FALSE(n.valid[3]);
+    EXPECT_FALSE(n.valid[4]);
+    EXPECT_TRUE(std::isnan(n.normals(0, 4)));
+    EXPECT_EQ(n.normals.col(0), Eigen::Vector3d(0, 0, 1));
+  }
+}
+
+TEST(MeshNormals, RealScansGiveUnitFiniteNormalsWhereValid) {
+  for (const char* file : {"meshes/bun_zipper_res3.ply", "meshes/bun045_rangegrid_tri.ply"}) {
+    SCOPED_TRACE(file);
+    const pcl::PolygonMesh mesh = loadMesh(sharedData(file));
+    const MeshTopology t(mesh);
+    const Eigen::Matrix3Xd p = vertexPositions(mesh.cloud);
+    for (auto w : kAll) {
+      const MeshNormals n = computeMeshNormals(t, p, {w});
+      // Unreferenced vertices, and on res3 vertices whose only faces are a face and its reversed
+      // duplicate (their normals cancel), have no normal.
+      EXPECT_GE(n.invalid_vertices, t.counts().unreferenced_vertices);
+      EXPECT_LE(n.invalid_vertices, t.counts().unreferenced_vertices + 10);
+      for (Eigen::Index i = 0; i < p.cols(); ++i) {
+        if (n.valid[i]) ASSERT_NEAR(n.normals.col(i).norm(), 1.0, 1e-12);
+      }
+    }
+  }
+}
+
+TEST(MeshNormals, EpsilonOnlyForMeanCurvature) {
+  const SurfaceSample s = makeIcosphere(1);
+  EXPECT_THROW(computeMeshNormals(topologyOf(s), s.points, {NormalWeighting::Area, 0.1}),
+               pcl::BadArgumentException);
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
