@@ -8,35 +8,18 @@
 #include <sstream>
 
 #include "test_data.h"
+#include "tool_runner.h"
 
 namespace pcl_ddg {
 namespace test {
 namespace {
 
-struct ToolRun {
-  int exit_code;
-  std::string out;
-};
-
-ToolRun runInfo(const std::string& arguments) {
-  const std::string command = std::string(PCL_DDG_INFO_TOOL) + " " + arguments + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  ToolRun run{-1, ""};
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) run.out += buffer.data();
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
+ToolRun runInfo(const std::string& arguments) { return runTool(PCL_DDG_INFO_TOOL, arguments); }
 
 boost::property_tree::ptree json(const std::string& file) {
-  const std::string command = std::string(PCL_DDG_INFO_TOOL) + " " + file + " -json 2>/dev/null";
-  FILE* pipe = popen(command.c_str(), "r");
-  std::string text;
-  std::array<char, 4096> buffer;
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) text += buffer.data();
-  EXPECT_EQ(pclose(pipe), 0) << file;
-  std::istringstream in(text);
+  const ToolRun run = runInfo(file + " -json");
+  EXPECT_EQ(run.exit_code, 0) << file << ": " << run.err;
+  std::istringstream in(run.out);
   boost::property_tree::ptree tree;
   boost::property_tree::read_json(in, tree);
   return tree;
@@ -107,14 +90,14 @@ TEST(PclDdgInfo, ExitCodesAndOneLineErrors) {
   EXPECT_EQ(runInfo("-h").exit_code, 0);
   const ToolRun usage = runInfo("");
   EXPECT_EQ(usage.exit_code, 2);
-  EXPECT_EQ(usage.out.rfind("pcl_ddg_info: error: ", 0), 0u) << usage.out;
+  EXPECT_EQ(usage.err.rfind("pcl_ddg_info: error: ", 0), 0u) << usage.err;
   EXPECT_EQ(runInfo(sharedData("meshes/cow.off") + " -bogus").exit_code, 2);
   const std::string dir = scratchFolder("info_errors");
   writeText(dir + "/broken.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n");
   const ToolRun broken = runInfo(dir + "/broken.ply");
   EXPECT_EQ(broken.exit_code, 1);
-  EXPECT_NE(broken.out.find("pcl_ddg_info: error: "), std::string::npos) << broken.out;
-  EXPECT_NE(broken.out.find("end_header"), std::string::npos) << broken.out;
+  EXPECT_NE(broken.err.find("pcl_ddg_info: error: "), std::string::npos) << broken.err;
+  EXPECT_NE(broken.err.find("end_header"), std::string::npos) << broken.err;
 }
 
 }  // namespace

@@ -1,0 +1,49 @@
+#include "common/mesh_job.h"
+
+#include <iostream>
+
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/mesh_report.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+
+namespace pcl_ddg {
+namespace tools {
+
+void warn(const char* tool_name, const std::string& message) {
+  std::cerr << tool_name << ": warning: " << message << "\n";
+}
+
+SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name) {
+  Timer timer("Loading " + path);
+  pcl::PolygonMesh mesh = loadMesh(path);
+  if (mesh.polygons.empty()) throw std::runtime_error(path + " has no faces (a point cloud?)");
+  MeshTopology topology(mesh);
+  Eigen::Matrix3Xd positions = vertexPositions(mesh.cloud);
+  timer.done(static_cast<std::size_t>(positions.cols()));
+
+  const MeshReport report = makeMeshReport(topology, positions);
+  const std::pair<std::int64_t, const char*> defects[] = {
+      {report.degenerate_faces, "degenerate faces (no weight)"},
+      {report.duplicate_faces, "duplicate faces"},
+      {report.nonmanifold_edges, "non-manifold edges"},
+      {report.nonmanifold_vertices, "non-manifold (bow-tie) vertices"},
+      {report.unreferenced_vertices, "unreferenced vertices (NaN results)"}};
+  for (const auto& [count, what] : defects) {
+    if (count > 0) warn(tool_name, std::to_string(count) + " " + what);
+  }
+  return {std::move(mesh), std::move(topology), std::move(positions)};
+}
+
+FieldPrecision precisionArgument(const ToolArguments& args) {
+  return args.choice("precision", {"float", "double"}, "float") == "double" ? FieldPrecision::Double
+                                                                           : FieldPrecision::Float;
+}
+
+void saveResult(const std::string& path, const pcl::PolygonMesh& mesh) {
+  Timer timer("Saving " + path);
+  saveMesh(path, mesh);
+  timer.done(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height);
+}
+
+}  // namespace tools
+}  // namespace pcl_ddg

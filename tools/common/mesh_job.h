@@ -1,0 +1,36 @@
+#pragma once
+// The shared shape of the mesh tools: load and check a surface mesh (warning about its defects),
+// then save the result with its new vertex fields.
+#include <pcl/PolygonMesh.h>
+
+#include <Eigen/Core>
+#include <string>
+
+#include "common/tool_common.h"
+#include "pcl_ddg/io/vertex_fields.h"
+#include "pcl_ddg/mesh/mesh_topology.h"
+
+namespace pcl_ddg {
+namespace tools {
+
+struct SurfaceMesh {
+  pcl::PolygonMesh mesh;
+  MeshTopology topology;
+  Eigen::Matrix3Xd positions;
+};
+
+/** Loads a mesh with faces; throws on out-of-range indices or non-finite coordinates, prints one
+ *  warning line per kind of defect (degenerate, duplicate, non-manifold, unreferenced). */
+SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name);
+
+/** -precision float|double. */
+FieldPrecision precisionArgument(const ToolArguments& args);
+
+/** Saves through saveMesh (format by extension, atomic), with a timing line. */
+void saveResult(const std::string& path, const pcl::PolygonMesh& mesh);
+
+/** Prints "tool: warning: message" on stderr. */
+void warn(const char* tool_name, const std::string& message);
+
+}  // namespace tools
+}  // namespace pcl_ddg
