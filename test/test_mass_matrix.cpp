@@ -4,7 +4,7 @@
 
 #include "analytic_surfaces.h"
 #include "pcl_ddg/operators/mass_matrix.h"
-#include "pcl_ddg/operators/triangle_quantities.h"
+#include "pcl_ddg/mesh/mesh_report.h"
 
 namespace pcl_ddg {
 namespace test {
@@ -64,8 +64,7 @@ TEST(MassMatrix, IsolatedAndDegenerateOnlyVerticesHaveZeroMass) {
   Eigen::Matrix3Xi tris(3, 2);
   tris << 0, 0, 1, 1, 2, 3;  // (0,1,2) fine, (0,1,3) collinear
   const MeshTopology t(5, tris);
-  const TriangleQuantities q = computeTriangleQuantities(t, p);
-  EXPECT_EQ(q.degenerate_triangles, 1);
+  EXPECT_EQ(makeMeshReport(t, p).zero_area_faces, 1);
   for (auto type : {MassType::Barycentric, MassType::Voronoi, MassType::MixedVoronoi}) {
     const Eigen::VectorXd m = lumpedMass(t, p, type);
     EXPECT_EQ(m[3], 0.0);

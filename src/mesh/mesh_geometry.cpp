@@ -6,13 +6,6 @@
 
 namespace pcl_ddg {
 
-bool isDegenerateTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                          const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, bc = c - b;
-  const double longest_squared = std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
-  return ab.cross(ac).norm() <= kDegenerateTriangleTolerance * longest_squared;
-}
-
 double meanEdgeLength(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
   const Eigen::Matrix2Xi& edges = topology.edgeVertices();
   double sum = 0.0;

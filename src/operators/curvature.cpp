@@ -3,20 +3,37 @@
 #include <cmath>
 #include <limits>
 
-#include "pcl_ddg/operators/laplacian.h"
-#include "pcl_ddg/operators/triangle_quantities.h"
+#include "triangle_geometry.h"
 
 namespace pcl_ddg {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-int cornerOf(const Eigen::Matrix3Xi& tris, int t, int v) {
-  return tris(0, t) == v ? 0 : (tris(1, t) == v ? 1 : 2);
+// Everything one vertex needs, gathered from its own triangles in one pass.
+struct VertexSums {
+  double mass = 0.0;
+  double angle_sum = 0.0;
+  Eigen::Vector3d laplace = Eigen::Vector3d::Zero();      ///< (L x)_v, cotangent L
+  Eigen::Vector3d area_normal = Eigen::Vector3d::Zero();  ///< orientation reference
+};
+
+VertexSums gather(const MeshTopology& topology, const Eigen::Matrix3Xd& positions, int v,
+                  MassType mass) {
+  VertexSums s;
+  detail::forEachCornerOf(topology, positions, v, [&](const detail::CornerView& c, int) {
+    s.mass += detail::cornerMass(c, mass);
+    s.angle_sum += c.angle();
+    s.laplace += detail::cotangentLaplacianPart(c);
+    s.area_normal += c.area_vector;
+  });
+  return s;
 }
 
-Eigen::VectorXd angleDefect(const MeshTopology& topology, const TriangleQuantities& q) {
-  const Eigen::Matrix3Xi& tris = topology.triangles();
+}  // namespace
+
+Eigen::VectorXd angleDefect(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+  detail::requireMatchingPositions(topology, positions);
   Eigen::VectorXd defect(topology.numVertices());
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < topology.numVertices(); ++v) {
@@ -25,61 +42,37 @@ Eigen::VectorXd angleDefect(const MeshTopology& topology, const TriangleQuantiti
       continue;
     }
     double angle_sum = 0.0;
-    for (const int t : topology.incidentTriangles(v)) angle_sum += q.angles(cornerOf(tris, t, v), t);
+    detail::forEachCornerOf(topology, positions, v,
+                            [&](const detail::CornerView& c, int) { angle_sum += c.angle(); });
     defect[v] = (topology.isBoundary(v) ? kPi : 2.0 * kPi) - angle_sum;
   }
   return defect;
 }
 
-// -1/2 M^-1 L x from the summed cotangent Laplacian and the masses.
-Eigen::Matrix3Xd meanCurvatureNormal(const Eigen::SparseMatrix<double>& cotan_laplacian,
-                                     const Eigen::VectorXd& mass,
-                                     const Eigen::Matrix3Xd& positions) {
-  // L is symmetric, so (L x^T)^T = x L.
-  Eigen::Matrix3Xd hn = -0.5 * (positions * cotan_laplacian);
-  for (Eigen::Index v = 0; v < hn.cols(); ++v) {
-    hn.col(v) = mass[v] > 0.0 ? Eigen::Vector3d(hn.col(v) / mass[v]) : Eigen::Vector3d::Zero();
+Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+                                     MassType mass) {
+  detail::requireMatchingPositions(topology, positions);
+  Eigen::Matrix3Xd hn(3, topology.numVertices());
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < topology.numVertices(); ++v) {
+    double m = 0.0;
+    Eigen::Vector3d laplace = Eigen::Vector3d::Zero();
+    detail::forEachCornerOf(topology, positions, v, [&](const detail::CornerView& c, int) {
+      m += detail::cornerMass(c, mass);
+      laplace += detail::cotangentLaplacianPart(c);
+    });
+    hn.col(v) = m > 0.0 ? Eigen::Vector3d(-0.5 * laplace / m) : Eigen::Vector3d::Zero();
   }
   return hn;
 }
 
-// Area-weighted vertex normals (unnormalised): the orientation reference for H.
-Eigen::Matrix3Xd areaNormals(const MeshTopology& topology, const TriangleQuantities& q) {
-  Eigen::Matrix3Xd n(3, topology.numVertices());
-#pragma omp parallel for schedule(static)
-  for (int v = 0; v < topology.numVertices(); ++v) {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const int t : topology.incidentTriangles(v)) sum += q.area_vectors.col(t);
-    n.col(v) = sum;
-  }
-  return n;
-}
-
-}  // namespace
-
-Eigen::VectorXd angleDefect(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
-  return angleDefect(topology, computeTriangleQuantities(topology, positions));
-}
-
-Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
-                                     MassType mass) {
-  const TriangleQuantities q = computeTriangleQuantities(topology, positions);
-  return meanCurvatureNormal(cotangentLaplacian(topology, q),
-                             lumpedMass(topology, positions, q, mass), positions);
-}
-
 VertexCurvatures computeCurvatures(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
                                    MassType mass) {
-  const TriangleQuantities q = computeTriangleQuantities(topology, positions);
-  VertexCurvatures c;
-  c.vertex_area = lumpedMass(topology, positions, q, mass);
-  const Eigen::VectorXd defect = angleDefect(topology, q);
-  const Eigen::Matrix3Xd hn =
-      meanCurvatureNormal(cotangentLaplacian(topology, q), c.vertex_area, positions);
-  const Eigen::Matrix3Xd reference = areaNormals(topology, q);
-
+  detail::requireMatchingPositions(topology, positions);
   const int n = topology.numVertices();
   const double nan = std::numeric_limits<double>::quiet_NaN();
+  VertexCurvatures c;
+  c.vertex_area.resize(n);
   c.mean.resize(n);
   c.gauss.resize(n);
   c.kappa1.resize(n);
@@ -88,16 +81,17 @@ VertexCurvatures computeCurvatures(const MeshTopology& topology, const Eigen::Ma
   std::int64_t clamped = 0, invalid = 0;
 #pragma omp parallel for schedule(static) reduction(+ : clamped, invalid)
   for (int v = 0; v < n; ++v) {
-    const double area = c.vertex_area[v];
-    if (!(area > 0.0)) {
+    const VertexSums s = gather(topology, positions, v, mass);
+    c.vertex_area[v] = s.mass;
+    if (!(s.mass > 0.0)) {
       c.mean[v] = c.gauss[v] = c.kappa1[v] = c.kappa2[v] = nan;
       ++invalid;
       continue;
     }
     c.valid[v] = 1;
-    const double h = hn.col(v).norm();
-    c.mean[v] = hn.col(v).dot(reference.col(v)) < 0.0 ? -h : h;
-    c.gauss[v] = defect[v] / area;
+    const Eigen::Vector3d hn = -0.5 * s.laplace / s.mass;
+    c.mean[v] = hn.dot(s.area_normal) < 0.0 ? -hn.norm() : hn.norm();
+    c.gauss[v] = ((topology.isBoundary(v) ? kPi : 2.0 * kPi) - s.angle_sum) / s.mass;
     const double discriminant = c.mean[v] * c.mean[v] - c.gauss[v];
     if (discriminant < 0.0) ++clamped;
     const double root = std::sqrt(std::max(discriminant, 0.0));

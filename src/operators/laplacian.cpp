@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "pcl_ddg/operators/triangle_quantities.h"
+#include "triangle_geometry.h"
 
 namespace pcl_ddg {
 namespace {
@@ -66,18 +66,19 @@ Eigen::SparseMatrix<double> uniformLaplacian(const MeshTopology& topology) {
 }
 
 Eigen::SparseMatrix<double> cotangentLaplacian(const MeshTopology& topology,
-                                               const TriangleQuantities& q) {
+                                               const Eigen::Matrix3Xd& positions) {
+  detail::requireMatchingPositions(topology, positions);
   Eigen::SparseMatrix<double> l = graphPattern(topology);
   const Eigen::Matrix3Xi& tris = topology.triangles();
   // Gather: column v sums, over its triangles, half the cotangent opposite each edge at v.
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < topology.numVertices(); ++v) {
-    for (const int t : topology.incidentTriangles(v)) {
-      const int k = tris(0, t) == v ? 0 : (tris(1, t) == v ? 1 : 2);
+    detail::forEachCornerOf(topology, positions, v, [&](const detail::CornerView& c, int t) {
+      const int k = detail::cornerOf(tris, t, v);
       const int a = tris((k + 1) % 3, t), b = tris((k + 2) % 3, t);
-      l.valuePtr()[slot(l, v, a)] += 0.5 * q.cotangents((k + 2) % 3, t);  // edge va, opposite b
-      l.valuePtr()[slot(l, v, b)] += 0.5 * q.cotangents((k + 1) % 3, t);  // edge vb, opposite a
-    }
+      l.valuePtr()[slot(l, v, a)] += 0.5 * c.cotangent(2);  // edge va, opposite b
+      l.valuePtr()[slot(l, v, b)] += 0.5 * c.cotangent(1);  // edge vb, opposite a
+    });
   }
   setDiagonalFromRowSums(l);
   return l;
@@ -96,19 +97,11 @@ void divideRowsByMass(Eigen::SparseMatrix<double>& matrix, const Eigen::VectorXd
 Eigen::SparseMatrix<double> laplacian(const MeshTopology& topology,
                                       const Eigen::Matrix3Xd& positions, LaplacianWeights weights,
                                       LaplacianForm form, MassType mass) {
-  const bool need_geometry =
-      weights == LaplacianWeights::Cotangent || form == LaplacianForm::Averaged;
-  if (!need_geometry) {
-    requireMatchingPositions(topology, positions);
-    return uniformLaplacian(topology);
-  }
-  const TriangleQuantities q = computeTriangleQuantities(topology, positions);
+  detail::requireMatchingPositions(topology, positions);
   Eigen::SparseMatrix<double> l = weights == LaplacianWeights::Cotangent
-                                      ? cotangentLaplacian(topology, q)
+                                      ? cotangentLaplacian(topology, positions)
                                       : uniformLaplacian(topology);
-  if (form == LaplacianForm::Averaged) {
-    divideRowsByMass(l, lumpedMass(topology, positions, q, mass));
-  }
+  if (form == LaplacianForm::Averaged) divideRowsByMass(l, lumpedMass(topology, positions, mass));
   return l;
 }
 

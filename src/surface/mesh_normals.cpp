@@ -5,32 +5,25 @@
 #include <cmath>
 #include <limits>
 
+#include "../operators/triangle_geometry.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
-#include "pcl_ddg/operators/laplacian.h"
-#include "pcl_ddg/operators/triangle_quantities.h"
 
 namespace pcl_ddg {
 
 MeshNormals computeMeshNormals(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
                                const MeshNormalOptions& options) {
-  const TriangleQuantities q = computeTriangleQuantities(topology, positions);
-  const Eigen::Matrix3Xi& tris = topology.triangles();
-  const int n = topology.numVertices();
-
-  Eigen::Matrix3Xd laplace;  // M^-1 L x, only for the mean-curvature weighting
+  detail::requireMatchingPositions(topology, positions);
+  const NormalWeighting weighting = options.weighting;
   double epsilon = options.epsilon;
-  if (options.weighting == NormalWeighting::MeanCurvature) {
-    Eigen::SparseMatrix<double> l = cotangentLaplacian(topology, q);
-    divideRowsByMass(l, lumpedMass(topology, positions, q, options.mass));
-    laplace = (l * positions.transpose()).transpose();
-    if (epsilon < 0.0) {
-      const double h = meanEdgeLength(topology, positions);
-      epsilon = h > 0.0 ? 0.02 / h : 0.0;
-    }
-  } else if (options.epsilon >= 0.0) {
+  if (weighting != NormalWeighting::MeanCurvature && epsilon >= 0.0) {
     throw pcl::BadArgumentException("epsilon applies to mean-curvature normals only");
   }
+  if (weighting == NormalWeighting::MeanCurvature && epsilon < 0.0) {
+    const double h = meanEdgeLength(topology, positions);
+    epsilon = h > 0.0 ? 0.02 / h : 0.0;
+  }
 
+  const int n = topology.numVertices();
   MeshNormals result;
   result.normals.resize(3, n);
   result.valid.assign(n, 0);
@@ -38,22 +31,26 @@ MeshNormals computeMeshNormals(const MeshTopology& topology, const Eigen::Matrix
 #pragma omp parallel for schedule(static) reduction(+ : invalid, fallback)
   for (int v = 0; v < n; ++v) {
     Eigen::Vector3d area_sum = Eigen::Vector3d::Zero(), sum = Eigen::Vector3d::Zero();
-    for (const int t : topology.incidentTriangles(v)) {
-      const double area = q.areas[t];
-      if (area == 0.0) continue;
-      const Eigen::Vector3d unit = q.area_vectors.col(t) / area;
-      area_sum += q.area_vectors.col(t);
-      if (options.weighting == NormalWeighting::Uniform) sum += unit;
-      if (options.weighting == NormalWeighting::Angle) {
-        const int k = tris(0, t) == v ? 0 : (tris(1, t) == v ? 1 : 2);
-        sum += q.angles(k, t) * unit;
+    Eigen::Vector3d laplace = Eigen::Vector3d::Zero();
+    double mass = 0.0;
+    detail::forEachCornerOf(topology, positions, v, [&](const detail::CornerView& c, int) {
+      area_sum += c.area_vector;
+      switch (weighting) {
+        case NormalWeighting::Uniform: sum += c.area_vector / c.area_vector.norm(); break;
+        case NormalWeighting::Angle: sum += c.angle() * c.area_vector / c.area_vector.norm(); break;
+        case NormalWeighting::MeanCurvature:
+          laplace += detail::cotangentLaplacianPart(c);
+          mass += detail::cornerMass(c, options.mass);
+          break;
+        case NormalWeighting::Area: break;
       }
-    }
-    if (options.weighting == NormalWeighting::Area) sum = area_sum;
-    if (options.weighting == NormalWeighting::MeanCurvature) {
-      const Eigen::Vector3d towards_normal = -laplace.col(v);
+    });
+    if (weighting == NormalWeighting::Area) sum = area_sum;
+    if (weighting == NormalWeighting::MeanCurvature) {
+      // -M^-1 L x; on the boundary it also holds the boundary curve's curvature (in the plane).
+      const Eigen::Vector3d towards_normal = mass > 0.0 ? Eigen::Vector3d(-laplace / mass)
+                                                        : Eigen::Vector3d::Zero();
       const double magnitude = towards_normal.norm();
-      // On the boundary -L x also holds the boundary's own curvature (in the tangent plane).
       if (!topology.isBoundary(v) && magnitude >= epsilon && magnitude > 0.0) {
         sum = towards_normal.dot(area_sum) < 0.0 ? Eigen::Vector3d(-towards_normal) : towards_normal;
       } else {

@@ -1,6 +1,8 @@
 #pragma once
 // Elementary measures of a mesh embedded by vertex positions (3 x N, double).
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
 #include <limits>
 
 #include "pcl_ddg/mesh/mesh_topology.h"
@@ -15,8 +17,16 @@ namespace pcl_ddg {
 constexpr double kDegenerateTriangleTolerance = 1e-12;
 
 /** True for a zero-area (collinear or repeated-corner) triangle, by the relative guard above. */
-bool isDegenerateTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                          const Eigen::Vector3d& c);
+inline bool isDegenerateTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                 const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, bc = c - b;
+  const double longest_squared =
+      std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
+  // Squared on both sides: no square root in the operators' innermost loop. (Edges shorter than
+  // about 1e-75 underflow here; such coordinates are outside what double geometry supports.)
+  const double bound = kDegenerateTriangleTolerance * longest_squared;
+  return ab.cross(ac).squaredNorm() <= bound * bound;
+}
 
 /** Mean length of the unique edges whose end points are finite (0 if there are none). */
 double meanEdgeLength(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);

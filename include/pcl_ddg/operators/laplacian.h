@@ -34,11 +34,9 @@ Eigen::SparseMatrix<double> laplacian(const MeshTopology& topology,
                                       LaplacianForm form = LaplacianForm::Summed,
                                       MassType mass = MassType::MixedVoronoi);
 
-struct TriangleQuantities;
-
-/** The summed cotangent Laplacian from precomputed triangle quantities. */
+/** The summed cotangent Laplacian. */
 Eigen::SparseMatrix<double> cotangentLaplacian(const MeshTopology& topology,
-                                               const TriangleQuantities& triangles);
+                                               const Eigen::Matrix3Xd& positions);
 
 /** The summed uniform Laplacian (positions are not needed). */
 Eigen::SparseMatrix<double> uniformLaplacian(const MeshTopology& topology);

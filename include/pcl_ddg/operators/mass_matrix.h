@@ -19,15 +19,10 @@ namespace pcl_ddg {
 
 enum class MassType { Barycentric, Voronoi, MixedVoronoi };
 
-struct TriangleQuantities;
-
-/** Vertex areas (the diagonal of M). */
+/** Vertex areas (the diagonal of M), gathered per vertex (OpenMP). Throws InvalidMeshException
+ *  on non-finite or mismatched positions. */
 Eigen::VectorXd lumpedMass(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
                            MassType type = MassType::MixedVoronoi);
-
-/** Same, from precomputed triangle quantities (saves recomputing them). */
-Eigen::VectorXd lumpedMass(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
-                           const TriangleQuantities& triangles, MassType type);
 
 /** The diagonal mass matrix as a sparse matrix. */
 Eigen::SparseMatrix<double> massMatrix(const MeshTopology& topology,

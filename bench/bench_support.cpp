@@ -1,0 +1,88 @@
+#include "bench_support.h"
+
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+
+namespace pcl_ddg {
+namespace bench {
+namespace {
+
+// Records the real time of every run while the console reporter prints as usual.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const Run& run : runs) {
+      if (run.run_type == Run::RT_Iteration && !run.error_occurred) {
+        times_ms_[run.run_name.function_name] = run.GetAdjustedRealTime() *
+                                                benchmark::GetTimeUnitMultiplier(benchmark::kMillisecond) /
+                                                benchmark::GetTimeUnitMultiplier(run.time_unit);
+      }
+    }
+  }
+  void printRatios() const {
+    std::printf("\n%-40s %12s %12s %8s\n", "operation", "ours (ms)", "baseline", "ratio");
+    for (const auto& [name, ours] : times_ms_) {
+      if (name.rfind("ours/", 0) != 0) continue;
+      const std::string what = name.substr(5);
+      const auto baseline = times_ms_.find("baseline/" + what);
+      if (baseline == times_ms_.end()) {
+        std::printf("%-40s %12.1f %12s %8s\n", what.c_str(), ours, "-", "-");
+      } else {
+        std::printf("%-40s %12.1f %12.1f %7.1fx\n", what.c_str(), ours, baseline->second,
+                    baseline->second / ours);
+      }
+    }
+  }
+
+ private:
+  std::map<std::string, double> times_ms_;
+};
+
+}  // namespace
+
+const BenchMesh& torusMesh(int around, int tube) {
+  static std::map<std::pair<int, int>, std::unique_ptr<BenchMesh>> cache;
+  auto& slot = cache[{around, tube}];
+  if (slot) return *slot;
+  slot = std::make_unique<BenchMesh>();
+  BenchMesh& m = *slot;
+  const double pi = 3.14159265358979323846;
+  m.points.resize(3, static_cast<Eigen::Index>(around) * tube);
+  for (int j = 0; j < tube; ++j) {
+    for (int i = 0; i < around; ++i) {
+      const double u = 2 * pi * i / around, v = 2 * pi * j / tube;
+      m.points.col(j * around + i) << (1 + 0.4 * std::cos(v)) * std::cos(u),
+          (1 + 0.4 * std::cos(v)) * std::sin(u), 0.4 * std::sin(v);
+    }
+  }
+  m.triangles.resize(3, 2 * static_cast<Eigen::Index>(around) * tube);
+  Eigen::Index t = 0;
+  for (int j = 0; j < tube; ++j) {
+    for (int i = 0; i < around; ++i) {
+      const int a = j * around + i, b = j * around + (i + 1) % around;
+      const int c = ((j + 1) % tube) * around + (i + 1) % around, d = ((j + 1) % tube) * around + i;
+      m.triangles.col(t++) << a, b, c;
+      m.triangles.col(t++) << a, c, d;
+    }
+  }
+  return m;
+}
+
+int runWithRatios(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  reporter.printRatios();
+  benchmark::Shutdown();
+  return 0;
+}
+
+}  // namespace bench
+}  // namespace pcl_ddg
