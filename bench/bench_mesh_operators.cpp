@@ -1,5 +1,6 @@
 // Mesh operators on a 1.15M-vertex torus (2.3M triangles), each next to the textbook baseline:
-// triplet-list assembly with setFromTriplets for L, face-loop scatter for normals and masses.
+// triplet-list assembly with setFromTriplets for L (and the mean-curvature normals built on it),
+// serial face-loop scatter for the other normals and the masses.
 #include <benchmark/benchmark.h>
 
 #include <Eigen/Geometry>
@@ -31,13 +32,22 @@ const Fixture& fixture() {
 
 // ---- baselines -------------------------------------------------------------------------------
 
-Eigen::Matrix3Xd baselineAreaNormals(const BenchMesh& m) {
+// Face-loop scatter: each face adds its weighted normal to its three corners.
+Eigen::Matrix3Xd baselineFaceNormals(const BenchMesh& m, NormalWeighting weighting) {
   Eigen::Matrix3Xd n = Eigen::Matrix3Xd::Zero(3, m.points.cols());
   for (Eigen::Index t = 0; t < m.triangles.cols(); ++t) {
-    const Eigen::Vector3d a = m.points.col(m.triangles(0, t));
-    const Eigen::Vector3d cross =
-        (m.points.col(m.triangles(1, t)) - a).cross(m.points.col(m.triangles(2, t)) - a);
-    for (int k = 0; k < 3; ++k) n.col(m.triangles(k, t)) += cross;
+    Eigen::Vector3d p[3];
+    for (int k = 0; k < 3; ++k) p[k] = m.points.col(m.triangles(k, t));
+    const Eigen::Vector3d cross = (p[1] - p[0]).cross(p[2] - p[0]);
+    for (int k = 0; k < 3; ++k) {
+      double weight = 1.0;  // area weighting: the cross product is twice the area
+      if (weighting == NormalWeighting::Uniform) weight = 1.0 / cross.norm();
+      if (weighting == NormalWeighting::Angle) {
+        const Eigen::Vector3d u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
+        weight = std::atan2(u.cross(v).norm(), u.dot(v)) / cross.norm();
+      }
+      n.col(m.triangles(k, t)) += weight * cross;
+    }
   }
   n.colwise().normalize();
   return n;
@@ -54,7 +64,8 @@ Eigen::SparseMatrix<double> baselineCotanLaplacian(const BenchMesh& m) {
     for (int k = 0; k < 3; ++k) {
       const int i = m.triangles((k + 1) % 3, t), j = m.triangles((k + 2) % 3, t);
       const int o = m.triangles(k, t);
-      const double w = 0.5 * cotangent(m.points.col(i) - m.points.col(o), m.points.col(j) - m.points.col(o));
+      const double w =
+          0.5 * cotangent(m.points.col(i) - m.points.col(o), m.points.col(j) - m.points.col(o));
       triplets.emplace_back(i, j, w);
       triplets.emplace_back(j, i, w);
       triplets.emplace_back(i, i, -w);
@@ -82,12 +93,27 @@ Eigen::VectorXd baselineMixedMass(const BenchMesh& m) {
         a = area / 4;
       } else {
         a = ((p[(k + 1) % 3] - p[k]).squaredNorm() * cot[(k + 2) % 3] +
-             (p[(k + 2) % 3] - p[k]).squaredNorm() * cot[(k + 1) % 3]) / 8;
+             (p[(k + 2) % 3] - p[k]).squaredNorm() * cot[(k + 1) % 3]) /
+            8;
       }
       mass[m.triangles(k, t)] += a;
     }
   }
   return mass;
+}
+
+// -M^-1 L x from the triplet-assembled L, oriented like the area normal.
+Eigen::Matrix3Xd baselineMeanCurvatureNormals(const BenchMesh& m) {
+  const Eigen::SparseMatrix<double> l = baselineCotanLaplacian(m);
+  const Eigen::VectorXd mass = baselineMixedMass(m);
+  const Eigen::Matrix3Xd area_normals = baselineFaceNormals(m, NormalWeighting::Area);
+  Eigen::Matrix3Xd n = -(l * m.points.transpose()).transpose();
+  for (Eigen::Index v = 0; v < n.cols(); ++v) {
+    n.col(v) /= mass[v];
+    if (n.col(v).dot(area_normals.col(v)) < 0) n.col(v) = -n.col(v);
+  }
+  n.colwise().normalize();
+  return n;
 }
 
 // ---- benchmarks ------------------------------------------------------------------------------
@@ -99,20 +125,47 @@ void setCounters(benchmark::State& state) {
 void normals(benchmark::State& state, NormalWeighting weighting) {
   const Fixture& f = fixture();
   for (auto _ : state) {
-    benchmark::DoNotOptimize(computeMeshNormals(f.topology, f.mesh.points, {weighting}).normals.data());
+    benchmark::DoNotOptimize(
+        computeMeshNormals(f.topology, f.mesh.points, {weighting}).normals.data());
   }
   setCounters(state);
 }
-BENCHMARK_CAPTURE(normals, ours/area_normals, NormalWeighting::Area)->Name("ours/area_normals")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(normals, ours/uniform_normals, NormalWeighting::Uniform)->Name("ours/uniform_normals")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(normals, ours/angle_normals, NormalWeighting::Angle)->Name("ours/angle_normals")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(normals, ours/mean_curvature_normals, NormalWeighting::MeanCurvature)->Name("ours/mean_curvature_normals")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(normals, ours / area_normals, NormalWeighting::Area)
+    ->Name("ours/area_normals")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(normals, ours / uniform_normals, NormalWeighting::Uniform)
+    ->Name("ours/uniform_normals")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(normals, ours / angle_normals, NormalWeighting::Angle)
+    ->Name("ours/angle_normals")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(normals, ours / mean_curvature_normals, NormalWeighting::MeanCurvature)
+    ->Name("ours/mean_curvature_normals")
+    ->Unit(benchmark::kMillisecond);
 
-void baselineNormals(benchmark::State& state) {
-  for (auto _ : state) benchmark::DoNotOptimize(baselineAreaNormals(fixture().mesh).data());
+void baselineNormals(benchmark::State& state, NormalWeighting weighting) {
+  for (auto _ : state)
+    benchmark::DoNotOptimize(baselineFaceNormals(fixture().mesh, weighting).data());
   setCounters(state);
 }
-BENCHMARK(baselineNormals)->Name("baseline/area_normals")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(baselineNormals, area, NormalWeighting::Area)
+    ->Name("baseline/area_normals")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(baselineNormals, uniform, NormalWeighting::Uniform)
+    ->Name("baseline/uniform_normals")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(baselineNormals, angle, NormalWeighting::Angle)
+    ->Name("baseline/angle_normals")
+    ->Unit(benchmark::kMillisecond);
+
+void baselineMeanCurvatureNormalsBench(benchmark::State& state) {
+  for (auto _ : state)
+    benchmark::DoNotOptimize(baselineMeanCurvatureNormals(fixture().mesh).data());
+  setCounters(state);
+}
+BENCHMARK(baselineMeanCurvatureNormalsBench)
+    ->Name("baseline/mean_curvature_normals")
+    ->Unit(benchmark::kMillisecond);
 
 void cotanLaplacian(benchmark::State& state) {
   const Fixture& f = fixture();
@@ -157,11 +210,14 @@ void baselineLaplacianAndMass(benchmark::State& state) {
   }
   setCounters(state);
 }
-BENCHMARK(baselineLaplacianAndMass)->Name("baseline/cotan_laplacian+mixed_mass")->Unit(benchmark::kMillisecond);
+BENCHMARK(baselineLaplacianAndMass)
+    ->Name("baseline/cotan_laplacian+mixed_mass")
+    ->Unit(benchmark::kMillisecond);
 
 void curvatures(benchmark::State& state) {
   const Fixture& f = fixture();
-  for (auto _ : state) benchmark::DoNotOptimize(computeCurvatures(f.topology, f.mesh.points).mean.data());
+  for (auto _ : state)
+    benchmark::DoNotOptimize(computeCurvatures(f.topology, f.mesh.points).mean.data());
   setCounters(state);
 }
 BENCHMARK(curvatures)->Name("ours/all_curvatures")->Unit(benchmark::kMillisecond);
@@ -182,7 +238,8 @@ void baselineCurvatures(benchmark::State& state) {
       }
     }
     const Eigen::VectorXd h = hn.colwise().norm().transpose().cwiseQuotient(2 * mass);
-    const Eigen::VectorXd k = (2 * 3.14159265358979323846 - angle_sum.array()).matrix().cwiseQuotient(mass);
+    const Eigen::VectorXd k =
+        (2 * 3.14159265358979323846 - angle_sum.array()).matrix().cwiseQuotient(mass);
     const Eigen::VectorXd root = (h.array().square() - k.array()).max(0.0).sqrt().matrix();
     const Eigen::VectorXd kappa1 = h + root, kappa2 = h - root;
     benchmark::DoNotOptimize(kappa1.data());
@@ -196,4 +253,6 @@ BENCHMARK(baselineCurvatures)->Name("baseline/all_curvatures")->Unit(benchmark::
 }  // namespace bench
 }  // namespace pcl_ddg
 
-int main(int argc, char** argv) { return pcl_ddg::bench::runWithRatios(argc, argv); }
+int main(int argc, char** argv) {
+  return pcl_ddg::bench::runWithRatios(argc, argv);
+}

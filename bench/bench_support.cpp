@@ -19,9 +19,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
       if (run.run_type == Run::RT_Iteration && !run.error_occurred) {
-        times_ms_[run.run_name.function_name] = run.GetAdjustedRealTime() *
-                                                benchmark::GetTimeUnitMultiplier(benchmark::kMillisecond) /
-                                                benchmark::GetTimeUnitMultiplier(run.time_unit);
+        times_ms_[run.run_name.function_name] =
+            run.GetAdjustedRealTime() * benchmark::GetTimeUnitMultiplier(benchmark::kMillisecond) /
+            benchmark::GetTimeUnitMultiplier(run.time_unit);
       }
     }
   }

@@ -40,9 +40,10 @@ TEST(Curvature, GaussBonnetOnAnalyticMeshesOpenAndClosed) {
 }
 
 TEST(Curvature, GaussBonnetOnRealScans) {
-  for (const char* file : {"meshes/bumpy.off", "meshes/bunny.off", "meshes/cow.off", "meshes/horse.ply",
-                           "meshes/igea.ply", "meshes/rocker-arm.off", "meshes/tum_rabbit.vtk",
-                           "meshes/bun_zipper.ply", "meshes/bun045_rangegrid_tri.ply"}) {
+  for (const char* file :
+       {"meshes/bumpy.off", "meshes/bunny.off", "meshes/cow.off", "meshes/horse.ply",
+        "meshes/igea.ply", "meshes/rocker-arm.off", "meshes/tum_rabbit.vtk",
+        "meshes/bun_zipper.ply", "meshes/bun045_rangegrid_tri.ply"}) {
     SCOPED_TRACE(file);
     const pcl::PolygonMesh mesh = loadMesh(sharedData(file));
     const MeshTopology t(mesh);
@@ -71,10 +72,11 @@ TEST(Curvature, IcosphereConvergesAtOrderTwo) {
     const Eigen::Matrix3Xd hn = meanCurvatureNormal(t, s.points);
     const Eigen::VectorXd projected = (hn.cwiseProduct(s.normals)).colwise().sum().transpose();
     const Errors exact = errors(projected, s.mean_curvature);
-    std::printf("icosphere level %d (%ld V): K max %.2e rms %.2e | H max %.2e rms %.2e | "
-                "n.Hn max %.2e rms %.2e\n",
-                level, static_cast<long>(s.points.cols()), k.max, k.rms, h.max, h.rms, exact.max,
-                exact.rms);
+    std::printf(
+        "icosphere level %d (%ld V): K max %.2e rms %.2e | H max %.2e rms %.2e | "
+        "n.Hn max %.2e rms %.2e\n",
+        level, static_cast<long>(s.points.cols()), k.max, k.rms, h.max, h.rms, exact.max,
+        exact.rms);
     EXPECT_LT(exact.max, 3e-12);  // ACCURACY.md: 1.4e-12
     if (level >= 3) {
       EXPECT_NEAR(std::log2(previous_k.max / k.max), 2.0, 0.25) << "level " << level;
@@ -92,9 +94,10 @@ TEST(Curvature, IcosphereConvergesAtOrderTwo) {
 // Barycentric areas make K inconsistent: the error does not decrease (documented behaviour).
 TEST(Curvature, BarycentricAreaDoesNotConverge) {
   const SurfaceSample coarse = makeIcosphere(4), fine = makeIcosphere(6);
-  const double e4 = errors(computeCurvatures(topologyOf(coarse), coarse.points, MassType::Barycentric).gauss,
-                           coarse.gauss_curvature)
-                        .max;
+  const double e4 =
+      errors(computeCurvatures(topologyOf(coarse), coarse.points, MassType::Barycentric).gauss,
+             coarse.gauss_curvature)
+          .max;
   const double e6 =
       errors(computeCurvatures(topologyOf(fine), fine.points, MassType::Barycentric).gauss,
              fine.gauss_curvature)
@@ -135,7 +138,8 @@ TEST(Curvature, JitteredMeshesDoNotConvergePointwise) {
   const SurfaceSample coarse = makeIcosphere(4, 1.0, 0.1), fine = makeIcosphere(6, 1.0, 0.1);
   const VertexCurvatures cc = computeCurvatures(topologyOf(coarse), coarse.points);
   const VertexCurvatures cf = computeCurvatures(topologyOf(fine), fine.points);
-  const Errors kc = errors(cc.gauss, coarse.gauss_curvature), kf = errors(cf.gauss, fine.gauss_curvature);
+  const Errors kc = errors(cc.gauss, coarse.gauss_curvature),
+               kf = errors(cf.gauss, fine.gauss_curvature);
   const Errors hf = errors(cf.mean, fine.mean_curvature);
   std::printf("jittered icosphere: K rms level 4 %.2e, level 6 %.2e; H rms level 6 %.2e\n", kc.rms,
               kf.rms, hf.rms);
@@ -146,8 +150,10 @@ TEST(Curvature, JitteredMeshesDoNotConvergePointwise) {
   EXPECT_LT(kf.rms, 3e-2);
   EXPECT_GT(hf.rms, 3e-3);
   const SurfaceSample torus_c = makeTorus({128, 0.1, 3}), torus_f = makeTorus({512, 0.1, 3});
-  const Errors tc = errors(computeCurvatures(topologyOf(torus_c), torus_c.points).mean, torus_c.mean_curvature);
-  const Errors tf = errors(computeCurvatures(topologyOf(torus_f), torus_f.points).mean, torus_f.mean_curvature);
+  const Errors tc =
+      errors(computeCurvatures(topologyOf(torus_c), torus_c.points).mean, torus_c.mean_curvature);
+  const Errors tf =
+      errors(computeCurvatures(topologyOf(torus_f), torus_f.points).mean, torus_f.mean_curvature);
   std::printf("jittered torus: H rms %.2e -> %.2e\n", tc.rms, tf.rms);
   EXPECT_GT(tf.rms, 0.5 * tc.rms);
   EXPECT_NEAR(tf.rms, 0.071, 0.02);  // ACCURACY.md: 0.071 at 131,072 V

@@ -33,12 +33,14 @@ Mesh fromFile(const char* name, const std::string& path) {
 
 std::vector<Mesh> testMeshes() {
   std::vector<Mesh> meshes;
-  meshes.push_back(fromSample("jittered torus far away", makeTorus({24, 0.1, 5}).rotateAndShiftFar()));
+  meshes.push_back(
+      fromSample("jittered torus far away", makeTorus({24, 0.1, 5}).rotateAndShiftFar()));
   meshes.push_back(fromSample("jittered sphere", makeIcosphere(2, 2.0, 0.1)));
   meshes.push_back(fromSample("saddle (boundary)", makeSaddle({12, 0.1, 2})));
   meshes.push_back(fromFile("bun_zipper_res4 (non-manifold, duplicates)",
                             sharedData("meshes/bun_zipper_res4.ply")));
-  meshes.push_back(fromFile("bun_zipper_res3 (unused vertices)", sharedData("meshes/bun_zipper_res3.ply")));
+  meshes.push_back(
+      fromFile("bun_zipper_res3 (unused vertices)", sharedData("meshes/bun_zipper_res3.ply")));
   return meshes;
 }
 
@@ -53,7 +55,8 @@ TEST(Laplacian, RowsSumToZeroAndSummedFormIsSymmetric) {
       EXPECT_LT((l - transpose).cwiseAbs().sum(), 1e-14 * l.cwiseAbs().sum());
       const Eigen::SparseMatrix<double> averaged =
           laplacian(m.topology, m.points, w, LaplacianForm::Averaged);
-      EXPECT_LT((averaged * ones).cwiseAbs().maxCoeff(), 1e-9 * averaged.cwiseAbs().sum() / l.cols());
+      EXPECT_LT((averaged * ones).cwiseAbs().maxCoeff(),
+                1e-9 * averaged.cwiseAbs().sum() / l.cols());
     }
   }
 }
@@ -109,7 +112,8 @@ double worstInteriorRow(const MeshTopology& t, const Eigen::Matrix3Xd& points, L
 TEST(Laplacian, CotangentLinearPrecisionOnIrregularPlanarPatch) {
   SurfaceSample plane = makePlane({20, 0.1, 11});
   Eigen::Isometry3d rotation = Eigen::Isometry3d::Identity();
-  rotation.linear() = Eigen::AngleAxisd(0.9, Eigen::Vector3d(3, -1, 2).normalized()).toRotationMatrix();
+  rotation.linear() =
+      Eigen::AngleAxisd(0.9, Eigen::Vector3d(3, -1, 2).normalized()).toRotationMatrix();
   plane.transform(rotation);
   const MeshTopology t(static_cast<int>(plane.points.cols()), plane.triangles);
   EXPECT_LT(worstInteriorRow(t, plane.points, LaplacianWeights::Cotangent), 1e-12);

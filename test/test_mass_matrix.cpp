@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "analytic_surfaces.h"
-#include "pcl_ddg/operators/mass_matrix.h"
 #include "pcl_ddg/mesh/mesh_report.h"
+#include "pcl_ddg/operators/mass_matrix.h"
 
 namespace pcl_ddg {
 namespace test {

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstdio>
 
-#include "analytic_surfaces.h"
 #include <pcl/exceptions.h>
+#include "analytic_surfaces.h"
 
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -32,8 +32,8 @@ MeshTopology topologyOf(const SurfaceSample& s) {
 }
 
 TEST(MeshNormals, EveryWeightingMatchesTheExactNormalOnRegularMeshes) {
-  for (const SurfaceSample& s : {makeTorus({128, 0.0, 1}).rotateAndShiftFar(), makeIcosphere(4),
-                                 makeSaddle({64, 0.0, 1})}) {
+  for (const SurfaceSample& s :
+       {makeTorus({128, 0.0, 1}).rotateAndShiftFar(), makeIcosphere(4), makeSaddle({64, 0.0, 1})}) {
     const MeshTopology t = topologyOf(s);
     for (auto w : kAll) {
       const MeshNormals n = computeMeshNormals(t, s.points, {w});
@@ -66,7 +66,9 @@ TEST(MeshNormals, MeanCurvatureNormalsEqualAreaNormalsOnAPlane) {
   const MeshNormals mc = computeMeshNormals(t, plane.points, {NormalWeighting::MeanCurvature});
   const MeshNormals area = computeMeshNormals(t, plane.points, {NormalWeighting::Area});
   EXPECT_EQ(mc.fallback_vertices, t.numVertices());
-  EXPECT_EQ(mc.normals, area.normals);
+  // The same area vectors, formed from another corner: equal up to the rounding of coordinates
+  // 1e5 from the origin (measured 1.5e-6 degrees).
+  EXPECT_LT(maxAngleDegrees(mc.normals, area.normals), 1e-5);
   // 1e5 from the origin the vertices are planar only to their rounding.
   EXPECT_LT(maxAngleDegrees(area.normals, plane.normals), 1e-5);
 }

@@ -15,10 +15,17 @@ namespace pcl_ddg {
 namespace test {
 namespace {
 
-const char* kSharedMeshes[] = {"bumpy.off",           "bun045_rangegrid_tri.ply", "bun_zipper.ply",
-                               "bun_zipper_res3.ply", "bun_zipper_res4.ply",      "bunny.off",
-                               "cow.off",             "horse.ply",                "igea.ply",
-                               "rocker-arm.off",      "tum_rabbit.vtk"};
+const char* kSharedMeshes[] = {"bumpy.off",
+                               "bun045_rangegrid_tri.ply",
+                               "bun_zipper.ply",
+                               "bun_zipper_res3.ply",
+                               "bun_zipper_res4.ply",
+                               "bunny.off",
+                               "cow.off",
+                               "horse.ply",
+                               "igea.ply",
+                               "rocker-arm.off",
+                               "tum_rabbit.vtk"};
 
 class MeshTools : public ::testing::Test {
  protected:
@@ -37,7 +44,8 @@ TEST_F(MeshTools, NormalsOnEverySharedMeshAreUnitWhereValid) {
     ASSERT_EQ(run.exit_code, 0) << run.err;
     const pcl::PolygonMesh out = loadMesh(path("out.ply"));
     const MeshTopology t(out);
-    const Eigen::VectorXd nx = vertexScalarField(out.cloud, "nx"), ny = vertexScalarField(out.cloud, "ny"),
+    const Eigen::VectorXd nx = vertexScalarField(out.cloud, "nx"),
+                          ny = vertexScalarField(out.cloud, "ny"),
                           nz = vertexScalarField(out.cloud, "nz");
     int invalid = 0;
     for (Eigen::Index i = 0; i < nx.size(); ++i) {
@@ -49,7 +57,8 @@ TEST_F(MeshTools, NormalsOnEverySharedMeshAreUnitWhereValid) {
       ASSERT_NEAR(norm, 1.0, 1e-6);
     }
     EXPECT_GE(invalid, t.counts().unreferenced_vertices);
-    EXPECT_EQ(out.polygons.size(), loadMesh(sharedData(std::string("meshes/") + file)).polygons.size());
+    EXPECT_EQ(out.polygons.size(),
+              loadMesh(sharedData(std::string("meshes/") + file)).polygons.size());
   }
 }
 
@@ -60,10 +69,12 @@ TEST_F(MeshTools, CurvatureOnEverySharedMeshWritesAllFields) {
                                                             " " + path("out.ply") + " -color mean");
     ASSERT_EQ(run.exit_code, 0) << run.err;
     const pcl::PolygonMesh out = loadMesh(path("out.ply"));
-    for (const char* field : {"mean_curvature", "gauss_curvature", "k1", "k2", "vertex_area", "red"}) {
+    for (const char* field :
+         {"mean_curvature", "gauss_curvature", "k1", "k2", "vertex_area", "red"}) {
       EXPECT_TRUE(hasVertexField(out.cloud, field)) << field;
     }
-    const Eigen::VectorXd k1 = vertexScalarField(out.cloud, "k1"), k2 = vertexScalarField(out.cloud, "k2");
+    const Eigen::VectorXd k1 = vertexScalarField(out.cloud, "k1"),
+                          k2 = vertexScalarField(out.cloud, "k2");
     for (Eigen::Index i = 0; i < k1.size(); ++i) {
       if (!std::isnan(k1[i])) ASSERT_GE(k1[i], k2[i]);
     }
@@ -96,7 +107,8 @@ TEST_F(MeshTools, BadInputGivesOneLineNonZeroExitAndNoOutput) {
   writeText(path("nan.obj"), "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n");
   writeText(path("range.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
   writeText(path("cloud.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
-  writeText(path("garbage.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n");
+  writeText(path("garbage.ply"),
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n");
   for (const char* tool : {PCL_DDG_NORMALS_TOOL, PCL_DDG_CURVATURE_TOOL}) {
     for (const char* input : {"nan.obj", "range.obj", "cloud.obj", "garbage.ply", "missing.ply"}) {
       SCOPED_TRACE(std::string(tool) + " " + input);
@@ -105,16 +117,18 @@ TEST_F(MeshTools, BadInputGivesOneLineNonZeroExitAndNoOutput) {
       EXPECT_NE(run.err.find(": error: "), std::string::npos) << run.err;
       EXPECT_FALSE(std::filesystem::exists(path("out.ply")));
     }
-    EXPECT_EQ(runTool(tool, sharedData("meshes/cow.off") + " " + path("out.ply") + " -bogus 1").exit_code, 2);
+    EXPECT_EQ(
+        runTool(tool, sharedData("meshes/cow.off") + " " + path("out.ply") + " -bogus 1").exit_code,
+        2);
     EXPECT_EQ(runTool(tool, sharedData("meshes/cow.off") + " " + path("out.xyz")).exit_code, 2);
     EXPECT_EQ(runTool(tool, sharedData("meshes/cow.off")).exit_code, 2);
   }
-  EXPECT_EQ(runTool(PCL_DDG_NORMALS_TOOL, sharedData("meshes/cow.off") + " " + path("o.ply") +
-                                              " -method area -epsilon 1")
+  EXPECT_EQ(runTool(PCL_DDG_NORMALS_TOOL,
+                    sharedData("meshes/cow.off") + " " + path("o.ply") + " -method area -epsilon 1")
                 .exit_code,
             2);
-  EXPECT_EQ(runTool(PCL_DDG_CURVATURE_TOOL, sharedData("meshes/cow.off") + " " + path("o.ply") +
-                                                " -area heron")
+  EXPECT_EQ(runTool(PCL_DDG_CURVATURE_TOOL,
+                    sharedData("meshes/cow.off") + " " + path("o.ply") + " -area heron")
                 .exit_code,
             2);
   for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
@@ -135,12 +149,12 @@ TEST_F(MeshTools, NormalMethodsAndPcdOutput) {
 }
 
 TEST_F(MeshTools, RenderMakesAPicture) {
-  const ToolRun run =
-      runTool(PCL_DDG_RENDER_TOOL, sharedData("meshes/cow.off") + " " + path("cow.png") + " -size 64");
+  const ToolRun run = runTool(PCL_DDG_RENDER_TOOL,
+                              sharedData("meshes/cow.off") + " " + path("cow.png") + " -size 64");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_GT(std::filesystem::file_size(path("cow.png")), 100u);
-  EXPECT_EQ(runTool(PCL_DDG_RENDER_TOOL, sharedData("meshes/cow.off") + " " + path("cow.png") +
-                                             " -field nothing")
+  EXPECT_EQ(runTool(PCL_DDG_RENDER_TOOL,
+                    sharedData("meshes/cow.off") + " " + path("cow.png") + " -field nothing")
                 .exit_code,
             1);
 }

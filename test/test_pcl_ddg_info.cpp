@@ -14,7 +14,9 @@ namespace pcl_ddg {
 namespace test {
 namespace {
 
-ToolRun runInfo(const std::string& arguments) { return runTool(PCL_DDG_INFO_TOOL, arguments); }
+ToolRun runInfo(const std::string& arguments) {
+  return runTool(PCL_DDG_INFO_TOOL, arguments);
+}
 
 boost::property_tree::ptree json(const std::string& file) {
   const ToolRun run = runInfo(file + " -json");

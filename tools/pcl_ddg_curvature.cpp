@@ -20,14 +20,16 @@ constexpr const char* kSyntax =
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(argc, argv, {"area", "color", "percentile", "precision"}, {});
-  if (args.positional().size() != 2) throw tools::UsageError("expected an input and an output file");
+  if (args.positional().size() != 2)
+    throw tools::UsageError("expected an input and an output file");
   const std::string area = args.choice("area", {"mixed", "voronoi", "barycentric"}, "mixed");
   const MassType mass = area == "voronoi"       ? MassType::Voronoi
                         : area == "barycentric" ? MassType::Barycentric
                                                 : MassType::MixedVoronoi;
   const std::string color = args.choice("color", {"none", "mean", "gauss", "k1", "k2"}, "none");
   const double percentile = args.number("percentile", 2.0);
-  if (percentile < 0.0 || percentile >= 50.0) throw tools::UsageError("-percentile must be in [0, 50)");
+  if (percentile < 0.0 || percentile >= 50.0)
+    throw tools::UsageError("-percentile must be in [0, 50)");
   const FieldPrecision precision = tools::precisionArgument(args);
   const std::string output = args.positional()[1];
   if (fileExtension(output) != "ply" && fileExtension(output) != "pcd") {
@@ -45,9 +47,11 @@ int run(int argc, char** argv) {
     tools::warn(kName, std::to_string(c.clamped_vertices) +
                            " vertices with H^2 < K (umbilic or noisy): k1 = k2 = H there");
   }
-  const std::pair<const char*, const Eigen::VectorXd*> fields[] = {
-      {"mean_curvature", &c.mean}, {"gauss_curvature", &c.gauss}, {"k1", &c.kappa1},
-      {"k2", &c.kappa2},           {"vertex_area", &c.vertex_area}};
+  const std::pair<const char*, const Eigen::VectorXd*> fields[] = {{"mean_curvature", &c.mean},
+                                                                   {"gauss_curvature", &c.gauss},
+                                                                   {"k1", &c.kappa1},
+                                                                   {"k2", &c.kappa2},
+                                                                   {"vertex_area", &c.vertex_area}};
   for (const auto& [name, values] : fields) setVertexField(in.mesh.cloud, name, *values, precision);
   if (color != "none") {
     const Eigen::VectorXd& values = color == "mean"    ? c.mean

@@ -17,7 +17,8 @@ constexpr const char* kSyntax =
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(argc, argv, {"method", "epsilon", "precision"}, {});
-  if (args.positional().size() != 2) throw tools::UsageError("expected an input and an output file");
+  if (args.positional().size() != 2)
+    throw tools::UsageError("expected an input and an output file");
   const std::string method =
       args.choice("method", {"uniform", "area", "angle", "mean_curvature"}, "area");
   MeshNormalOptions options;
@@ -43,7 +44,8 @@ int run(int argc, char** argv) {
   const MeshNormals normals = computeMeshNormals(in.topology, in.positions, options);
   timer.done(static_cast<std::size_t>(in.positions.cols()));
   if (normals.invalid_vertices > 0) {
-    tools::warn(kName, std::to_string(normals.invalid_vertices) + " vertices without a normal (NaN)");
+    tools::warn(kName,
+                std::to_string(normals.invalid_vertices) + " vertices without a normal (NaN)");
   }
   if (options.weighting == NormalWeighting::MeanCurvature) {
     tools::warn(kName, std::to_string(normals.fallback_vertices) +

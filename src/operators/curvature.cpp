@@ -49,8 +49,8 @@ Eigen::VectorXd angleDefect(const MeshTopology& topology, const Eigen::Matrix3Xd
   return defect;
 }
 
-Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
-                                     MassType mass) {
+Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology,
+                                     const Eigen::Matrix3Xd& positions, MassType mass) {
   detail::requireMatchingPositions(topology, positions);
   Eigen::Matrix3Xd hn(3, topology.numVertices());
 #pragma omp parallel for schedule(static)

@@ -7,14 +7,18 @@ namespace pcl_ddg {
 Eigen::VectorXd lumpedMass(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
                            MassType type) {
   detail::requireMatchingPositions(topology, positions);
+  const Eigen::Matrix3Xi& triangles = topology.triangles();
+  Eigen::Matrix3Xd corner_mass(3, triangles.cols());
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index t = 0; t < triangles.cols(); ++t) {
+    const detail::CornerView c =
+        detail::viewFromCorner(positions, triangles, static_cast<int>(t), 0);
+    corner_mass.col(t) = c.degenerate ? Eigen::Vector3d::Zero() : detail::cornerMasses(c, type);
+  }
   Eigen::VectorXd mass(topology.numVertices());
 #pragma omp parallel for schedule(static)
-  for (int v = 0; v < topology.numVertices(); ++v) {
-    double sum = 0.0;
-    detail::forEachCornerOf(topology, positions, v,
-                            [&](const detail::CornerView& c, int) { sum += detail::cornerMass(c, type); });
-    mass[v] = sum;
-  }
+  for (int v = 0; v < topology.numVertices(); ++v)
+    mass[v] = detail::sumCornerValues(topology, corner_mass, v);
   return mass;
 }
 

@@ -12,9 +12,9 @@ namespace pcl_ddg {
 namespace test {
 
 ToolRun runTool(const std::string& binary, const std::string& arguments) {
-  const std::string err_path =
-      (std::filesystem::temp_directory_path() / ("pcl_ddg_tool_stderr_" + std::to_string(::getpid())))
-          .string();
+  const std::string err_path = (std::filesystem::temp_directory_path() /
+                                ("pcl_ddg_tool_stderr_" + std::to_string(::getpid())))
+                                   .string();
   const std::string command = binary + " " + arguments + " 2>" + err_path;
   ToolRun run;
   FILE* pipe = popen(command.c_str(), "r");

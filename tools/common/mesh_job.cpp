@@ -36,7 +36,7 @@ SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name) {
 
 FieldPrecision precisionArgument(const ToolArguments& args) {
   return args.choice("precision", {"float", "double"}, "float") == "double" ? FieldPrecision::Double
-                                                                           : FieldPrecision::Float;
+                                                                            : FieldPrecision::Float;
 }
 
 void saveResult(const std::string& path, const pcl::PolygonMesh& mesh) {

@@ -20,8 +20,7 @@ constexpr double kDegenerateTriangleTolerance = 1e-12;
 inline bool isDegenerateTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                  const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, ac = c - a, bc = c - b;
-  const double longest_squared =
-      std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
+  const double longest_squared = std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
   // Squared on both sides: no square root in the operators' innermost loop. (Edges shorter than
   // about 1e-75 underflow here; such coordinates are outside what double geometry supports.)
   const double bound = kDegenerateTriangleTolerance * longest_squared;

@@ -25,13 +25,14 @@ namespace pcl_ddg {
 Eigen::VectorXd angleDefect(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
 
 /** The mean-curvature normal Hn = -1/2 M^-1 L x (zero at zero-mass vertices). */
-Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology,
+                                     const Eigen::Matrix3Xd& positions,
                                      MassType mass = MassType::MixedVoronoi);
 
 struct VertexCurvatures {
-  Eigen::VectorXd mean;         ///< H, signed
-  Eigen::VectorXd gauss;        ///< K density (angle defect / vertex area)
-  Eigen::VectorXd kappa1;       ///< kappa1 >= kappa2
+  Eigen::VectorXd mean;    ///< H, signed
+  Eigen::VectorXd gauss;   ///< K density (angle defect / vertex area)
+  Eigen::VectorXd kappa1;  ///< kappa1 >= kappa2
   Eigen::VectorXd kappa2;
   Eigen::VectorXd vertex_area;  ///< the mass used
   std::vector<std::uint8_t> valid;

@@ -11,8 +11,8 @@
 //                 to agree with the area normal. Where |M^-1 L x| (= 2|H|) is below epsilon the
 //                 surface is locally flat, that direction is noise, and the area normal is used
 //                 (counted in fallback_vertices), as on boundary vertices, where -M^-1 L x
-//                 also holds the curvature of the boundary curve. Default epsilon: 0.02 / mean edge length, i.e.
-//                 radii of curvature above 100 mean edge lengths count as flat.
+//                 also holds the curvature of the boundary curve. Default epsilon: 0.02 / mean edge
+//                 length, i.e. radii of curvature above 100 mean edge lengths count as flat.
 // Degenerate triangles contribute nothing. Vertices with no non-degenerate triangle (isolated
 // ones included) get a NaN normal and valid = 0.
 #include <Eigen/Core>
