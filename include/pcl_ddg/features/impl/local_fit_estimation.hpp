@@ -1,0 +1,104 @@
+#pragma once
+#include <pcl/common/point_tests.h>
+
+#include <string>
+
+#include "pcl_ddg/features/local_fit_estimation.h"
+#include "pcl_ddg/search/mesh_ring_search.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace pcl_ddg {
+
+template <typename PointInT, typename PointOutT>
+bool LocalFitEstimation<PointInT, PointOutT>::initCompute() {
+  if (!pcl::Feature<PointInT, PointOutT>::initCompute()) return false;
+  std::shared_ptr<const MeshTopology> mesh = orientation_mesh_;
+  used_orientation_ = orientation_;
+  if (!orientation_chosen_) {
+    const auto ring_search = std::dynamic_pointer_cast<MeshRingSearch<PointInT>>(this->tree_);
+    used_orientation_ = ring_search ? NormalOrientation::MeshFaces : NormalOrientation::Viewpoint;
+    if (ring_search) mesh = ring_search->topologyPtr();
+  }
+  if (used_orientation_ == NormalOrientation::MeshFaces) {
+    if (mesh->numVertices() != static_cast<int>(this->input_->size())) {
+      PCL_ERROR("[pcl_ddg::%s] the orientation mesh has %d vertices for %zu input points\n",
+                this->getClassName().c_str(), mesh->numVertices(), this->input_->size());
+      return false;
+    }
+    Eigen::Matrix3Xd positions(3, this->input_->size());
+    for (std::size_t i = 0; i < this->input_->size(); ++i) {
+      positions.col(i) = (*this->input_)[i].getVector3fMap().template cast<double>();
+    }
+    reference_normals_ = meshOrientationNormals(*mesh, positions);
+  } else {
+    reference_normals_.resize(3, 0);
+  }
+  return true;
+}
+
+template <typename PointInT, typename PointOutT>
+bool LocalFitEstimation<PointInT, PointOutT>::orient(Eigen::Vector3d& n, pcl::index_t index,
+                                                     const Eigen::Vector3d& p) const {
+  double agreement = 0.0;
+  if (reference_normals_.cols() > 0) agreement = n.dot(reference_normals_.col(index));
+  if (agreement == 0.0) agreement = n.dot(viewpoint_ - p);  // no face normal there
+  if (agreement >= 0.0) return false;
+  n = -n;
+  return true;
+}
+
+template <typename PointInT, typename PointOutT>
+template <typename Fit>
+void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut& output, Fit&& fit) {
+  const pcl::Indices& indices = *this->indices_;
+  const auto& surface = *this->surface_;
+  int threads = static_cast<int>(threads_);
+#ifdef _OPENMP
+  if (threads == 0) threads = omp_get_num_procs();
+#endif
+  std::int64_t failed = 0, fell_back = 0;
+  output.is_dense = true;
+#pragma omp parallel num_threads(threads) reduction(+ : failed, fell_back)
+  {
+    // Per-thread buffers, grown once and reused for every point.
+    pcl::Indices neighbours;
+    std::vector<float> squared_distances;
+    Eigen::Matrix3Xd local(3, 64);
+#pragma omp for schedule(dynamic, 256)
+    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(indices.size()); ++i) {
+      const PointInT& query = (*this->input_)[indices[i]];
+      FitOutcome outcome = FitOutcome::Failed;
+      if (pcl::isXYZFinite(query) &&
+          this->searchForNeighbors(indices[i], this->search_parameter_, neighbours, squared_distances) > 0) {
+        const Eigen::Vector3d origin = query.getVector3fMap().template cast<double>();
+        if (local.cols() < static_cast<Eigen::Index>(neighbours.size())) local.resize(3, neighbours.size());
+        int count = 0;
+        for (const pcl::index_t j : neighbours) {
+          if (pcl::isXYZFinite(surface[j])) {
+            local.col(count++) = surface[j].getVector3fMap().template cast<double>() - origin;
+          }
+        }
+        outcome = fit(local, count, indices[i], origin, static_cast<std::size_t>(i));
+      }
+      if (outcome == FitOutcome::Failed) {
+        setInvalid(output[i]);
+        ++failed;
+      } else if (outcome == FitOutcome::FellBack) {
+        ++fell_back;
+      }
+    }
+  }
+  failed_points_ = failed;
+  fallback_points_ = fell_back;
+  if (failed > 0) {
+    output.is_dense = false;
+    PCL_WARN("[pcl_ddg::%s] %lld of %zu points could not be estimated (non-finite, or fewer than the "
+             "minimum of finite neighbours): their output is NaN\n",
+             this->getClassName().c_str(), static_cast<long long>(failed), indices.size());
+  }
+}
+
+}  // namespace pcl_ddg

@@ -1,0 +1,57 @@
+#include "estimator_support.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pcl_ddg {
+namespace test {
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr toCloud(const Eigen::Matrix3Xd& points) {
+  auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  cloud->resize(points.cols());
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    (*cloud)[i].getVector3fMap() = points.col(i).cast<float>();
+  }
+  cloud->width = static_cast<std::uint32_t>(points.cols());
+  cloud->height = 1;
+  cloud->is_dense = points.allFinite();
+  return cloud;
+}
+
+std::shared_ptr<const MeshTopology> topologyPtrOf(const SurfaceSample& surface) {
+  return std::make_shared<const MeshTopology>(static_cast<int>(surface.points.cols()), surface.triangles);
+}
+
+Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals) {
+  Eigen::Matrix3Xd n(3, normals.size());
+  for (std::size_t i = 0; i < normals.size(); ++i) n.col(i) = normals[i].getNormalVector3fMap().cast<double>();
+  return n;
+}
+
+AngleErrors angleErrors(const Eigen::Matrix3Xd& estimated, const Eigen::Matrix3Xd& truth, SignMode mode) {
+  AngleErrors e;
+  int counted = 0;
+  for (Eigen::Index i = 0; i < estimated.cols(); ++i) {
+    if (!estimated.col(i).allFinite()) {
+      ++e.invalid;
+      continue;
+    }
+    const Eigen::Vector3d n = estimated.col(i).normalized();
+    double cosine = n.dot(truth.col(i));
+    if (mode == SignMode::Unsigned) cosine = std::abs(cosine);
+    // atan2 of sine and cosine keeps small angles accurate.
+    const double angle = std::atan2(n.cross(truth.col(i)).norm(), cosine) * 180.0 / M_PI;
+    e.mean += angle;
+    e.max = std::max(e.max, angle);
+    ++counted;
+  }
+  if (counted > 0) e.mean /= counted;
+  return e;
+}
+
+double observedOrder(double error_coarse, double error_fine, double h_coarse, double h_fine) {
+  return std::log(error_coarse / error_fine) / std::log(h_coarse / h_fine);
+}
+
+}  // namespace test
+}  // namespace pcl_ddg
