@@ -1,0 +1,257 @@
+// PCA normals: first-order convergence on analytic surfaces, exactness far from the origin,
+// parity with pcl::NormalEstimation, orientation, and bad input.
+#include <gtest/gtest.h>
+#include <pcl/features/normal_3d.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/search/kdtree.h>
+
+#include <Eigen/Eigenvalues>
+#include <cstdio>
+#include <limits>
+
+#include "analytic_surfaces.h"
+#include "estimator_support.h"
+#include "pcl_ddg/features/pca_normal_estimation.h"
+#include "pcl_ddg/search/mesh_ring_search.h"
+#include "test_data.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+using Normals = pcl::PointCloud<pcl::Normal>;
+
+Normals ourNormals(const Cloud::Ptr& cloud, pcl::search::Search<pcl::PointXYZ>::Ptr search, int k) {
+  PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+  estimator.setInputCloud(cloud);
+  estimator.setSearchMethod(search);
+  estimator.setKSearch(k);
+  Normals normals;
+  estimator.compute(normals);
+  return normals;
+}
+
+Normals pclNormals(const Cloud::Ptr& cloud, int k) {
+  pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+  estimator.setInputCloud(cloud);
+  estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  estimator.setKSearch(k);
+  Normals normals;
+  estimator.compute(normals);
+  return normals;
+}
+
+pcl::search::Search<pcl::PointXYZ>::Ptr kdTree() { return std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>(); }
+
+// The surface scaled by factor (lengths times factor, curvatures divided by it).
+SurfaceSample scaled(SurfaceSample s, double factor) {
+  s.points *= factor;
+  s.mean_curvature /= factor;
+  s.kappa1 /= factor;
+  s.kappa2 /= factor;
+  s.gauss_curvature /= factor * factor;
+  return s;
+}
+
+TEST(PCANormals, ConvergeAtFirstOrderOnAJitteredTorusCloud) {
+  // ACCURACY.md: torus R = 1, r = 0.4, jittered samples, k = 20: PCA mean error 1.57, 0.78, 0.39,
+  // 0.19 degrees at 2k, 8k, 32k, 131k points. Ours, with 0.1-spacing parameter jitter: 1.41, 0.67,
+  // 0.34, 0.17.
+  const double reference[] = {1.57, 0.78, 0.39, 0.19};
+  double previous = 0.0;
+  int level = 0;
+  for (const int resolution : {64, 128, 256, 512}) {
+    const SurfaceSample torus = makeTorus({resolution, 0.1, 11}).asCloud();
+    const AngleErrors e = angleErrors(normalsOf(ourNormals(toCloud(torus.points), kdTree(), 20)), torus.normals,
+                                      SignMode::Unsigned);
+    std::printf("PCA torus %6ld points: mean %.4f max %.4f deg\n", torus.points.cols(), e.mean, e.max);
+    EXPECT_EQ(e.invalid, 0);
+    EXPECT_LE(e.mean, 1.1 * reference[level]);
+    if (previous > 0.0) EXPECT_GT(observedOrder(previous, e.mean, 2.0, 1.0), 0.9);
+    previous = e.mean;
+    ++level;
+  }
+}
+
+TEST(PCANormals, FirstOrderOnEveryAnalyticSurfaceAndExactOnThePlane) {
+  struct Case {
+    const char* name;
+    SurfaceSample (*make)(int);
+  };
+  const Case cases[] = {
+      {"plane", [](int r) { return makePlane({r, 0.25, 3}); }},
+      {"sphere", [](int r) { return makeIcosphere(r == 32 ? 4 : 5, 1.0, 0.25, 3); }},
+      {"cylinder", [](int r) { return makeCylinder({2 * r, 0.25, 3}); }},
+      {"torus", [](int r) { return makeTorus({2 * r, 0.25, 3}); }},
+      {"saddle", [](int r) { return makeSaddle({r, 0.25, 3}); }},
+      {"paraboloid", [](int r) { return makeParaboloid({r, 0.25, 3}); }},
+  };
+  for (const Case& c : cases) {
+    double error[2];
+    for (int i = 0; i < 2; ++i) {
+      // Scaled by 100 about the origin before the shift, so float coordinates resolve the sampling.
+      SurfaceSample big = scaled(c.make(i == 0 ? 32 : 64), 100.0);
+      big.rotateAndShiftFar();
+      const AngleErrors e = angleErrors(normalsOf(ourNormals(toCloud(big.points), kdTree(), 16)), big.normals,
+                                        SignMode::Unsigned);
+      std::printf("PCA %-10s %6ld points (x100, shifted 1e5): mean %.5f max %.5f deg\n", c.name,
+                  big.points.cols(), e.mean, e.max);
+      EXPECT_EQ(e.invalid, 0);
+      error[i] = e.mean;
+    }
+    if (std::string(c.name) == "plane") {
+      // Exact but for the input: 1e5 from the origin floats are 0.0078 apart (measured 0.007 deg).
+      EXPECT_LT(error[1], 0.05);
+      SurfaceSample near = c.make(64);
+      near.transform(Eigen::Isometry3d(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())));
+      const AngleErrors e = angleErrors(normalsOf(ourNormals(toCloud(near.points), kdTree(), 16)), near.normals,
+                                        SignMode::Unsigned);
+      EXPECT_LT(e.max, 1e-4) << "a plane near the origin is fitted to float rounding";
+    } else {
+      EXPECT_GT(observedOrder(error[0], error[1], 2.0, 1.0), 0.8) << c.name;
+    }
+  }
+}
+
+TEST(PCANormals, FarFromTheOriginOursKeepsItsAccuracyAndIsAtLeastAsAccurateAsPCL) {
+  // The same torus (scaled by 100 so float coordinates resolve it) near the origin and 1e5 away.
+  SurfaceSample near = scaled(makeTorus({128, 0.25, 5}), 100.0).asCloud();
+  SurfaceSample far = near;
+  far.rotateAndShiftFar();
+  const AngleErrors ours_near = angleErrors(normalsOf(ourNormals(toCloud(near.points), kdTree(), 16)), near.normals,
+                                            SignMode::Unsigned);
+  const AngleErrors ours_far = angleErrors(normalsOf(ourNormals(toCloud(far.points), kdTree(), 16)), far.normals,
+                                           SignMode::Unsigned);
+  const AngleErrors pcl_far = angleErrors(normalsOf(pclNormals(toCloud(far.points), 16)), far.normals,
+                                          SignMode::Unsigned);
+  // Measured: 1.0141 / 1.0122 / 1.0122 deg. (PCL 1.13 shifts its float covariance by a point of
+  // the neighbourhood, so it holds up here too; ACCURACY.md's "degrees" are older PCL's.)
+  std::printf("torus x100: ours near %.4f deg, ours 1e5 away %.4f deg, pcl::NormalEstimation 1e5 away %.4f deg "
+              "(mean; max %.2f)\n",
+              ours_near.mean, ours_far.mean, pcl_far.mean, pcl_far.max);
+  EXPECT_LT(std::abs(ours_far.mean - ours_near.mean), 0.05 * ours_near.mean);
+  EXPECT_LE(ours_far.mean, pcl_far.mean * (1.0 + 1e-3));
+}
+
+// The exact plane normal of a neighbourhood: centred two-pass covariance and Eigen's iterative
+// (QR) symmetric eigensolver, in double.
+Eigen::Vector3d exactPlaneNormal(const Cloud& cloud, const pcl::Indices& neighbours) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto j : neighbours) mean += cloud[j].getVector3fMap().cast<double>();
+  mean /= static_cast<double>(neighbours.size());
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const auto j : neighbours) {
+    const Eigen::Vector3d d = cloud[j].getVector3fMap().cast<double>() - mean;
+    covariance += d * d.transpose();
+  }
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
+}
+
+TEST(PCANormals, OnUTMTerrainOursIsTheExactPlaneFitAndAtLeastAsAccurateAsPCL) {
+  auto cloud = std::make_shared<Cloud>();
+  ASSERT_EQ(pcl::io::loadPCDFile(sharedData("clouds/terrain_CSite1_red2-utm.pcd"), *cloud), 0);
+  pcl::search::KdTree<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  Eigen::Matrix3Xd truth(3, cloud->size());
+  pcl::Indices neighbours;
+  std::vector<float> distances;
+  for (std::size_t i = 0; i < cloud->size(); ++i) {
+    tree.nearestKSearch(static_cast<pcl::index_t>(i), 16, neighbours, distances);
+    truth.col(i) = exactPlaneNormal(*cloud, neighbours);
+  }
+  const Eigen::Matrix3Xd ours = normalsOf(ourNormals(cloud, kdTree(), 16));
+  const Eigen::Matrix3Xd theirs = normalsOf(pclNormals(cloud, 16));
+  const AngleErrors ours_all = angleErrors(ours, truth, SignMode::Unsigned);
+  const AngleErrors theirs_all = angleErrors(theirs, truth, SignMode::Unsigned);
+  std::printf("UTM terrain (%zu points, UTM coordinates) against the exact double plane fit: ours mean "
+              "%.2e max %.2e deg; pcl::NormalEstimation mean %.2e max %.2e deg\n",
+              cloud->size(), ours_all.mean, ours_all.max, theirs_all.mean, theirs_all.max);
+  EXPECT_EQ(ours_all.invalid, 0);
+  EXPECT_LT(ours_all.mean, 1e-4);
+  EXPECT_LE(ours_all.mean, theirs_all.mean);
+}
+
+TEST(PCANormals, MeshInputIsOrientedLikeTheFacesAndCloudsTowardsTheViewpoint) {
+  const SurfaceSample torus = makeTorus({64, 0.25, 2}).rotateAndShiftFar();
+  const auto cloud = toCloud(torus.points);
+  auto ring = std::make_shared<MeshRingSearch<pcl::PointXYZ>>(topologyPtrOf(torus));
+  const Eigen::Matrix3Xd normals_on_mesh = normalsOf(ourNormals(cloud, ring, 16));
+  int inward = 0;
+  for (Eigen::Index i = 0; i < normals_on_mesh.cols(); ++i) inward += normals_on_mesh.col(i).dot(torus.normals.col(i)) < 0.0;
+  EXPECT_EQ(inward, 0) << "outward everywhere, like the faces";
+
+  // A sphere seen from its centre: every normal faces inward.
+  const SurfaceSample sphere = makeIcosphere(3, 2.0, 0.2, 1).transform(Eigen::Isometry3d(Eigen::Translation3d(5, 6, 7)));
+  PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+  estimator.setInputCloud(toCloud(sphere.points));
+  estimator.setSearchMethod(kdTree());
+  estimator.setKSearch(12);
+  estimator.setViewPoint(5, 6, 7);
+  Normals normals;
+  estimator.compute(normals);
+  EXPECT_EQ(estimator.getOrientation(), NormalOrientation::Viewpoint);
+  EXPECT_LT(angleErrors(normalsOf(normals), -sphere.normals, SignMode::Signed).max, 20.0);
+}
+
+TEST(PCANormals, NonFinitePointsGetNaNAndAreCountedDuplicatesDoNoHarm) {
+  SurfaceSample torus = makeTorus({64, 0.25, 4}).asCloud();
+  Eigen::Matrix3Xd points(3, 2 * torus.points.cols());
+  points << torus.points, torus.points;  // every point twice
+  points.col(10).setConstant(std::numeric_limits<double>::quiet_NaN());
+  points.col(20).x() = std::numeric_limits<double>::infinity();
+  PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+  estimator.setInputCloud(toCloud(points));
+  estimator.setSearchMethod(kdTree());
+  estimator.setKSearch(24);
+  Normals normals;
+  estimator.compute(normals);
+  ASSERT_EQ(normals.size(), static_cast<std::size_t>(points.cols()));
+  EXPECT_FALSE(normals.is_dense);
+  EXPECT_EQ(estimator.getFailedPoints(), 2);
+  EXPECT_TRUE(std::isnan(normals[10].normal_x));
+  EXPECT_TRUE(std::isnan(normals[20].curvature));
+  Eigen::Matrix3Xd truth(3, points.cols());
+  truth << torus.normals, torus.normals;
+  const AngleErrors e = angleErrors(normalsOf(normals), truth, SignMode::Unsigned);
+  EXPECT_EQ(e.invalid, 2);
+  EXPECT_LT(e.max, 10.0);
+}
+
+TEST(PCANormals, KLargerThanAComponentUsesWhatThereIsAndFailsBelowThreePoints) {
+  // A lone triangle, an isolated vertex and a torus in one mesh.
+  const SurfaceSample torus = makeTorus({16, 0.0, 1});
+  const int n = static_cast<int>(torus.points.cols());
+  Eigen::Matrix3Xd points(3, n + 4);
+  points << torus.points, Eigen::Matrix<double, 3, 4>((Eigen::Matrix<double, 3, 4>() << 5, 6, 5, 9,  //
+                                                       0, 0, 1, 9,                                    //
+                                                       0, 0, 0, 9)
+                                                          .finished());
+  Eigen::Matrix3Xi tris(3, torus.triangles.cols() + 1);
+  tris << torus.triangles, Eigen::Vector3i(n, n + 1, n + 2);
+  auto ring = std::make_shared<MeshRingSearch<pcl::PointXYZ>>(std::make_shared<const MeshTopology>(n + 4, tris));
+  PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+  estimator.setInputCloud(toCloud(points));
+  estimator.setSearchMethod(ring);
+  estimator.setKSearch(16);
+  Normals normals;
+  estimator.compute(normals);
+  EXPECT_EQ(estimator.getFailedPoints(), 1) << "only the isolated vertex";
+  for (int v = n; v < n + 3; ++v) EXPECT_NEAR(std::abs(normals[v].normal_z), 1.0, 1e-6);
+  EXPECT_TRUE(std::isnan(normals[n + 3].normal_x));
+}
+
+TEST(PCANormals, EmptyInputFailsThroughPCLsContract) {
+  PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+  estimator.setInputCloud(std::make_shared<Cloud>());
+  estimator.setSearchMethod(kdTree());
+  estimator.setKSearch(8);
+  Normals normals;
+  normals.resize(3);
+  estimator.compute(normals);
+  EXPECT_TRUE(normals.empty());
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
