@@ -66,13 +66,16 @@ TEST(MeshRingSearch, NearestKIsWholeRingsThenTheNearestOfTheLastRing) {
       for (std::size_t i = 0; i < found.size(); ++i) {
         EXPECT_LE(hops[found[i]], last_ring);
         if (i > 0) EXPECT_GE(hops[found[i]], hops[found[i - 1]]) << "ring order";
-        EXPECT_NEAR(distances[i], (s.points.col(found[i]) - s.points.col(query)).squaredNorm(), 1e-5);
-        if (hops[found[i]] == last_ring) farthest_chosen_in_last_ring = std::max(farthest_chosen_in_last_ring, distances[i]);
+        EXPECT_NEAR(distances[i], (s.points.col(found[i]) - s.points.col(query)).squaredNorm(),
+                    1e-5);
+        if (hops[found[i]] == last_ring)
+          farthest_chosen_in_last_ring = std::max(farthest_chosen_in_last_ring, distances[i]);
       }
       for (int v = 0; v < n; ++v) {
         if (hops[v] < last_ring) EXPECT_TRUE(chosen.count(v)) << "inner rings are complete";
         if (hops[v] == last_ring && !chosen.count(v)) {
-          EXPECT_GE((s.points.col(v) - s.points.col(query)).squaredNorm(), farthest_chosen_in_last_ring - 1e-6);
+          EXPECT_GE((s.points.col(v) - s.points.col(query)).squaredNorm(),
+                    farthest_chosen_in_last_ring - 1e-6);
         }
       }
     }
@@ -113,7 +116,8 @@ TEST(MeshRingSearch, RadiusSearchIsATopologicalBall) {
   const int centre = n / 2;
   ring.radiusSearch(centre, 0.3, on_mesh, d_mesh);
   tree.radiusSearch(centre, 0.3, in_space, d_space);
-  const long other_plate = std::count_if(in_space.begin(), in_space.end(), [&](int v) { return v >= n; });
+  const long other_plate =
+      std::count_if(in_space.begin(), in_space.end(), [&](int v) { return v >= n; });
   EXPECT_GT(other_plate, 10);
   for (const int v : on_mesh) EXPECT_LT(v, n);
   // On its own plate (convex, so every point of the ball is reachable) it finds the same set.
@@ -153,7 +157,8 @@ TEST(MeshRingSearch, PCLNormalEstimationRunsOnItUnchanged) {
   parallel.setKSearch(7);
   pcl::PointCloud<pcl::Normal> parallel_normals;
   parallel.compute(parallel_normals);
-  const AngleErrors difference = angleErrors(normalsOf(parallel_normals), normalsOf(normals), SignMode::Unsigned);
+  const AngleErrors difference =
+      angleErrors(normalsOf(parallel_normals), normalsOf(normals), SignMode::Unsigned);
   EXPECT_LT(difference.max, 1e-3);
 }
 

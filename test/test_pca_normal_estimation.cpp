@@ -42,7 +42,9 @@ Normals pclNormals(const Cloud::Ptr& cloud, int k) {
   return normals;
 }
 
-pcl::search::Search<pcl::PointXYZ>::Ptr kdTree() { return std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>(); }
+pcl::search::Search<pcl::PointXYZ>::Ptr kdTree() {
+  return std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+}
 
 // The surface scaled by factor (lengths times factor, curvatures divided by it).
 SurfaceSample scaled(SurfaceSample s, double factor) {
@@ -63,9 +65,10 @@ TEST(PCANormals, ConvergeAtFirstOrderOnAJitteredTorusCloud) {
   int level = 0;
   for (const int resolution : {64, 128, 256, 512}) {
     const SurfaceSample torus = makeTorus({resolution, 0.1, 11}).asCloud();
-    const AngleErrors e = angleErrors(normalsOf(ourNormals(toCloud(torus.points), kdTree(), 20)), torus.normals,
-                                      SignMode::Unsigned);
-    std::printf("PCA torus %6ld points: mean %.4f max %.4f deg\n", torus.points.cols(), e.mean, e.max);
+    const AngleErrors e = angleErrors(normalsOf(ourNormals(toCloud(torus.points), kdTree(), 20)),
+                                      torus.normals, SignMode::Unsigned);
+    std::printf("PCA torus %6ld points: mean %.4f max %.4f deg\n", torus.points.cols(), e.mean,
+                e.max);
     EXPECT_EQ(e.invalid, 0);
     EXPECT_LE(e.mean, 1.1 * reference[level]);
     if (previous > 0.0) EXPECT_GT(observedOrder(previous, e.mean, 2.0, 1.0), 0.9);
@@ -80,12 +83,27 @@ TEST(PCANormals, FirstOrderOnEveryAnalyticSurfaceAndExactOnThePlane) {
     SurfaceSample (*make)(int);
   };
   const Case cases[] = {
-      {"plane", [](int r) { return makePlane({r, 0.25, 3}); }},
+      {"plane",
+       [](int r) {
+         return makePlane({r, 0.25, 3});
+       }},
       {"sphere", [](int r) { return makeIcosphere(r == 32 ? 4 : 5, 1.0, 0.25, 3); }},
-      {"cylinder", [](int r) { return makeCylinder({2 * r, 0.25, 3}); }},
-      {"torus", [](int r) { return makeTorus({2 * r, 0.25, 3}); }},
-      {"saddle", [](int r) { return makeSaddle({r, 0.25, 3}); }},
-      {"paraboloid", [](int r) { return makeParaboloid({r, 0.25, 3}); }},
+      {"cylinder",
+       [](int r) {
+         return makeCylinder({2 * r, 0.25, 3});
+       }},
+      {"torus",
+       [](int r) {
+         return makeTorus({2 * r, 0.25, 3});
+       }},
+      {"saddle",
+       [](int r) {
+         return makeSaddle({r, 0.25, 3});
+       }},
+      {"paraboloid",
+       [](int r) {
+         return makeParaboloid({r, 0.25, 3});
+       }},
   };
   for (const Case& c : cases) {
     double error[2];
@@ -93,8 +111,8 @@ TEST(PCANormals, FirstOrderOnEveryAnalyticSurfaceAndExactOnThePlane) {
       // Scaled by 100 about the origin before the shift, so float coordinates resolve the sampling.
       SurfaceSample big = scaled(c.make(i == 0 ? 32 : 64), 100.0);
       big.rotateAndShiftFar();
-      const AngleErrors e = angleErrors(normalsOf(ourNormals(toCloud(big.points), kdTree(), 16)), big.normals,
-                                        SignMode::Unsigned);
+      const AngleErrors e = angleErrors(normalsOf(ourNormals(toCloud(big.points), kdTree(), 16)),
+                                        big.normals, SignMode::Unsigned);
       std::printf("PCA %-10s %6ld points (x100, shifted 1e5): mean %.5f max %.5f deg\n", c.name,
                   big.points.cols(), e.mean, e.max);
       EXPECT_EQ(e.invalid, 0);
@@ -104,9 +122,10 @@ TEST(PCANormals, FirstOrderOnEveryAnalyticSurfaceAndExactOnThePlane) {
       // Exact but for the input: 1e5 from the origin floats are 0.0078 apart (measured 0.007 deg).
       EXPECT_LT(error[1], 0.05);
       SurfaceSample near = c.make(64);
-      near.transform(Eigen::Isometry3d(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())));
-      const AngleErrors e = angleErrors(normalsOf(ourNormals(toCloud(near.points), kdTree(), 16)), near.normals,
-                                        SignMode::Unsigned);
+      near.transform(
+          Eigen::Isometry3d(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())));
+      const AngleErrors e = angleErrors(normalsOf(ourNormals(toCloud(near.points), kdTree(), 16)),
+                                        near.normals, SignMode::Unsigned);
       EXPECT_LT(e.max, 1e-4) << "a plane near the origin is fitted to float rounding";
     } else {
       EXPECT_GT(observedOrder(error[0], error[1], 2.0, 1.0), 0.8) << c.name;
@@ -119,17 +138,19 @@ TEST(PCANormals, FarFromTheOriginOursKeepsItsAccuracyAndIsAtLeastAsAccurateAsPCL
   SurfaceSample near = scaled(makeTorus({128, 0.25, 5}), 100.0).asCloud();
   SurfaceSample far = near;
   far.rotateAndShiftFar();
-  const AngleErrors ours_near = angleErrors(normalsOf(ourNormals(toCloud(near.points), kdTree(), 16)), near.normals,
-                                            SignMode::Unsigned);
-  const AngleErrors ours_far = angleErrors(normalsOf(ourNormals(toCloud(far.points), kdTree(), 16)), far.normals,
-                                           SignMode::Unsigned);
-  const AngleErrors pcl_far = angleErrors(normalsOf(pclNormals(toCloud(far.points), 16)), far.normals,
-                                          SignMode::Unsigned);
+  const AngleErrors ours_near = angleErrors(
+      normalsOf(ourNormals(toCloud(near.points), kdTree(), 16)), near.normals, SignMode::Unsigned);
+  const AngleErrors ours_far = angleErrors(normalsOf(ourNormals(toCloud(far.points), kdTree(), 16)),
+                                           far.normals, SignMode::Unsigned);
+  const AngleErrors pcl_far =
+      angleErrors(normalsOf(pclNormals(toCloud(far.points), 16)), far.normals, SignMode::Unsigned);
   // Measured: 1.0141 / 1.0122 / 1.0122 deg. (PCL 1.13 shifts its float covariance by a point of
   // the neighbourhood, so it holds up here too; ACCURACY.md's "degrees" are older PCL's.)
-  std::printf("torus x100: ours near %.4f deg, ours 1e5 away %.4f deg, pcl::NormalEstimation 1e5 away %.4f deg "
-              "(mean; max %.2f)\n",
-              ours_near.mean, ours_far.mean, pcl_far.mean, pcl_far.max);
+  std::printf(
+      "torus x100: ours near %.4f deg, ours 1e5 away %.4f deg, pcl::NormalEstimation 1e5 away %.4f "
+      "deg "
+      "(mean; max %.2f)\n",
+      ours_near.mean, ours_far.mean, pcl_far.mean, pcl_far.max);
   EXPECT_LT(std::abs(ours_far.mean - ours_near.mean), 0.05 * ours_near.mean);
   EXPECT_LE(ours_far.mean, pcl_far.mean * (1.0 + 1e-3));
 }
@@ -164,9 +185,10 @@ TEST(PCANormals, OnUTMTerrainOursIsTheExactPlaneFitAndAtLeastAsAccurateAsPCL) {
   const Eigen::Matrix3Xd theirs = normalsOf(pclNormals(cloud, 16));
   const AngleErrors ours_all = angleErrors(ours, truth, SignMode::Unsigned);
   const AngleErrors theirs_all = angleErrors(theirs, truth, SignMode::Unsigned);
-  std::printf("UTM terrain (%zu points, UTM coordinates) against the exact double plane fit: ours mean "
-              "%.2e max %.2e deg; pcl::NormalEstimation mean %.2e max %.2e deg\n",
-              cloud->size(), ours_all.mean, ours_all.max, theirs_all.mean, theirs_all.max);
+  std::printf(
+      "UTM terrain (%zu points, UTM coordinates) against the exact double plane fit: ours mean "
+      "%.2e max %.2e deg; pcl::NormalEstimation mean %.2e max %.2e deg\n",
+      cloud->size(), ours_all.mean, ours_all.max, theirs_all.mean, theirs_all.max);
   EXPECT_EQ(ours_all.invalid, 0);
   EXPECT_LT(ours_all.mean, 1e-4);
   EXPECT_LE(ours_all.mean, theirs_all.mean);
@@ -178,11 +200,13 @@ TEST(PCANormals, MeshInputIsOrientedLikeTheFacesAndCloudsTowardsTheViewpoint) {
   auto ring = std::make_shared<MeshRingSearch<pcl::PointXYZ>>(topologyPtrOf(torus));
   const Eigen::Matrix3Xd normals_on_mesh = normalsOf(ourNormals(cloud, ring, 16));
   int inward = 0;
-  for (Eigen::Index i = 0; i < normals_on_mesh.cols(); ++i) inward += normals_on_mesh.col(i).dot(torus.normals.col(i)) < 0.0;
+  for (Eigen::Index i = 0; i < normals_on_mesh.cols(); ++i)
+    inward += normals_on_mesh.col(i).dot(torus.normals.col(i)) < 0.0;
   EXPECT_EQ(inward, 0) << "outward everywhere, like the faces";
 
   // A sphere seen from its centre: every normal faces inward.
-  const SurfaceSample sphere = makeIcosphere(3, 2.0, 0.2, 1).transform(Eigen::Isometry3d(Eigen::Translation3d(5, 6, 7)));
+  const SurfaceSample sphere =
+      makeIcosphere(3, 2.0, 0.2, 1).transform(Eigen::Isometry3d(Eigen::Translation3d(5, 6, 7)));
   PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
   estimator.setInputCloud(toCloud(sphere.points));
   estimator.setSearchMethod(kdTree());
@@ -223,13 +247,15 @@ TEST(PCANormals, KLargerThanAComponentUsesWhatThereIsAndFailsBelowThreePoints) {
   const SurfaceSample torus = makeTorus({16, 0.0, 1});
   const int n = static_cast<int>(torus.points.cols());
   Eigen::Matrix3Xd points(3, n + 4);
-  points << torus.points, Eigen::Matrix<double, 3, 4>((Eigen::Matrix<double, 3, 4>() << 5, 6, 5, 9,  //
-                                                       0, 0, 1, 9,                                    //
-                                                       0, 0, 0, 9)
-                                                          .finished());
+  points << torus.points,
+      Eigen::Matrix<double, 3, 4>((Eigen::Matrix<double, 3, 4>() << 5, 6, 5, 9,  //
+                                   0, 0, 1, 9,                                   //
+                                   0, 0, 0, 9)
+                                      .finished());
   Eigen::Matrix3Xi tris(3, torus.triangles.cols() + 1);
   tris << torus.triangles, Eigen::Vector3i(n, n + 1, n + 2);
-  auto ring = std::make_shared<MeshRingSearch<pcl::PointXYZ>>(std::make_shared<const MeshTopology>(n + 4, tris));
+  auto ring = std::make_shared<MeshRingSearch<pcl::PointXYZ>>(
+      std::make_shared<const MeshTopology>(n + 4, tris));
   PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
   estimator.setInputCloud(toCloud(points));
   estimator.setSearchMethod(ring);

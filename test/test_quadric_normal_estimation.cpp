@@ -27,7 +27,8 @@ struct QuadricResult {
   std::int64_t fallback = 0, failed = 0;
 };
 
-QuadricResult estimate(const Eigen::Matrix3Xd& points, pcl::search::Search<pcl::PointXYZ>::Ptr search, int k) {
+QuadricResult estimate(const Eigen::Matrix3Xd& points,
+                       pcl::search::Search<pcl::PointXYZ>::Ptr search, int k) {
   Estimator estimator;
   estimator.setInputCloud(toCloud(points));
   estimator.setSearchMethod(search);
@@ -39,7 +40,9 @@ QuadricResult estimate(const Eigen::Matrix3Xd& points, pcl::search::Search<pcl::
   return r;
 }
 
-pcl::search::Search<pcl::PointXYZ>::Ptr kdTree() { return std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>(); }
+pcl::search::Search<pcl::PointXYZ>::Ptr kdTree() {
+  return std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+}
 
 SurfaceSample scaled(SurfaceSample s, double factor) {
   s.points *= factor;
@@ -72,10 +75,12 @@ CurvatureErrors curvatureErrors(const QuadricResult& r, const SurfaceSample& s) 
     e.kappa2_rms += std::pow(k2 - s.kappa2[i], 2);
     e.mean_rms += std::pow(0.5 * (k1 + k2) - s.mean_curvature[i], 2);
     e.gauss_rms += std::pow(k1 * k2 - s.gauss_curvature[i], 2);
-    const Eigen::Vector3d d(c.principal_curvature_x, c.principal_curvature_y, c.principal_curvature_z);
+    const Eigen::Vector3d d(c.principal_curvature_x, c.principal_curvature_y,
+                            c.principal_curvature_z);
     // After negation kappa1 belongs to the other direction: compare with the matching one.
     const Eigen::Vector3d exact = (k1 == c.pc1) ? s.dir1.col(i) : s.dir2.col(i);
-    e.direction_mean_degrees += std::acos(std::min(1.0, std::abs(d.normalized().dot(exact)))) * 180.0 / M_PI;
+    e.direction_mean_degrees +=
+        std::acos(std::min(1.0, std::abs(d.normalized().dot(exact)))) * 180.0 / M_PI;
     ++n;
   }
   e.kappa1_rms = std::sqrt(e.kappa1_rms / n);
@@ -88,7 +93,8 @@ CurvatureErrors curvatureErrors(const QuadricResult& r, const SurfaceSample& s) 
 
 TEST(QuadricNormals, ConvergeAtSecondOrderOnAJitteredTorusCloud) {
   // ACCURACY.md (torus R = 1, r = 0.4, jittered samples, k = 20): quadric normal mean error 0.42,
-  // 0.098, 0.024, 0.006 degrees; H RMS 8.1e-2, 2.3e-2, 8.0e-3, 3.6e-3; K RMS 0.16, 0.056, 0.024, 0.012.
+  // 0.098, 0.024, 0.006 degrees; H RMS 8.1e-2, 2.3e-2, 8.0e-3, 3.6e-3; K RMS 0.16, 0.056, 0.024,
+  // 0.012.
   const double normal_reference[] = {0.42, 0.098, 0.024, 0.006};
   const double mean_reference[] = {8.1e-2, 2.3e-2, 8.0e-3, 3.6e-3};
   const double gauss_reference[] = {0.16, 0.056, 0.024, 0.012};
@@ -99,10 +105,12 @@ TEST(QuadricNormals, ConvergeAtSecondOrderOnAJitteredTorusCloud) {
     const QuadricResult r = estimate(torus.points, kdTree(), 20);
     const AngleErrors e = angleErrors(normalsOf(r.normals), torus.normals, SignMode::Unsigned);
     const CurvatureErrors c = curvatureErrors(r, torus);
-    std::printf("quadric torus %6ld points: normal mean %.4f max %.4f deg; H RMS %.2e, K RMS %.2e, k1 RMS %.2e, "
-                "k2 RMS %.2e, direction %.3f deg\n",
-                torus.points.cols(), e.mean, e.max, c.mean_rms, c.gauss_rms, c.kappa1_rms, c.kappa2_rms,
-                c.direction_mean_degrees);
+    std::printf(
+        "quadric torus %6ld points: normal mean %.4f max %.4f deg; H RMS %.2e, K RMS %.2e, k1 RMS "
+        "%.2e, "
+        "k2 RMS %.2e, direction %.3f deg\n",
+        torus.points.cols(), e.mean, e.max, c.mean_rms, c.gauss_rms, c.kappa1_rms, c.kappa2_rms,
+        c.direction_mean_degrees);
     EXPECT_EQ(e.invalid, 0);
     EXPECT_EQ(r.fallback, 0);
     EXPECT_LE(e.mean, 1.1 * normal_reference[level]);
@@ -120,12 +128,27 @@ TEST(QuadricNormals, SecondOrderOnEveryAnalyticSurfaceAndAsAccurateFarFromTheOri
     SurfaceSample (*make)(int);
   };
   const Case cases[] = {
-      {"plane", [](int r) { return makePlane({r, 0.1, 3}); }},
+      {"plane",
+       [](int r) {
+         return makePlane({r, 0.1, 3});
+       }},
       {"sphere", [](int r) { return makeIcosphere(r == 32 ? 4 : 5, 1.0, 0.1, 3); }},
-      {"cylinder", [](int r) { return makeCylinder({2 * r, 0.1, 3}); }},
-      {"torus", [](int r) { return makeTorus({2 * r, 0.1, 3}); }},
-      {"saddle", [](int r) { return makeSaddle({r, 0.1, 3}); }},
-      {"paraboloid", [](int r) { return makeParaboloid({r, 0.1, 3}); }},
+      {"cylinder",
+       [](int r) {
+         return makeCylinder({2 * r, 0.1, 3});
+       }},
+      {"torus",
+       [](int r) {
+         return makeTorus({2 * r, 0.1, 3});
+       }},
+      {"saddle",
+       [](int r) {
+         return makeSaddle({r, 0.1, 3});
+       }},
+      {"paraboloid",
+       [](int r) {
+         return makeParaboloid({r, 0.1, 3});
+       }},
   };
   const Eigen::Isometry3d rotation(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
   for (const Case& c : cases) {
@@ -136,8 +159,8 @@ TEST(QuadricNormals, SecondOrderOnEveryAnalyticSurfaceAndAsAccurateFarFromTheOri
       s.transform(rotation);
       const QuadricResult r = estimate(s.points, kdTree(), 20);
       const AngleErrors e = angleErrors(normalsOf(r.normals), s.normals, SignMode::Unsigned);
-      std::printf("quadric %-10s %6ld points: normal mean %.2e max %.2e deg, fallbacks %ld\n", c.name,
-                  s.points.cols(), e.mean, e.max, static_cast<long>(r.fallback));
+      std::printf("quadric %-10s %6ld points: normal mean %.2e max %.2e deg, fallbacks %ld\n",
+                  c.name, s.points.cols(), e.mean, e.max, static_cast<long>(r.fallback));
       EXPECT_EQ(e.invalid, 0);
       error[i] = e.mean;
     }
@@ -150,10 +173,10 @@ TEST(QuadricNormals, SecondOrderOnEveryAnalyticSurfaceAndAsAccurateFarFromTheOri
     // accuracy but for the input's float rounding there (0.0078 apart; measured <= 0.011 deg).
     SurfaceSample far = scaled(c.make(64), 100.0);
     far.rotateAndShiftFar();
-    const AngleErrors e = angleErrors(normalsOf(estimate(far.points, kdTree(), 20).normals), far.normals,
-                                      SignMode::Unsigned);
-    std::printf("quadric %-10s %6ld points x100, shifted 1e5: normal mean %.2e deg\n", c.name, far.points.cols(),
-                e.mean);
+    const AngleErrors e = angleErrors(normalsOf(estimate(far.points, kdTree(), 20).normals),
+                                      far.normals, SignMode::Unsigned);
+    std::printf("quadric %-10s %6ld points x100, shifted 1e5: normal mean %.2e deg\n", c.name,
+                far.points.cols(), e.mean);
     EXPECT_LT(e.mean, error[1] + 0.02) << c.name;
   }
 }
@@ -167,9 +190,21 @@ TEST(QuadricNormals, PrincipalCurvaturesAndDirectionsOnMeshesConverge) {
   };
   const Case cases[] = {
       {"sphere", [](int r) { return makeIcosphere(r == 32 ? 4 : 5, 1.0, 0.0, 1); }, true},
-      {"cylinder", [](int r) { return makeCylinder({2 * r, 0.1, 1}); }, false},
-      {"torus", [](int r) { return makeTorus({2 * r, 0.1, 1}); }, false},
-      {"saddle", [](int r) { return makeSaddle({r, 0.1, 1}); }, false},
+      {"cylinder",
+       [](int r) {
+         return makeCylinder({2 * r, 0.1, 1});
+       },
+       false},
+      {"torus",
+       [](int r) {
+         return makeTorus({2 * r, 0.1, 1});
+       },
+       false},
+      {"saddle",
+       [](int r) {
+         return makeSaddle({r, 0.1, 1});
+       },
+       false},
   };
   for (const Case& c : cases) {
     double kappa_error[2], direction_error[2];
@@ -188,9 +223,11 @@ TEST(QuadricNormals, PrincipalCurvaturesAndDirectionsOnMeshesConverge) {
       }
       EXPECT_EQ(flipped, 0) << c.name << ": oriented like the faces";
       const CurvatureErrors e = curvatureErrors(r, s);
-      std::printf("quadric %-8s %6ld vertices: k1 RMS %.2e, k2 RMS %.2e, H RMS %.2e, K RMS %.2e, direction %.3f deg\n",
-                  c.name, s.points.cols(), e.kappa1_rms, e.kappa2_rms, e.mean_rms, e.gauss_rms,
-                  e.direction_mean_degrees);
+      std::printf(
+          "quadric %-8s %6ld vertices: k1 RMS %.2e, k2 RMS %.2e, H RMS %.2e, K RMS %.2e, direction "
+          "%.3f deg\n",
+          c.name, s.points.cols(), e.kappa1_rms, e.kappa2_rms, e.mean_rms, e.gauss_rms,
+          e.direction_mean_degrees);
       kappa_error[i] = std::max(e.kappa1_rms, e.kappa2_rms);
       direction_error[i] = e.direction_mean_degrees;
     }

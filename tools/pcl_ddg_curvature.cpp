@@ -1,5 +1,7 @@
-// pcl_ddg_curvature: discrete mean, Gaussian and principal curvatures of a mesh, as vertex
-// properties (and optionally as colours).
+// pcl_ddg_curvature: curvatures of a mesh (discrete: cotangent Laplacian and angle defect) or of a
+// mesh or point cloud (fitted: a quadric through each point's neighbours), as vertex properties
+// and optionally as colours.
+#include "common/local_fit_job.h"
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
 #include "pcl_ddg/io/color_map.h"
@@ -10,22 +12,27 @@ namespace {
 
 constexpr const char* kName = "pcl_ddg_curvature";
 constexpr const char* kDescription =
-    "Computes discrete curvatures (cotangent Laplacian, angle defect) and writes mean_curvature,\n"
-    "gauss_curvature, k1, k2 and vertex_area as vertex properties.";
+    "Computes curvatures and writes mean_curvature (signed, > 0 where convex), gauss_curvature, k1 "
+    ">= k2\n"
+    "as vertex properties: -method cotan (mesh; cotangent Laplacian and angle defect, also "
+    "vertex_area)\n"
+    "or quadric (mesh or cloud; quadric fitted to each point's neighbours, also the k1 direction\n"
+    "k1_direction_x/y/z and the normal).";
 constexpr const char* kSyntax =
-    "input.{ply,obj,off,stl,vtk} output.{ply,pcd} [-area mixed|voronoi|barycentric]\n"
+    "input.{ply,obj,off,stl,vtk,pcd} output.{ply,pcd} [-method cotan|quadric (default: cotan on "
+    "meshes)]\n"
+    "         [-area mixed|voronoi|barycentric (cotan)]\n"
+    "         [-neighbours bfs|knn] [-k N (default 20)] [-radius r or 2.5h] (quadric)\n"
     "         [-color mean|gauss|k1|k2] [-percentile p (colour scale clamp, default 2)]\n"
     "         [-precision float|double]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
-  const tools::ToolArguments args(argc, argv, {"area", "color", "percentile", "precision"}, {});
+  const tools::ToolArguments args(
+      argc, argv,
+      {"method", "area", "neighbours", "k", "radius", "color", "percentile", "precision"}, {});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
-  const std::string area = args.choice("area", {"mixed", "voronoi", "barycentric"}, "mixed");
-  const MassType mass = area == "voronoi"       ? MassType::Voronoi
-                        : area == "barycentric" ? MassType::Barycentric
-                                                : MassType::MixedVoronoi;
   const std::string color = args.choice("color", {"none", "mean", "gauss", "k1", "k2"}, "none");
   const double percentile = args.number("percentile", 2.0);
   if (percentile < 0.0 || percentile >= 50.0)
@@ -35,29 +42,72 @@ int run(int argc, char** argv) {
   if (fileExtension(output) != "ply" && fileExtension(output) != "pcd") {
     throw tools::UsageError("the output must be .ply or .pcd");
   }
+  const std::string requested =
+      args.has("method") ? args.choice("method", {"cotan", "quadric"}, "cotan") : "";
+  if (requested == "quadric" && args.has("area"))
+    throw tools::UsageError("-area applies to -method cotan");
+  if (requested == "cotan" && (args.has("neighbours") || args.has("k") || args.has("radius"))) {
+    throw tools::UsageError("-neighbours, -k and -radius apply to -method quadric");
+  }
+  const std::string area = args.choice("area", {"mixed", "voronoi", "barycentric"}, "mixed");
 
-  tools::SurfaceMesh in = tools::loadSurfaceMesh(args.positional()[0], kName);
-  tools::Timer timer("Computing curvatures");
-  const VertexCurvatures c = computeCurvatures(in.topology, in.positions, mass);
-  timer.done(static_cast<std::size_t>(in.positions.cols()));
-  if (c.invalid_vertices > 0) {
-    tools::warn(kName, std::to_string(c.invalid_vertices) + " vertices without area (NaN)");
+  tools::SurfaceInput in = tools::loadSurfaceInput(args.positional()[0], kName);
+  const std::string method = !requested.empty() ? requested : (in.topology ? "cotan" : "quadric");
+  Eigen::VectorXd mean, gauss, kappa1, kappa2;
+  if (method == "cotan") {
+    if (!in.topology)
+      throw tools::UsageError("-method cotan needs a mesh; this input is a point cloud");
+    const MassType mass = area == "voronoi"       ? MassType::Voronoi
+                          : area == "barycentric" ? MassType::Barycentric
+                                                  : MassType::MixedVoronoi;
+    tools::Timer timer("Computing curvatures");
+    const VertexCurvatures c = computeCurvatures(*in.topology, in.positions, mass);
+    timer.done(static_cast<std::size_t>(in.positions.cols()));
+    if (c.invalid_vertices > 0)
+      tools::warn(kName, std::to_string(c.invalid_vertices) + " vertices without area (NaN)");
+    if (c.clamped_vertices > 0) {
+      tools::warn(kName, std::to_string(c.clamped_vertices) +
+                             " vertices with H^2 < K (umbilic or noisy): k1 = k2 = H there");
+    }
+    mean = c.mean;
+    gauss = c.gauss;
+    kappa1 = c.kappa1;
+    kappa2 = c.kappa2;
+    setVertexField(in.mesh.cloud, "vertex_area", c.vertex_area, precision);
+  } else {
+    const LocalFitOptions options = tools::localFitArguments(args, in, LocalFitMethod::Quadric);
+    tools::Timer timer("Fitting quadrics");
+    const LocalFitResult result = [&] {
+      const tools::QuietPCLWarnings quiet;
+      return fitLocalSurfaces(in.points, in.topology, options);
+    }();
+    timer.done(in.points->size());
+    tools::warnAboutLocalFit(kName, result);
+    const auto n = static_cast<Eigen::Index>(result.curvatures.size());
+    kappa1.resize(n);
+    kappa2.resize(n);
+    Eigen::Matrix3Xd direction(3, n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const pcl::PrincipalCurvatures& c = result.curvatures[i];
+      kappa1[i] = c.pc1;
+      kappa2[i] = c.pc2;
+      direction.col(i) << c.principal_curvature_x, c.principal_curvature_y, c.principal_curvature_z;
+    }
+    mean = 0.5 * (kappa1 + kappa2);
+    gauss = kappa1.cwiseProduct(kappa2);
+    const char* names[] = {"k1_direction_x", "k1_direction_y", "k1_direction_z"};
+    for (int d = 0; d < 3; ++d)
+      setVertexField(in.mesh.cloud, names[d], direction.row(d).transpose(), precision);
+    tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
   }
-  if (c.clamped_vertices > 0) {
-    tools::warn(kName, std::to_string(c.clamped_vertices) +
-                           " vertices with H^2 < K (umbilic or noisy): k1 = k2 = H there");
-  }
-  const std::pair<const char*, const Eigen::VectorXd*> fields[] = {{"mean_curvature", &c.mean},
-                                                                   {"gauss_curvature", &c.gauss},
-                                                                   {"k1", &c.kappa1},
-                                                                   {"k2", &c.kappa2},
-                                                                   {"vertex_area", &c.vertex_area}};
+  const std::pair<const char*, const Eigen::VectorXd*> fields[] = {
+      {"mean_curvature", &mean}, {"gauss_curvature", &gauss}, {"k1", &kappa1}, {"k2", &kappa2}};
   for (const auto& [name, values] : fields) setVertexField(in.mesh.cloud, name, *values, precision);
   if (color != "none") {
-    const Eigen::VectorXd& values = color == "mean"    ? c.mean
-                                    : color == "gauss" ? c.gauss
-                                    : color == "k1"    ? c.kappa1
-                                                       : c.kappa2;
+    const Eigen::VectorXd& values = color == "mean"    ? mean
+                                    : color == "gauss" ? gauss
+                                    : color == "k1"    ? kappa1
+                                                       : kappa2;
     setVertexColors(in.mesh.cloud,
                     colorize(values, ColorMap::Diverging, {percentile, 100.0 - percentile}));
   }

@@ -1,4 +1,6 @@
-// pcl_ddg_normals: per-vertex normals of a mesh, written as nx ny nz vertex properties.
+// pcl_ddg_normals: per-vertex normals of a mesh (face-weighted or mean-curvature), or of a mesh or
+// point cloud by a plane (pca) or quadric fit to each point's neighbours.
+#include "common/local_fit_job.h"
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
 #include "pcl_ddg/io/mesh_io.h"
@@ -8,52 +10,97 @@ namespace {
 
 constexpr const char* kName = "pcl_ddg_normals";
 constexpr const char* kDescription =
-    "Estimates per-vertex normals of a mesh and writes them as nx, ny, nz vertex properties.";
+    "Estimates normals of a mesh or a point cloud: from the mesh faces (uniform, area, angle,\n"
+    "mean_curvature) or by fitting a plane (pca) or a quadric to each point's neighbours, found "
+    "on\n"
+    "the mesh (bfs rings) or in space (knn, kd-tree). Writes nx ny nz (.ply) or normal_x normal_y\n"
+    "normal_z curvature (.pcd).";
 constexpr const char* kSyntax =
-    "input.{ply,obj,off,stl,vtk} output.{ply,pcd} [-method uniform|area|angle|mean_curvature]\n"
+    "input.{ply,obj,off,stl,vtk,pcd} output.{ply,pcd}\n"
+    "         [-method uniform|area|angle|mean_curvature|pca|quadric (default: area on meshes, pca "
+    "on clouds)]\n"
     "         [-epsilon e (mean_curvature: |M^-1 L x| below e counts as flat; default 0.02/h)]\n"
+    "         [-neighbours bfs|knn (pca, quadric; bfs needs a mesh)] [-k N (default 16, quadric "
+    "20)]\n"
+    "         [-radius r (a length, or a multiple of the mean spacing like 2.5h; instead of -k)]\n"
     "         [-precision float|double]";
+
+pcl_ddg::NormalWeighting weightingOf(const std::string& method) {
+  using pcl_ddg::NormalWeighting;
+  return method == "uniform"          ? NormalWeighting::Uniform
+         : method == "angle"          ? NormalWeighting::Angle
+         : method == "mean_curvature" ? NormalWeighting::MeanCurvature
+                                      : NormalWeighting::Area;
+}
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
-  const tools::ToolArguments args(argc, argv, {"method", "epsilon", "precision"}, {});
+  const tools::ToolArguments args(
+      argc, argv, {"method", "epsilon", "neighbours", "k", "radius", "precision"}, {});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
-  const std::string method =
-      args.choice("method", {"uniform", "area", "angle", "mean_curvature"}, "area");
-  MeshNormalOptions options;
-  options.weighting = method == "uniform"          ? NormalWeighting::Uniform
-                      : method == "angle"          ? NormalWeighting::Angle
-                      : method == "mean_curvature" ? NormalWeighting::MeanCurvature
-                                                   : NormalWeighting::Area;
-  if (args.has("epsilon")) {
-    if (options.weighting != NormalWeighting::MeanCurvature) {
-      throw tools::UsageError("-epsilon applies to -method mean_curvature only");
-    }
-    options.epsilon = args.number("epsilon", -1.0);
-    if (options.epsilon < 0.0) throw tools::UsageError("-epsilon must be >= 0");
-  }
   const FieldPrecision precision = tools::precisionArgument(args);
   const std::string output = args.positional()[1];
   if (fileExtension(output) != "ply" && fileExtension(output) != "pcd") {
     throw tools::UsageError("the output must be .ply or .pcd");
   }
+  const std::vector<std::string> methods = {"uniform",        "area", "angle",
+                                            "mean_curvature", "pca",  "quadric"};
+  const std::string requested = args.has("method") ? args.choice("method", methods, "area") : "";
+  const bool fitted = requested == "pca" || requested == "quadric";
+  const bool neighbour_options = args.has("neighbours") || args.has("k") || args.has("radius");
+  if (!requested.empty() && !fitted && neighbour_options) {
+    throw tools::UsageError("-neighbours, -k and -radius apply to pca and quadric");
+  }
+  if (args.has("epsilon") && requested != "mean_curvature") {
+    throw tools::UsageError("-epsilon applies to -method mean_curvature only");
+  }
 
-  tools::SurfaceMesh in = tools::loadSurfaceMesh(args.positional()[0], kName);
-  tools::Timer timer("Computing " + method + " normals");
-  const MeshNormals normals = computeMeshNormals(in.topology, in.positions, options);
-  timer.done(static_cast<std::size_t>(in.positions.cols()));
-  if (normals.invalid_vertices > 0) {
-    tools::warn(kName,
-                std::to_string(normals.invalid_vertices) + " vertices without a normal (NaN)");
-  }
-  if (options.weighting == NormalWeighting::MeanCurvature) {
-    tools::warn(kName, std::to_string(normals.fallback_vertices) +
-                           " flat or boundary vertices took the area-weighted normal");
-  }
-  const char* names[3] = {"nx", "ny", "nz"};
-  for (int d = 0; d < 3; ++d) {
-    setVertexField(in.mesh.cloud, names[d], normals.normals.row(d).transpose(), precision);
+  tools::SurfaceInput in = tools::loadSurfaceInput(args.positional()[0], kName);
+  const std::string method =
+      !requested.empty() ? requested : (in.topology && !neighbour_options ? "area" : "pca");
+  if (method != "pca" && method != "quadric") {
+    if (!in.topology)
+      throw tools::UsageError("-method " + method + " needs a mesh; this input is a point cloud");
+    MeshNormalOptions options;
+    options.weighting = weightingOf(method);
+    if (args.has("epsilon")) {
+      options.epsilon = args.number("epsilon", -1.0);
+      if (options.epsilon < 0.0) throw tools::UsageError("-epsilon must be >= 0");
+    }
+    const Eigen::Matrix3Xd& positions = in.positions;
+    tools::Timer timer("Computing " + method + " normals");
+    const MeshNormals normals = computeMeshNormals(*in.topology, positions, options);
+    timer.done(static_cast<std::size_t>(positions.cols()));
+    if (normals.invalid_vertices > 0) {
+      tools::warn(kName,
+                  std::to_string(normals.invalid_vertices) + " vertices without a normal (NaN)");
+    }
+    if (options.weighting == NormalWeighting::MeanCurvature) {
+      tools::warn(kName, std::to_string(normals.fallback_vertices) +
+                             " flat or boundary vertices took the area-weighted normal");
+    }
+    const bool pcd = fileExtension(output) == "pcd";
+    const char* names[2][3] = {{"nx", "ny", "nz"}, {"normal_x", "normal_y", "normal_z"}};
+    for (int d = 0; d < 3; ++d) {
+      setVertexField(in.mesh.cloud, names[pcd][d], normals.normals.row(d).transpose(), precision);
+    }
+  } else {
+    const LocalFitOptions options = tools::localFitArguments(
+        args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
+    tools::Timer timer(
+        "Computing " + method + " normals (" +
+        (options.neighbourhood == NeighbourhoodKind::MeshRings ? "mesh rings" : "kd-tree") + ", " +
+        (options.radius > 0.0 ? "radius " + std::to_string(options.radius)
+                              : "k = " + std::to_string(options.k)) +
+        ")");
+    const LocalFitResult result = [&] {
+      const tools::QuietPCLWarnings quiet;
+      return fitLocalSurfaces(in.points, in.topology, options);
+    }();
+    timer.done(in.points->size());
+    tools::warnAboutLocalFit(kName, result);
+    tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
   }
   tools::saveResult(output, in.mesh);
   return 0;

@@ -52,7 +52,8 @@ QuadricFit fitQuadric(const PlaneFit& plane, const Eigen::Matrix3Xd& points, int
   fit.kappa1 = -shape.eigenvalues()[0];
   fit.kappa2 = -shape.eigenvalues()[1];
   const Eigen::Vector2d a = shape.eigenvectors().col(0);
-  const Eigen::Vector3d du = plane.tangent1 + fu * plane.normal, dv = plane.tangent2 + fv * plane.normal;
+  const Eigen::Vector3d du = plane.tangent1 + fu * plane.normal,
+                        dv = plane.tangent2 + fv * plane.normal;
   fit.direction1 = (a.x() * du + a.y() * dv).normalized();
   fit.direction2 = fit.normal.cross(fit.direction1);
   fit.valid = fit.normal.allFinite() && fit.direction1.allFinite() && std::isfinite(fit.kappa1) &&

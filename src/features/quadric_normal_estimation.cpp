@@ -4,10 +4,10 @@
 
 #include "pcl_ddg/features/impl/quadric_normal_estimation.hpp"
 
-#define PCL_DDG_INSTANTIATE_FOR_OUTPUTS(T)                    \
-  PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, pcl::Normal)       \
-  PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, pcl::PointNormal)  \
-  PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, pcl::PointXYZRGBNormal)
+#define PCL_DDG_INSTANTIATE_FOR_OUTPUTS(T)                             \
+  PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, pcl::Normal)          \
+      PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, pcl::PointNormal) \
+          PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, pcl::PointXYZRGBNormal)
 
 PCL_DDG_INSTANTIATE_FOR_OUTPUTS(pcl::PointXYZ)
 PCL_DDG_INSTANTIATE_FOR_OUTPUTS(pcl::PointXYZRGB)

@@ -7,7 +7,8 @@ namespace detail {
 
 VisitStamps& VisitStamps::forThisThread(int num_vertices) {
   thread_local VisitStamps stamps;
-  if (stamps.stamps_.size() < static_cast<std::size_t>(num_vertices)) stamps.stamps_.resize(num_vertices, 0);
+  if (stamps.stamps_.size() < static_cast<std::size_t>(num_vertices))
+    stamps.stamps_.resize(num_vertices, 0);
   return stamps;
 }
 

@@ -19,16 +19,36 @@ pcl::PointCloud<pcl::PointXYZ>::Ptr toCloud(const Eigen::Matrix3Xd& points) {
 }
 
 std::shared_ptr<const MeshTopology> topologyPtrOf(const SurfaceSample& surface) {
-  return std::make_shared<const MeshTopology>(static_cast<int>(surface.points.cols()), surface.triangles);
+  return std::make_shared<const MeshTopology>(static_cast<int>(surface.points.cols()),
+                                              surface.triangles);
+}
+
+SurfaceSample makeTwoSheets(double gap) {
+  const SurfaceSample top = makePlane({24, 0.1, 1});
+  const SurfaceSample bottom = makePlane({24, 0.1, 2});
+  const Eigen::Index n = top.points.cols();
+  SurfaceSample s;
+  s.points.resize(3, 2 * n);
+  s.points << top.points, bottom.points.colwise() - Eigen::Vector3d(0, 0, gap);
+  s.normals.resize(3, 2 * n);
+  s.normals << top.normals, -bottom.normals;
+  // The bottom plate faces down: its triangles are wound the other way.
+  Eigen::Matrix3Xi flipped = bottom.triangles;
+  flipped.row(1).swap(flipped.row(2));
+  s.triangles.resize(3, 2 * top.triangles.cols());
+  s.triangles << top.triangles, flipped.array() + static_cast<int>(n);
+  return s;
 }
 
 Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals) {
   Eigen::Matrix3Xd n(3, normals.size());
-  for (std::size_t i = 0; i < normals.size(); ++i) n.col(i) = normals[i].getNormalVector3fMap().cast<double>();
+  for (std::size_t i = 0; i < normals.size(); ++i)
+    n.col(i) = normals[i].getNormalVector3fMap().cast<double>();
   return n;
 }
 
-AngleErrors angleErrors(const Eigen::Matrix3Xd& estimated, const Eigen::Matrix3Xd& truth, SignMode mode) {
+AngleErrors angleErrors(const Eigen::Matrix3Xd& estimated, const Eigen::Matrix3Xd& truth,
+                        SignMode mode) {
   AngleErrors e;
   int counted = 0;
   for (Eigen::Index i = 0; i < estimated.cols(); ++i) {

@@ -16,6 +16,10 @@ pcl::PointCloud<pcl::PointXYZ>::Ptr toCloud(const Eigen::Matrix3Xd& points);
 
 std::shared_ptr<const MeshTopology> topologyPtrOf(const SurfaceSample& surface);
 
+/** A thin two-sheet surface: two jittered 24 x 24 plates over [-1,1]^2 (h = 1/12), the top one
+ *  facing +z, the bottom one gap below it facing -z, as one mesh of two components. */
+SurfaceSample makeTwoSheets(double gap);
+
 /** Normals of a PCL cloud as a 3 x N double matrix (NaN kept). */
 Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals);
 
@@ -26,7 +30,8 @@ struct AngleErrors {
 
 /** Angles between estimates and truth; Unsigned compares lines (up to sign). */
 enum class SignMode { Signed, Unsigned };
-AngleErrors angleErrors(const Eigen::Matrix3Xd& estimated, const Eigen::Matrix3Xd& truth, SignMode mode);
+AngleErrors angleErrors(const Eigen::Matrix3Xd& estimated, const Eigen::Matrix3Xd& truth,
+                        SignMode mode);
 
 /** log(e_coarse / e_fine) / log(h_coarse / h_fine). */
 double observedOrder(double error_coarse, double error_fine, double h_coarse, double h_fine);

@@ -17,9 +17,13 @@ SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name) {
   Timer timer("Loading " + path);
   pcl::PolygonMesh mesh = loadMesh(path);
   if (mesh.polygons.empty()) throw std::runtime_error(path + " has no faces (a point cloud?)");
+  timer.done(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height);
+  return checkSurfaceMesh(std::move(mesh), tool_name);
+}
+
+SurfaceMesh checkSurfaceMesh(pcl::PolygonMesh mesh, const char* tool_name) {
   MeshTopology topology(mesh);
   Eigen::Matrix3Xd positions = vertexPositions(mesh.cloud);
-  timer.done(static_cast<std::size_t>(positions.cols()));
 
   const MeshReport report = makeMeshReport(topology, positions);
   const std::pair<std::int64_t, const char*> defects[] = {

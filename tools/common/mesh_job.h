@@ -23,6 +23,9 @@ struct SurfaceMesh {
  *  warning line per kind of defect (degenerate, duplicate, non-manifold, unreferenced). */
 SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name);
 
+/** The checks and warnings of loadSurfaceMesh, for a mesh already loaded. */
+SurfaceMesh checkSurfaceMesh(pcl::PolygonMesh mesh, const char* tool_name);
+
 /** -precision float|double. */
 FieldPrecision precisionArgument(const ToolArguments& args);
 

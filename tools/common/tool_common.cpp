@@ -1,6 +1,5 @@
 #include "common/tool_common.h"
 
-#include <pcl/console/print.h>
 #include <pcl/exceptions.h>
 
 #include <cmath>

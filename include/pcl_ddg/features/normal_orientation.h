@@ -16,6 +16,7 @@ enum class NormalOrientation { Viewpoint, MeshFaces };
 
 /** Area-weighted vertex normals (unnormalised) from the triangles whose corners are all finite;
  *  zero where a vertex has none. Accepts NaN positions. */
-Eigen::Matrix3Xd meshOrientationNormals(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+Eigen::Matrix3Xd meshOrientationNormals(const MeshTopology& topology,
+                                        const Eigen::Matrix3Xd& positions);
 
 }  // namespace pcl_ddg

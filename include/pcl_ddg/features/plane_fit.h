@@ -5,12 +5,12 @@
 namespace pcl_ddg {
 
 struct PlaneFit {
-  bool valid = false;          ///< at least 3 points, not all on one line
-  Eigen::Vector3d centroid;    ///< in the coordinates of the input points
-  Eigen::Vector3d normal;      ///< unit eigenvector of the smallest eigenvalue (sign arbitrary)
-  Eigen::Vector3d tangent1;    ///< largest eigenvalue's eigenvector
-  Eigen::Vector3d tangent2;    ///< normal x tangent1, so (tangent1, tangent2, normal) is right-handed
-  Eigen::Vector3d eigenvalues; ///< of the covariance, ascending
+  bool valid = false;        ///< at least 3 points, not all on one line
+  Eigen::Vector3d centroid;  ///< in the coordinates of the input points
+  Eigen::Vector3d normal;    ///< unit eigenvector of the smallest eigenvalue (sign arbitrary)
+  Eigen::Vector3d tangent1;  ///< largest eigenvalue's eigenvector
+  Eigen::Vector3d tangent2;  ///< normal x tangent1, so (tangent1, tangent2, normal) is right-handed
+  Eigen::Vector3d eigenvalues;  ///< of the covariance, ascending
   /** Surface variation lambda0 / (lambda0 + lambda1 + lambda2), PCL's "curvature" (0 on a plane,
    *  1/3 for isotropic noise; not a curvature in 1/length). */
   double surface_variation = 0.0;

@@ -11,13 +11,13 @@
 namespace pcl_ddg {
 
 struct QuadricFit {
-  bool valid = false;            ///< fewer than 6 points or an ill-conditioned system: false
-  Eigen::Vector3d normal;        ///< unit, on the side of plane.normal
+  bool valid = false;      ///< fewer than 6 points or an ill-conditioned system: false
+  Eigen::Vector3d normal;  ///< unit, on the side of plane.normal
   /** Principal curvatures (1/length), kappa1 >= kappa2, signed so that they are positive where the
    *  surface bends away from `normal` (a sphere with outward normals has +1/r). */
   double kappa1 = 0.0, kappa2 = 0.0;
-  Eigen::Vector3d direction1;    ///< unit principal direction of kappa1, tangent to the fit
-  Eigen::Vector3d direction2;    ///< normal x direction1
+  Eigen::Vector3d direction1;  ///< unit principal direction of kappa1, tangent to the fit
+  Eigen::Vector3d direction2;  ///< normal x direction1
 
   /** Turns the normal around: the curvatures change sign and swap (kappa1 >= kappa2 stays). */
   void flip();

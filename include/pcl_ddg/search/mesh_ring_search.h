@@ -62,8 +62,9 @@ class MeshRingSearch : public pcl::search::Search<PointT> {
 
   int radiusSearch(pcl::index_t index, double radius, pcl::Indices& k_indices,
                    std::vector<float>& k_sqr_distances, unsigned int max_nn = 0) const override;
-  int radiusSearch(const PointCloud& cloud, pcl::index_t index, double radius, pcl::Indices& k_indices,
-                   std::vector<float>& k_sqr_distances, unsigned int max_nn = 0) const override;
+  int radiusSearch(const PointCloud& cloud, pcl::index_t index, double radius,
+                   pcl::Indices& k_indices, std::vector<float>& k_sqr_distances,
+                   unsigned int max_nn = 0) const override;
   /** Not a vertex: fails (PCL_ERROR, 0 results). */
   int radiusSearch(const PointT& point, double radius, pcl::Indices& k_indices,
                    std::vector<float>& k_sqr_distances, unsigned int max_nn = 0) const override;

@@ -52,7 +52,8 @@ bool LocalFitEstimation<PointInT, PointOutT>::orient(Eigen::Vector3d& n, pcl::in
 
 template <typename PointInT, typename PointOutT>
 template <typename Fit>
-void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut& output, Fit&& fit) {
+void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut& output,
+                                                                   Fit&& fit) {
   const pcl::Indices& indices = *this->indices_;
   const auto& surface = *this->surface_;
   int threads = static_cast<int>(threads_);
@@ -71,10 +72,11 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(indices.size()); ++i) {
       const PointInT& query = (*this->input_)[indices[i]];
       FitOutcome outcome = FitOutcome::Failed;
-      if (pcl::isXYZFinite(query) &&
-          this->searchForNeighbors(indices[i], this->search_parameter_, neighbours, squared_distances) > 0) {
+      if (pcl::isXYZFinite(query) && this->searchForNeighbors(indices[i], this->search_parameter_,
+                                                              neighbours, squared_distances) > 0) {
         const Eigen::Vector3d origin = query.getVector3fMap().template cast<double>();
-        if (local.cols() < static_cast<Eigen::Index>(neighbours.size())) local.resize(3, neighbours.size());
+        if (local.cols() < static_cast<Eigen::Index>(neighbours.size()))
+          local.resize(3, neighbours.size());
         int count = 0;
         for (const pcl::index_t j : neighbours) {
           if (pcl::isXYZFinite(surface[j])) {
@@ -95,9 +97,10 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut
   fallback_points_ = fell_back;
   if (failed > 0) {
     output.is_dense = false;
-    PCL_WARN("[pcl_ddg::%s] %lld of %zu points could not be estimated (non-finite, or fewer than the "
-             "minimum of finite neighbours): their output is NaN\n",
-             this->getClassName().c_str(), static_cast<long long>(failed), indices.size());
+    PCL_WARN(
+        "[pcl_ddg::%s] %lld of %zu points could not be estimated (non-finite, or fewer than the "
+        "minimum of finite neighbours): their output is NaN\n",
+        this->getClassName().c_str(), static_cast<long long>(failed), indices.size());
   }
 }
 

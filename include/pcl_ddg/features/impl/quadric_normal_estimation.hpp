@@ -8,8 +8,8 @@
 namespace pcl_ddg {
 
 template <typename PointInT, typename PointOutT>
-void QuadricNormalEstimation<PointInT, PointOutT>::computeWithCurvatures(PointCloudOut& normals,
-                                                                         CurvatureCloud& curvatures) {
+void QuadricNormalEstimation<PointInT, PointOutT>::computeWithCurvatures(
+    PointCloudOut& normals, CurvatureCloud& curvatures) {
   curvatures_ = &curvatures;
   curvatures.clear();
   try {
@@ -29,44 +29,48 @@ void QuadricNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut&
   constexpr float nan = std::numeric_limits<float>::quiet_NaN();
   if (curvatures_) {
     pcl::PrincipalCurvatures missing;
-    missing.principal_curvature_x = missing.principal_curvature_y = missing.principal_curvature_z = nan;
+    missing.principal_curvature_x = missing.principal_curvature_y = missing.principal_curvature_z =
+        nan;
     missing.pc1 = missing.pc2 = nan;
     curvatures_->assign(output.size(), missing);
     curvatures_->width = output.width;
     curvatures_->height = output.height;
   }
-  this->fitEachNeighbourhood(output, [&](const Eigen::Matrix3Xd& neighbours, int count, pcl::index_t index,
-                                         const Eigen::Vector3d& position, std::size_t i) {
-    PointOutT& out = output[i];
-    const PlaneFit plane = fitPlane(neighbours, count);
-    if (!plane.valid) return Outcome::Failed;
-    // The query point is the origin of the neighbours' coordinates.
-    QuadricFit quadric = fitQuadric(plane, neighbours, count, Eigen::Vector3d::Zero());
-    Eigen::Vector3d normal = quadric.valid ? quadric.normal : plane.normal;
-    const bool flipped = this->orient(normal, index, position);
-    out.normal_x = static_cast<float>(normal.x());
-    out.normal_y = static_cast<float>(normal.y());
-    out.normal_z = static_cast<float>(normal.z());
-    out.curvature = static_cast<float>(plane.surface_variation);
-    if (!quadric.valid) return Outcome::FellBack;
-    if (curvatures_) {
-      if (flipped) quadric.flip();
-      pcl::PrincipalCurvatures& c = (*curvatures_)[i];
-      c.principal_curvature_x = static_cast<float>(quadric.direction1.x());
-      c.principal_curvature_y = static_cast<float>(quadric.direction1.y());
-      c.principal_curvature_z = static_cast<float>(quadric.direction1.z());
-      c.pc1 = static_cast<float>(quadric.kappa1);
-      c.pc2 = static_cast<float>(quadric.kappa2);
-    }
-    return Outcome::Fitted;
-  });
+  this->fitEachNeighbourhood(
+      output, [&](const Eigen::Matrix3Xd& neighbours, int count, pcl::index_t index,
+                  const Eigen::Vector3d& position, std::size_t i) {
+        PointOutT& out = output[i];
+        const PlaneFit plane = fitPlane(neighbours, count);
+        if (!plane.valid) return Outcome::Failed;
+        // The query point is the origin of the neighbours' coordinates.
+        QuadricFit quadric = fitQuadric(plane, neighbours, count, Eigen::Vector3d::Zero());
+        Eigen::Vector3d normal = quadric.valid ? quadric.normal : plane.normal;
+        const bool flipped = this->orient(normal, index, position);
+        out.normal_x = static_cast<float>(normal.x());
+        out.normal_y = static_cast<float>(normal.y());
+        out.normal_z = static_cast<float>(normal.z());
+        out.curvature = static_cast<float>(plane.surface_variation);
+        if (!quadric.valid) return Outcome::FellBack;
+        if (curvatures_) {
+          if (flipped) quadric.flip();
+          pcl::PrincipalCurvatures& c = (*curvatures_)[i];
+          c.principal_curvature_x = static_cast<float>(quadric.direction1.x());
+          c.principal_curvature_y = static_cast<float>(quadric.direction1.y());
+          c.principal_curvature_z = static_cast<float>(quadric.direction1.z());
+          c.pc1 = static_cast<float>(quadric.kappa1);
+          c.pc2 = static_cast<float>(quadric.kappa2);
+        }
+        return Outcome::Fitted;
+      });
 }
 
 template <typename PointInT, typename PointOutT>
 void QuadricNormalEstimation<PointInT, PointOutT>::setInvalid(PointOutT& point) const {
-  point.normal_x = point.normal_y = point.normal_z = point.curvature = std::numeric_limits<float>::quiet_NaN();
+  point.normal_x = point.normal_y = point.normal_z = point.curvature =
+      std::numeric_limits<float>::quiet_NaN();
 }
 
 }  // namespace pcl_ddg
 
-#define PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, NT) template class pcl_ddg::QuadricNormalEstimation<T, NT>;
+#define PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, NT) \
+  template class pcl_ddg::QuadricNormalEstimation<T, NT>;

@@ -21,19 +21,22 @@ MeshRingSearch<PointT>::MeshRingSearch(const pcl::PolygonMesh& mesh)
     : MeshRingSearch(std::make_shared<const MeshTopology>(mesh)) {}
 
 template <typename PointT>
-void MeshRingSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud, const IndicesConstPtr& indices) {
+void MeshRingSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud,
+                                           const IndicesConstPtr& indices) {
   if (!cloud || cloud->size() != static_cast<std::size_t>(topology_->numVertices())) {
-    throw pcl::BadArgumentException("MeshRingSearch: the cloud has " + std::to_string(cloud ? cloud->size() : 0) +
-                                    " points for a mesh of " + std::to_string(topology_->numVertices()) +
-                                    " vertices");
+    throw pcl::BadArgumentException(
+        "MeshRingSearch: the cloud has " + std::to_string(cloud ? cloud->size() : 0) +
+        " points for a mesh of " + std::to_string(topology_->numVertices()) + " vertices");
   }
   if (indices && !indices->empty()) {
-    throw pcl::BadArgumentException("MeshRingSearch searches the whole mesh: indices are not supported");
+    throw pcl::BadArgumentException(
+        "MeshRingSearch searches the whole mesh: indices are not supported");
   }
   this->input_ = cloud;
   this->indices_.reset();
   finite_.resize(cloud->size());
-  for (std::size_t i = 0; i < cloud->size(); ++i) finite_[i] = pcl::isXYZFinite((*cloud)[i]) ? 1 : 0;
+  for (std::size_t i = 0; i < cloud->size(); ++i)
+    finite_[i] = pcl::isXYZFinite((*cloud)[i]) ? 1 : 0;
 }
 
 template <typename PointT>
@@ -43,7 +46,8 @@ bool MeshRingSearch<PointT>::isSearchable(pcl::index_t index) const {
     return false;
   }
   if (index < 0 || index >= static_cast<pcl::index_t>(finite_.size())) {
-    PCL_ERROR("[pcl_ddg::MeshRingSearch] query index %d is not a vertex of the mesh\n", static_cast<int>(index));
+    PCL_ERROR("[pcl_ddg::MeshRingSearch] query index %d is not a vertex of the mesh\n",
+              static_cast<int>(index));
     return false;
   }
   return finite_[index] != 0;
@@ -84,7 +88,8 @@ int MeshRingSearch<PointT>::nearestKSearch(pcl::index_t index, int k, pcl::Indic
     ring_begin = ring_end;
   }
   k_sqr_distances.resize(k_indices.size());
-  for (std::size_t i = 0; i < k_indices.size(); ++i) k_sqr_distances[i] = squaredDistance(index, k_indices[i]);
+  for (std::size_t i = 0; i < k_indices.size(); ++i)
+    k_sqr_distances[i] = squaredDistance(index, k_indices[i]);
   if (k_indices.size() > static_cast<std::size_t>(k)) {
     // Keep the nearest members of the last ring: sort that ring's (distance, index) pairs.
     const std::size_t keep = static_cast<std::size_t>(k) - ring_begin;
@@ -109,7 +114,8 @@ int MeshRingSearch<PointT>::nearestKSearch(pcl::index_t index, int k, pcl::Indic
 
 template <typename PointT>
 int MeshRingSearch<PointT>::nearestKSearch(const PointCloud& cloud, pcl::index_t index, int k,
-                                           pcl::Indices& k_indices, std::vector<float>& k_sqr_distances) const {
+                                           pcl::Indices& k_indices,
+                                           std::vector<float>& k_sqr_distances) const {
   if (!isQueryCloud(cloud)) {
     k_indices.clear();
     k_sqr_distances.clear();
@@ -121,7 +127,8 @@ int MeshRingSearch<PointT>::nearestKSearch(const PointCloud& cloud, pcl::index_t
 template <typename PointT>
 int MeshRingSearch<PointT>::nearestKSearch(const PointT&, int, pcl::Indices& k_indices,
                                            std::vector<float>& k_sqr_distances) const {
-  PCL_ERROR("[pcl_ddg::MeshRingSearch] a point query has no place on the mesh: query by vertex index\n");
+  PCL_ERROR(
+      "[pcl_ddg::MeshRingSearch] a point query has no place on the mesh: query by vertex index\n");
   k_indices.clear();
   k_sqr_distances.clear();
   return 0;
@@ -129,7 +136,8 @@ int MeshRingSearch<PointT>::nearestKSearch(const PointT&, int, pcl::Indices& k_i
 
 template <typename PointT>
 int MeshRingSearch<PointT>::radiusSearch(pcl::index_t index, double radius, pcl::Indices& k_indices,
-                                         std::vector<float>& k_sqr_distances, unsigned int max_nn) const {
+                                         std::vector<float>& k_sqr_distances,
+                                         unsigned int max_nn) const {
   k_indices.clear();
   k_sqr_distances.clear();
   if (!(radius >= 0.0) || !isSearchable(index)) return 0;
@@ -159,7 +167,8 @@ int MeshRingSearch<PointT>::radiusSearch(pcl::index_t index, double radius, pcl:
 
 template <typename PointT>
 int MeshRingSearch<PointT>::radiusSearch(const PointCloud& cloud, pcl::index_t index, double radius,
-                                         pcl::Indices& k_indices, std::vector<float>& k_sqr_distances,
+                                         pcl::Indices& k_indices,
+                                         std::vector<float>& k_sqr_distances,
                                          unsigned int max_nn) const {
   if (!isQueryCloud(cloud)) {
     k_indices.clear();
@@ -172,7 +181,8 @@ int MeshRingSearch<PointT>::radiusSearch(const PointCloud& cloud, pcl::index_t i
 template <typename PointT>
 int MeshRingSearch<PointT>::radiusSearch(const PointT&, double, pcl::Indices& k_indices,
                                          std::vector<float>& k_sqr_distances, unsigned int) const {
-  PCL_ERROR("[pcl_ddg::MeshRingSearch] a point query has no place on the mesh: query by vertex index\n");
+  PCL_ERROR(
+      "[pcl_ddg::MeshRingSearch] a point query has no place on the mesh: query by vertex index\n");
   k_indices.clear();
   k_sqr_distances.clear();
   return 0;

@@ -1,0 +1,48 @@
+#pragma once
+// One call for the fitted estimators on a plain xyz cloud, with either kind of neighbourhood:
+// what the tools and the neighbourhood comparison use. (The estimators themselves take any PCL
+// search method; this only chooses between the two this library is about.)
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cstdint>
+#include <memory>
+
+#include "pcl_ddg/mesh/mesh_topology.h"
+
+namespace pcl_ddg {
+
+enum class LocalFitMethod { PCA, Quadric };
+
+enum class NeighbourhoodKind {
+  MeshRings,  ///< MeshRingSearch over the mesh's edges (needs a topology)
+  KdTree      ///< Euclidean, pcl::search::KdTree (FLANN)
+};
+
+struct LocalFitOptions {
+  LocalFitMethod method = LocalFitMethod::PCA;
+  NeighbourhoodKind neighbourhood = NeighbourhoodKind::KdTree;
+  int k = 16;                ///< neighbours, when radius is 0
+  double radius = 0.0;       ///< > 0: a radius search instead of k nearest
+  unsigned int threads = 0;  ///< 0: all cores
+};
+
+struct LocalFitResult {
+  pcl::PointCloud<pcl::Normal> normals;  ///< NaN where failed (see PCANormalEstimation)
+  /** Quadric only: principal curvatures and directions (see QuadricNormalEstimation). */
+  pcl::PointCloud<pcl::PrincipalCurvatures> curvatures;
+  std::int64_t failed_points = 0;
+  std::int64_t fallback_points = 0;  ///< quadric: PCA normal used
+};
+
+/**
+ * Runs PCANormalEstimation or QuadricNormalEstimation on cloud. With a topology (one vertex per
+ * point) normals are oriented like its faces, whichever neighbourhood is used, so that the two
+ * neighbourhoods can be compared point by point; without one, towards the origin as PCL does.
+ * Throws pcl::BadArgumentException for MeshRings without a topology or a bad k / radius.
+ */
+LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+                                const std::shared_ptr<const MeshTopology>& topology,
+                                const LocalFitOptions& options);
+
+}  // namespace pcl_ddg

@@ -1,0 +1,63 @@
+#include "pcl_ddg/features/local_fit.h"
+
+#include <pcl/exceptions.h>
+#include <pcl/search/kdtree.h>
+
+#include "pcl_ddg/features/pca_normal_estimation.h"
+#include "pcl_ddg/features/quadric_normal_estimation.h"
+#include "pcl_ddg/search/mesh_ring_search.h"
+
+namespace pcl_ddg {
+namespace {
+
+template <typename Estimator>
+void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+               const std::shared_ptr<const MeshTopology>& topology,
+               const LocalFitOptions& options) {
+  estimator.setInputCloud(cloud);
+  if (options.neighbourhood == NeighbourhoodKind::MeshRings) {
+    estimator.setSearchMethod(std::make_shared<MeshRingSearch<pcl::PointXYZ>>(topology));
+  } else {
+    estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  }
+  if (options.radius > 0.0) {
+    estimator.setRadiusSearch(options.radius);
+  } else {
+    estimator.setKSearch(options.k);
+  }
+  if (topology) estimator.setOrientationMesh(topology);
+  estimator.setNumberOfThreads(options.threads);
+}
+
+}  // namespace
+
+LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+                                const std::shared_ptr<const MeshTopology>& topology,
+                                const LocalFitOptions& options) {
+  if (options.neighbourhood == NeighbourhoodKind::MeshRings && !topology) {
+    throw pcl::BadArgumentException("mesh-ring neighbourhoods need a mesh (faces)");
+  }
+  if (!(options.radius >= 0.0) || (options.radius == 0.0 && options.k < 1)) {
+    throw pcl::BadArgumentException("k must be >= 1, or the radius > 0");
+  }
+  if (!cloud || cloud->empty()) throw pcl::BadArgumentException("the cloud is empty");
+  LocalFitResult result;
+  if (options.method == LocalFitMethod::PCA) {
+    PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+    configure(estimator, cloud, topology, options);
+    estimator.compute(result.normals);
+    result.failed_points = estimator.getFailedPoints();
+  } else {
+    QuadricNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+    configure(estimator, cloud, topology, options);
+    estimator.computeWithCurvatures(result.normals, result.curvatures);
+    result.failed_points = estimator.getFailedPoints();
+    result.fallback_points = estimator.getFallbackPoints();
+  }
+  if (result.normals.size() != cloud->size()) {
+    throw pcl::ComputeFailedException("normal estimation failed (see the PCL error above)");
+  }
+  return result;
+}
+
+}  // namespace pcl_ddg

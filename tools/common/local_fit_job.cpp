@@ -1,0 +1,150 @@
+#include "common/local_fit_job.h"
+
+#include <pcl/common/point_tests.h>
+#include <pcl/search/kdtree.h>
+
+#include <cmath>
+#include <cstdlib>
+
+#include "common/mesh_job.h"
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/mesh_geometry.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+
+namespace pcl_ddg {
+namespace tools {
+namespace {
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr toXYZ(const Eigen::Matrix3Xd& positions) {
+  auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  points->resize(positions.cols());
+  for (Eigen::Index i = 0; i < positions.cols(); ++i)
+    (*points)[i].getVector3fMap() = positions.col(i).cast<float>();
+  points->is_dense = positions.allFinite();
+  return points;
+}
+
+// Mean distance from a point to its nearest other point, over up to 10,000 finite points.
+double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) {
+  pcl::Indices finite;
+  for (std::size_t i = 0; i < points->size(); ++i) {
+    if (pcl::isXYZFinite((*points)[i])) finite.push_back(static_cast<pcl::index_t>(i));
+  }
+  if (finite.size() < 2) return 0.0;
+  pcl::search::KdTree<pcl::PointXYZ> tree;
+  tree.setInputCloud(points, std::make_shared<const pcl::Indices>(finite));
+  const std::size_t step = std::max<std::size_t>(1, finite.size() / 10000);
+  double sum = 0.0;
+  std::size_t counted = 0;
+  pcl::Indices found;
+  std::vector<float> distances;
+  for (std::size_t i = 0; i < finite.size(); i += step) {
+    // Exact duplicates are skipped: the spacing is between distinct samples.
+    if (tree.nearestKSearch((*points)[finite[i]], 8, found, distances) < 2) continue;
+    for (const float d : distances) {
+      if (d > 0.0f) {
+        sum += std::sqrt(d);
+        ++counted;
+        break;
+      }
+    }
+  }
+  return counted > 0 ? sum / counted : 0.0;
+}
+
+}  // namespace
+
+SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name) {
+  SurfaceInput input;
+  {
+    Timer timer("Loading " + path);
+    input.mesh = loadMesh(path);
+    timer.done(static_cast<std::size_t>(input.mesh.cloud.width) * input.mesh.cloud.height);
+  }
+  if (!input.mesh.polygons.empty()) {
+    SurfaceMesh mesh = checkSurfaceMesh(std::move(input.mesh), tool_name);
+    input.points = toXYZ(mesh.positions);
+    input.spacing = meanEdgeLength(mesh.topology, mesh.positions);
+    input.topology = std::make_shared<const MeshTopology>(std::move(mesh.topology));
+    input.positions = std::move(mesh.positions);
+    input.mesh = std::move(mesh.mesh);
+    return input;
+  }
+  input.positions = vertexPositions(input.mesh.cloud, NonFinitePolicy::Keep);
+  const Eigen::Matrix3Xd& positions = input.positions;
+  if (positions.cols() == 0) throw std::runtime_error(path + " has no points");
+  const NonFiniteVertices bad = findNonFiniteVertices(positions);
+  if (bad.count == positions.cols()) throw std::runtime_error(path + " has no finite point");
+  if (bad.count > 0)
+    warn(tool_name, std::to_string(bad.count) + " non-finite points (NaN output there)");
+  input.points = toXYZ(positions);
+  input.spacing = meanSpacing(input.points);
+  return input;
+}
+
+LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput& input,
+                                  LocalFitMethod method) {
+  LocalFitOptions options;
+  options.method = method;
+  const std::string neighbours =
+      args.choice("neighbours", {"bfs", "knn"}, input.topology ? "bfs" : "knn");
+  if (neighbours == "bfs" && !input.topology) {
+    throw UsageError("-neighbours bfs needs a mesh; this input is a point cloud (use knn)");
+  }
+  options.neighbourhood =
+      neighbours == "bfs" ? NeighbourhoodKind::MeshRings : NeighbourhoodKind::KdTree;
+  options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20 : 16);
+  if (options.k < 3) throw UsageError("-k must be at least 3");
+  if (args.has("radius")) {
+    std::string text = *args.value("radius");
+    double unit = 1.0;
+    if (!text.empty() && text.back() == 'h') {
+      text.pop_back();
+      unit = input.spacing;
+    }
+    char* end = nullptr;
+    const double value = std::strtod(text.c_str(), &end);
+    if (text.empty() || *end != '\0' || !(value > 0.0) || !std::isfinite(value)) {
+      throw UsageError("-radius must be a positive length or a multiple of the spacing like 2.5h");
+    }
+    options.radius = value * unit;
+  }
+  return options;
+}
+
+void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
+                     const pcl::PointCloud<pcl::Normal>& normals, FieldPrecision precision) {
+  const bool pcd = fileExtension(output_path) == "pcd";
+  const char* ply_names[] = {"nx", "ny", "nz"};
+  const char* pcd_names[] = {"normal_x", "normal_y", "normal_z"};
+  Eigen::VectorXd values(normals.size());
+  for (int d = 0; d < 3; ++d) {
+    for (std::size_t i = 0; i < normals.size(); ++i) values[i] = normals[i].normal[d];
+    setVertexField(cloud, pcd ? pcd_names[d] : ply_names[d], values, precision);
+  }
+  for (std::size_t i = 0; i < normals.size(); ++i) values[i] = normals[i].curvature;
+  setVertexField(cloud, "curvature", values, precision);
+}
+
+QuietPCLWarnings::QuietPCLWarnings() : level_(pcl::console::getVerbosityLevel()) {
+  pcl::console::setVerbosityLevel(pcl::console::L_ERROR);
+}
+
+QuietPCLWarnings::~QuietPCLWarnings() {
+  pcl::console::setVerbosityLevel(static_cast<pcl::console::VERBOSITY_LEVEL>(level_));
+}
+
+void warnAboutLocalFit(const char* tool_name, const LocalFitResult& result) {
+  if (result.failed_points > 0) {
+    warn(tool_name, std::to_string(result.failed_points) +
+                        " points without an estimate (non-finite, or too few neighbours): NaN");
+  }
+  if (result.fallback_points > 0) {
+    warn(tool_name, std::to_string(result.fallback_points) +
+                        " points with too few neighbours or an ill-conditioned quadric: PCA "
+                        "normal, NaN curvatures");
+  }
+}
+
+}  // namespace tools
+}  // namespace pcl_ddg

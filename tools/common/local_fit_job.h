@@ -1,0 +1,63 @@
+#pragma once
+// The shared shape of the tools that fit local surfaces (pca, quadric): input that is a mesh or a
+// point cloud, the neighbourhood options, and normals written under the names the output format
+// expects.
+#include <pcl/PolygonMesh.h>
+#include <pcl/console/print.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "common/tool_common.h"
+#include "pcl_ddg/features/local_fit.h"
+#include "pcl_ddg/io/vertex_fields.h"
+#include "pcl_ddg/mesh/mesh_topology.h"
+
+namespace pcl_ddg {
+namespace tools {
+
+/** A mesh (topology set, coordinates finite) or a point cloud (no topology, NaN points kept). */
+struct SurfaceInput {
+  pcl::PolygonMesh mesh;
+  std::shared_ptr<const MeshTopology> topology;
+  Eigen::Matrix3Xd positions;                  ///< double, as read
+  pcl::PointCloud<pcl::PointXYZ>::Ptr points;  ///< the same, as PCL points
+  /** Mean edge length of a mesh, or mean nearest-neighbour distance of a cloud. */
+  double spacing = 0.0;
+};
+
+/** Loads a mesh or a cloud, with the warnings of loadSurfaceMesh for meshes and a count of
+ *  non-finite points for clouds. */
+SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name);
+
+/** -neighbours bfs|knn (bfs is the default on meshes and impossible on clouds), -k N, and
+ *  -radius r, where r is a length or a multiple of the input's spacing written like 2.5h. */
+LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput& input,
+                                  LocalFitMethod method);
+
+/** Writes normals as nx ny nz (PLY) or normal_x normal_y normal_z (PCD), and PCL's curvature
+ *  (surface variation) as "curvature". */
+void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
+                     const pcl::PointCloud<pcl::Normal>& normals, FieldPrecision precision);
+
+/** While alive, PCL prints errors only: the estimators' own warnings would repeat, in the middle
+ *  of a timing line, the counts that warnAboutLocalFit reports after it. */
+class QuietPCLWarnings {
+ public:
+  QuietPCLWarnings();
+  ~QuietPCLWarnings();
+  QuietPCLWarnings(const QuietPCLWarnings&) = delete;
+  QuietPCLWarnings& operator=(const QuietPCLWarnings&) = delete;
+
+ private:
+  int level_;
+};
+
+/** Warns about points the estimator could not handle or fitted by the fallback. */
+void warnAboutLocalFit(const char* tool_name, const LocalFitResult& result);
+
+}  // namespace tools
+}  // namespace pcl_ddg

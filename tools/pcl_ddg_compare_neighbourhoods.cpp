@@ -1,0 +1,73 @@
+// pcl_ddg_compare_neighbourhoods: one estimator, run with topological (mesh rings) and Euclidean
+// (kd-tree) neighbourhoods; how much the normals and the neighbour sets differ, per vertex.
+#include <cstdio>
+
+#include "common/local_fit_job.h"
+#include "common/mesh_job.h"
+#include "common/tool_common.h"
+#include "pcl_ddg/features/neighbourhood_comparison.h"
+#include "pcl_ddg/io/color_map.h"
+#include "pcl_ddg/io/mesh_io.h"
+
+namespace {
+
+constexpr const char* kName = "pcl_ddg_compare_neighbourhoods";
+constexpr const char* kDescription =
+    "Runs a normal estimator on a mesh with mesh-ring (BFS) and with kd-tree neighbourhoods, "
+    "prints\n"
+    "how far the normals differ and how much the neighbour sets overlap, and writes per-vertex\n"
+    "angle_difference (degrees) and overlap (Jaccard, 0..1), coloured by the angle difference.";
+constexpr const char* kSyntax =
+    "input.{ply,obj,off,stl,vtk} output.{ply,pcd} [-method pca|quadric] [-k N (default 16)]\n"
+    "         [-radius r or 2.5h (instead of -k)] [-precision float|double]";
+
+int run(int argc, char** argv) {
+  using namespace pcl_ddg;
+  const tools::ToolArguments args(argc, argv, {"method", "k", "radius", "precision"}, {});
+  if (args.positional().size() != 2)
+    throw tools::UsageError("expected an input and an output file");
+  const std::string method = args.choice("method", {"pca", "quadric"}, "pca");
+  const FieldPrecision precision = tools::precisionArgument(args);
+  const std::string output = args.positional()[1];
+  if (fileExtension(output) != "ply" && fileExtension(output) != "pcd") {
+    throw tools::UsageError("the output must be .ply or .pcd");
+  }
+  tools::SurfaceInput in = tools::loadSurfaceInput(args.positional()[0], kName);
+  if (!in.topology)
+    throw std::runtime_error(args.positional()[0] +
+                             " has no faces: there are no mesh rings to compare");
+  LocalFitOptions options = tools::localFitArguments(
+      args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
+  if (!args.has("k")) options.k = 16;
+
+  tools::Timer timer("Comparing " + method + " normals from mesh rings and from a kd-tree");
+  const NeighbourhoodComparison c = [&] {
+    const tools::QuietPCLWarnings quiet;
+    return compareNeighbourhoods(in.points, in.topology, options);
+  }();
+  timer.done(in.points->size());
+  tools::warnAboutLocalFit(kName, c.mesh_rings);
+  tools::warnAboutLocalFit(kName, c.kd_tree);
+  const NeighbourhoodComparison::Summary& s = c.summary;
+  std::printf(
+      "angle difference (degrees) over %lld vertices: mean %.3f, median %.3f, 95th percentile "
+      "%.3f, max %.3f\n",
+      static_cast<long long>(s.compared), s.mean, s.median, s.percentile95, s.max);
+  std::printf("vertices over 5 degrees: %.2f%%, over 30 degrees: %.2f%%\n", 100.0 * s.share_over_5,
+              100.0 * s.share_over_30);
+  std::printf("neighbourhood overlap (mean Jaccard): %.3f\n", s.mean_overlap);
+
+  setVertexField(in.mesh.cloud, "angle_difference", c.angle_difference, precision);
+  setVertexField(in.mesh.cloud, "overlap", c.overlap, precision);
+  // Coloured from the smallest difference to 30 degrees (larger ones saturate).
+  Eigen::VectorXd clamped = c.angle_difference.cwiseMin(30.0);
+  setVertexColors(in.mesh.cloud, colorize(clamped, ColorMap::Sequential, {0.0, 100.0}));
+  tools::saveResult(output, in.mesh);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return pcl_ddg::tools::runTool(kName, kDescription, kSyntax, [&] { return run(argc, argv); });
+}
