@@ -7,10 +7,17 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace pcl_ddg {
 namespace bench {
 namespace {
+
+std::vector<std::pair<std::string, std::string>>& extraRatios() {
+  static std::vector<std::pair<std::string, std::string>> pairs;
+  return pairs;
+}
 
 // Records the real time of every run while the console reporter prints as usual.
 class RatioReporter : public benchmark::ConsoleReporter {
@@ -37,6 +44,12 @@ class RatioReporter : public benchmark::ConsoleReporter {
         std::printf("%-40s %12.1f %12.1f %7.1fx\n", what.c_str(), ours, baseline->second,
                     baseline->second / ours);
       }
+    }
+    for (const auto& [ours, baseline] : extraRatios()) {
+      const auto a = times_ms_.find(ours), b = times_ms_.find(baseline);
+      if (a == times_ms_.end() || b == times_ms_.end()) continue;
+      std::printf("%-40s %12.1f %12.1f %7.2fx  (vs %s)\n", ours.c_str(), a->second, b->second,
+                  b->second / a->second, baseline.c_str());
     }
   }
 
@@ -72,6 +85,10 @@ const BenchMesh& torusMesh(int around, int tube) {
     }
   }
   return m;
+}
+
+void addRatio(const std::string& ours_name, const std::string& baseline_name) {
+  extraRatios().emplace_back(ours_name, baseline_name);
 }
 
 int runWithRatios(int argc, char** argv) {

@@ -3,6 +3,7 @@
 // Google Benchmark table, the ratio of every "baseline/<name>" to its "ours/<name>" counterpart
 // measured in the same run.
 #include <Eigen/Core>
+#include <string>
 
 namespace pcl_ddg {
 namespace bench {
@@ -14,6 +15,9 @@ struct BenchMesh {
 
 /** A torus (R = 1, r = 0.4) of around x tube vertices, triangulated as a regular grid. */
 const BenchMesh& torusMesh(int around, int tube);
+
+/** Also prints baseline_name's time over ours_name's (for pairs whose names do not match). */
+void addRatio(const std::string& ours_name, const std::string& baseline_name);
 
 /** Runs the registered benchmarks and prints the ratio table; returns main's exit code. */
 int runWithRatios(int argc, char** argv);

@@ -1,10 +1,10 @@
 #include "pcl_ddg/features/local_fit.h"
 
 #include <pcl/exceptions.h>
-#include <pcl/search/kdtree.h>
 
 #include "pcl_ddg/features/pca_normal_estimation.h"
 #include "pcl_ddg/features/quadric_normal_estimation.h"
+#include "pcl_ddg/search/kd_tree_search.h"
 #include "pcl_ddg/search/mesh_ring_search.h"
 
 namespace pcl_ddg {
@@ -18,7 +18,7 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
   if (options.neighbourhood == NeighbourhoodKind::MeshRings) {
     estimator.setSearchMethod(std::make_shared<MeshRingSearch<pcl::PointXYZ>>(topology));
   } else {
-    estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+    estimator.setSearchMethod(std::make_shared<KdTreeSearch<pcl::PointXYZ>>());
   }
   if (options.radius > 0.0) {
     estimator.setRadiusSearch(options.radius);

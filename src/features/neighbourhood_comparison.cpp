@@ -1,7 +1,6 @@
 #include "pcl_ddg/features/neighbourhood_comparison.h"
 
 #include <pcl/exceptions.h>
-#include <pcl/search/kdtree.h>
 
 #include <algorithm>
 #include <cmath>
@@ -9,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "pcl_ddg/search/kd_tree_search.h"
 #include "pcl_ddg/search/mesh_ring_search.h"
 
 namespace pcl_ddg {
@@ -21,7 +21,7 @@ Eigen::VectorXd jaccardOverlaps(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
                                 const LocalFitOptions& options) {
   MeshRingSearch<pcl::PointXYZ> rings(topology);
   rings.setInputCloud(cloud);
-  pcl::search::KdTree<pcl::PointXYZ> tree;
+  KdTreeSearch<pcl::PointXYZ> tree;
   tree.setInputCloud(cloud);
   const auto n = static_cast<Eigen::Index>(cloud->size());
   Eigen::VectorXd overlap(n);

@@ -1,7 +1,7 @@
 #include "pcl_ddg/features/quadric_fit.h"
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -18,19 +18,26 @@ QuadricFit fitQuadric(const PlaneFit& plane, const Eigen::Matrix3Xd& points, int
   to_local << plane.tangent1.transpose(), plane.tangent2.transpose(), plane.normal.transpose();
   to_local /= scale;
 
-  Eigen::Matrix<double, 6, 6> normal_matrix = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 1> right_side = Eigen::Matrix<double, 6, 1>::Zero();
+  using Vector6d = Eigen::Matrix<double, 6, 1>;
+  using Matrix6d = Eigen::Matrix<double, 6, 6>;
+  Matrix6d normal_matrix = Matrix6d::Zero();  // upper triangle accumulated
+  Vector6d right_side = Vector6d::Zero();
   for (int i = 0; i < count; ++i) {
     const Eigen::Vector3d uvw = to_local * (points.col(i) - plane.centroid);
-    Eigen::Matrix<double, 6, 1> row;
+    Vector6d row;
     row << uvw.x() * uvw.x(), uvw.x() * uvw.y(), uvw.y() * uvw.y(), uvw.x(), uvw.y(), 1.0;
-    normal_matrix.selfadjointView<Eigen::Lower>().rankUpdate(row);
+    for (int a = 0; a < 6; ++a) {
+      for (int b = a; b < 6; ++b) normal_matrix(a, b) += row[a] * row[b];
+    }
     right_side += uvw.z() * row;
   }
-  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>, Eigen::Lower> ldlt(normal_matrix);
-  // Points on a conic (e.g. one ring of a regular grid) leave the quadric undetermined.
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.rcond() > 1e-10)) return fit;
-  const Eigen::Matrix<double, 6, 1> q = ldlt.solve(right_side);
+  const Eigen::LLT<Matrix6d, Eigen::Upper> cholesky(normal_matrix);
+  // Points on a conic (e.g. one ring of a regular grid) leave the quadric undetermined; the
+  // Cholesky pivots bound the conditioning (coordinates are scaled to O(1), so 1e-10 is relative).
+  if (cholesky.info() != Eigen::Success) return fit;
+  const Vector6d pivots = cholesky.matrixLLT().diagonal();
+  if (!(pivots.minCoeff() > 1e-5 * pivots.maxCoeff())) return fit;
+  const Vector6d q = cholesky.solve(right_side);
   if (!q.allFinite()) return fit;
 
   // Derivatives at the point: first ones are slopes (scale-free), second ones in 1/length.
@@ -41,19 +48,25 @@ QuadricFit fitQuadric(const PlaneFit& plane, const Eigen::Matrix3Xd& points, int
   const double w = std::sqrt(1.0 + fu * fu + fv * fv);
   fit.normal = (plane.normal - fu * plane.tangent1 - fv * plane.tangent2) / w;
 
-  // Shape operator I^-1 II of the graph; its eigenvalues bend towards +normal when positive,
-  // so they are negated for the convention "positive bends away from the normal".
-  Eigen::Matrix2d first, second;
-  first << 1.0 + fu * fu, fu * fv, fu * fv, 1.0 + fv * fv;
-  second << fuu, fuv, fuv, fvv;
-  second /= w;
-  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::Matrix2d> shape(second, first);
-  if (shape.info() != Eigen::Success) return fit;
-  fit.kappa1 = -shape.eigenvalues()[0];
-  fit.kappa2 = -shape.eigenvalues()[1];
-  const Eigen::Vector2d a = shape.eigenvectors().col(0);
-  const Eigen::Vector3d du = plane.tangent1 + fu * plane.normal,
-                        dv = plane.tangent2 + fv * plane.normal;
+  // Shape operator S = I^-1 II of the graph, in closed form: its eigenvalues are H +- sqrt(H^2 - K)
+  // with K = det II / det I and 2H = trace(S); they bend towards +normal when positive, so they are
+  // negated for the convention "positive bends away from the normal".
+  const double e = 1.0 + fu * fu, f = fu * fv, g = 1.0 + fv * fv;  // first fundamental form
+  const double l = fuu / w, m = fuv / w, n = fvv / w;                // second
+  const double det_first = e * g - f * f;
+  const double mean = (e * n - 2.0 * f * m + g * l) / (2.0 * det_first);
+  const double gauss = (l * n - m * m) / det_first;
+  const double root = std::sqrt(std::max(mean * mean - gauss, 0.0));
+  const double lowest = mean - root;  // becomes kappa1 after negation
+  fit.kappa1 = -lowest;
+  fit.kappa2 = -(mean + root);
+  // Its eigenvector: (II - lowest I) a = 0, from the row with more weight (either row is zero at an
+  // umbilic, where any tangent is principal).
+  const Eigen::Vector2d from_first(-(m - lowest * f), l - lowest * e);
+  const Eigen::Vector2d from_second(n - lowest * g, -(m - lowest * f));
+  Eigen::Vector2d a = from_first.squaredNorm() >= from_second.squaredNorm() ? from_first : from_second;
+  if (!(a.squaredNorm() > 0.0)) a = Eigen::Vector2d(1.0, 0.0);
+  const Eigen::Vector3d du = plane.tangent1 + fu * plane.normal, dv = plane.tangent2 + fv * plane.normal;
   fit.direction1 = (a.x() * du + a.y() * dv).normalized();
   fit.direction2 = fit.normal.cross(fit.direction1);
   fit.valid = fit.normal.allFinite() && fit.direction1.allFinite() && std::isfinite(fit.kappa1) &&

@@ -16,7 +16,7 @@ enum class LocalFitMethod { PCA, Quadric };
 
 enum class NeighbourhoodKind {
   MeshRings,  ///< MeshRingSearch over the mesh's edges (needs a topology)
-  KdTree      ///< Euclidean, pcl::search::KdTree (FLANN)
+  KdTree      ///< Euclidean: KdTreeSearch (FLANN)
 };
 
 struct LocalFitOptions {

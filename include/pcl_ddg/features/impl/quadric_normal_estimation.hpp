@@ -10,8 +10,7 @@ namespace pcl_ddg {
 template <typename PointInT, typename PointOutT>
 void QuadricNormalEstimation<PointInT, PointOutT>::computeWithCurvatures(
     PointCloudOut& normals, CurvatureCloud& curvatures) {
-  curvatures_ = &curvatures;
-  curvatures.clear();
+  curvatures_ = &curvatures;  // filled (not reallocated, when the size is unchanged) by computeFeature
   try {
     this->compute(normals);
   } catch (...) {

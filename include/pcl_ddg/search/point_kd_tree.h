@@ -1,0 +1,45 @@
+#pragma once
+// A FLANN kd-tree over 3D points, queried one point at a time without allocating (the core of
+// KdTreeSearch; FLANN itself stays out of the public headers).
+//
+// Why not pcl::KdTreeFLANN: it answers each query through FLANN's batch knnSearch, which opens an
+// OpenMP parallel region per call; inside an estimator that is already parallel over points that
+// costs as much as the search itself. Here each query calls the index's findNeighbors directly
+// with a result set that writes straight into the caller's vectors.
+#include <pcl/types.h>
+
+#include <memory>
+#include <vector>
+
+namespace pcl_ddg {
+namespace detail {
+
+class PointKdTree {
+ public:
+  /** Indexes the points xyz[3 * i .. 3 * i + 2] for i in [0, count); their ids in the answers are
+   *  ids[i] (the caller's numbering). */
+  PointKdTree(std::vector<float> xyz, std::vector<pcl::index_t> ids);
+  ~PointKdTree();
+  PointKdTree(const PointKdTree&) = delete;
+  PointKdTree& operator=(const PointKdTree&) = delete;
+
+  std::size_t size() const { return ids_.size(); }
+
+  /** The k nearest points, sorted by squared distance; returns how many (fewer if the tree is
+   *  smaller). */
+  int nearestK(const float* query, int k, pcl::Indices& indices, std::vector<float>& squared_distances) const;
+
+  /** All points within radius (squared distances below radius^2), sorted by distance if sorted;
+   *  max_nn > 0 keeps that many (the nearest ones when sorted). */
+  int withinRadius(const float* query, double radius, pcl::Indices& indices, std::vector<float>& squared_distances,
+                   unsigned int max_nn, bool sorted) const;
+
+ private:
+  struct Index;
+  std::vector<float> xyz_;
+  std::vector<pcl::index_t> ids_;
+  std::unique_ptr<Index> index_;
+};
+
+}  // namespace detail
+}  // namespace pcl_ddg
