@@ -19,13 +19,15 @@ std::vector<std::pair<std::string, std::string>>& extraRatios() {
   return pairs;
 }
 
-// Records the real time of every run while the console reporter prints as usual.
+// Records the real time of every run (the median when run with --benchmark_repetitions, which a
+// shared VM needs) while the console reporter prints as usual.
 class RatioReporter : public benchmark::ConsoleReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
-      if (run.run_type == Run::RT_Iteration && !run.error_occurred) {
+      const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
+      if ((run.run_type == Run::RT_Iteration || median) && !run.error_occurred) {
         times_ms_[run.run_name.function_name] =
             run.GetAdjustedRealTime() * benchmark::GetTimeUnitMultiplier(benchmark::kMillisecond) /
             benchmark::GetTimeUnitMultiplier(run.time_unit);
@@ -48,8 +50,8 @@ class RatioReporter : public benchmark::ConsoleReporter {
     for (const auto& [ours, baseline] : extraRatios()) {
       const auto a = times_ms_.find(ours), b = times_ms_.find(baseline);
       if (a == times_ms_.end() || b == times_ms_.end()) continue;
-      std::printf("%-40s %12.1f %12.1f %7.2fx  (vs %s)\n", ours.c_str(), a->second, b->second,
-                  b->second / a->second, baseline.c_str());
+      std::printf("%-40s %12.1f %12.1f  takes %.2fx the time of %s\n", ours.c_str(), a->second,
+                  b->second, a->second / b->second, baseline.c_str());
     }
   }
 

@@ -16,7 +16,7 @@ struct BenchMesh {
 /** A torus (R = 1, r = 0.4) of around x tube vertices, triangulated as a regular grid. */
 const BenchMesh& torusMesh(int around, int tube);
 
-/** Also prints baseline_name's time over ours_name's (for pairs whose names do not match). */
+/** Also prints ours_name's time as a multiple of baseline_name's (for pairs whose names differ). */
 void addRatio(const std::string& ours_name, const std::string& baseline_name);
 
 /** Runs the registered benchmarks and prints the ratio table; returns main's exit code. */

@@ -20,18 +20,29 @@ QuadricFit fitQuadric(const PlaneFit& plane, const Eigen::Matrix3Xd& points, int
 
   using Vector6d = Eigen::Matrix<double, 6, 1>;
   using Matrix6d = Eigen::Matrix<double, 6, 6>;
-  Matrix6d normal_matrix = Matrix6d::Zero();  // upper triangle accumulated
+  // The normal equations of the rows (u^2, uv, v^2, u, v, 1) hold only the 15 moments
+  // sum u^a v^b with a + b <= 4, and the right side the 6 moments sum w u^a v^b: accumulating those
+  // is a third less work than the 27 products of the rows.
+  double m40 = 0, m31 = 0, m22 = 0, m13 = 0, m04 = 0, m30 = 0, m21 = 0, m12 = 0, m03 = 0;
+  double m20 = 0, m11 = 0, m02 = 0, m10 = 0, m01 = 0;
   Vector6d right_side = Vector6d::Zero();
   for (int i = 0; i < count; ++i) {
     const Eigen::Vector3d uvw = to_local * (points.col(i) - plane.centroid);
-    Vector6d row;
-    row << uvw.x() * uvw.x(), uvw.x() * uvw.y(), uvw.y() * uvw.y(), uvw.x(), uvw.y(), 1.0;
-    for (int a = 0; a < 6; ++a) {
-      for (int b = a; b < 6; ++b) normal_matrix(a, b) += row[a] * row[b];
-    }
-    right_side += uvw.z() * row;
+    const double u = uvw.x(), v = uvw.y(), w = uvw.z();
+    const double uu = u * u, uv = u * v, vv = v * v;
+    m40 += uu * uu, m31 += uu * uv, m22 += uu * vv, m13 += uv * vv, m04 += vv * vv;
+    m30 += uu * u, m21 += uu * v, m12 += u * vv, m03 += vv * v;
+    m20 += uu, m11 += uv, m02 += vv, m10 += u, m01 += v;
+    right_side += w * Vector6d(uu, uv, vv, u, v, 1.0);
   }
-  const Eigen::LLT<Matrix6d, Eigen::Upper> cholesky(normal_matrix);
+  Matrix6d normal_matrix;
+  normal_matrix << m40, m31, m22, m30, m21, m20,  //
+      m31, m22, m13, m21, m12, m11,               //
+      m22, m13, m04, m12, m03, m02,               //
+      m30, m21, m12, m20, m11, m10,               //
+      m21, m12, m03, m11, m02, m01,               //
+      m20, m11, m02, m10, m01, count;
+  const Eigen::LLT<Eigen::Ref<Matrix6d>> cholesky(normal_matrix);  // in place
   // Points on a conic (e.g. one ring of a regular grid) leave the quadric undetermined; the
   // Cholesky pivots bound the conditioning (coordinates are scaled to O(1), so 1e-10 is relative).
   if (cholesky.info() != Eigen::Success) return fit;
