@@ -35,8 +35,10 @@ int threads() {
 struct Fixture {
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   std::shared_ptr<MeshRingSearch<pcl::PointXYZ>> rings;
-  std::shared_ptr<KdTreeSearch<pcl::PointXYZ>> tree = std::make_shared<KdTreeSearch<pcl::PointXYZ>>();
-  std::shared_ptr<pcl::search::KdTree<pcl::PointXYZ>> pcl_tree = std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
+  std::shared_ptr<KdTreeSearch<pcl::PointXYZ>> tree =
+      std::make_shared<KdTreeSearch<pcl::PointXYZ>>();
+  std::shared_ptr<pcl::search::KdTree<pcl::PointXYZ>> pcl_tree =
+      std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>();
 
   Fixture() {
     const BenchMesh& mesh = torusMesh(kAround, kTube);
@@ -81,8 +83,14 @@ void pca(benchmark::State& state, bool mesh_rings) {
   }
   setCounters(state);
 }
-BENCHMARK_CAPTURE(pca, bfs, true)->Name("ours/pca_bfs")->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(pca, kdtree, false)->Name("ours/pca_kdtree")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(pca, bfs, true)
+    ->Name("ours/pca_bfs")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(pca, kdtree, false)
+    ->Name("ours/pca_kdtree")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void quadric(benchmark::State& state) {
   QuadricNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
@@ -96,7 +104,10 @@ void quadric(benchmark::State& state) {
   }
   setCounters(state);
 }
-BENCHMARK(quadric)->Name("ours/quadric_bfs+curvatures")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(quadric)
+    ->Name("ours/quadric_bfs+curvatures")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 void pclNormalEstimationOMP(benchmark::State& state) {
   pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> estimator(threads());

@@ -80,7 +80,8 @@ TEST_P(KdTreeSearchOnSharedClouds, KNearestAndRadiusMatchPCLsKdTree) {
     for (const int k : {1, 16, 50}) {
       ours.nearestKSearch(p, k, a, da);
       reference.nearestKSearch(p, k, b, db);
-      expectSameNeighbours(a, da, b, db, GetParam() + " k=" + std::to_string(k) + " at " + std::to_string(i));
+      expectSameNeighbours(a, da, b, db,
+                           GetParam() + " k=" + std::to_string(k) + " at " + std::to_string(i));
     }
     ours.radiusSearch(p, radius, a, da);
     reference.radiusSearch(p, radius, b, db);
@@ -111,11 +112,13 @@ TEST_P(KdTreeSearchOnSharedClouds, NeverReturnsNonFinitePoints) {
   EXPECT_EQ(ours.nearestKSearch(nan_point, 5, neighbours, d2), 0);
   EXPECT_TRUE(neighbours.empty());
   EXPECT_EQ(ours.radiusSearch(nan_point, 1.0, neighbours, d2), 0);
-  std::cout << GetParam() << ": " << non_finite << " non-finite points of " << cloud->size() << "\n";
+  std::cout << GetParam() << ": " << non_finite << " non-finite points of " << cloud->size()
+            << "\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedClouds, KdTreeSearchOnSharedClouds,
-                         ::testing::Values("bun0.pcd", "milk.pcd", "rs1.pcd", "table_scene_mug_stereo_textured.pcd"),
+                         ::testing::Values("bun0.pcd", "milk.pcd", "rs1.pcd",
+                                           "table_scene_mug_stereo_textured.pcd"),
                          [](const auto& info) {
                            std::string name = info.param.substr(0, info.param.find('.'));
                            std::replace(name.begin(), name.end(), '_', 'X');
@@ -184,7 +187,8 @@ TEST(KdTreeSearch, PCLsNormalEstimationRunsOnItUnchangedWithTheSameResult) {
   estimation.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
   estimation.compute(with_pcl);
   ASSERT_EQ(with_ours.size(), with_pcl.size());
-  const AngleErrors difference = angleErrors(normalsOf(with_ours), normalsOf(with_pcl), SignMode::Signed);
+  const AngleErrors difference =
+      angleErrors(normalsOf(with_ours), normalsOf(with_pcl), SignMode::Signed);
   EXPECT_EQ(difference.invalid, 0);
   EXPECT_LT(difference.max, 1e-3) << "degrees";
 }

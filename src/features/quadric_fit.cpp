@@ -63,7 +63,7 @@ QuadricFit fitQuadric(const PlaneFit& plane, const Eigen::Matrix3Xd& points, int
   // with K = det II / det I and 2H = trace(S); they bend towards +normal when positive, so they are
   // negated for the convention "positive bends away from the normal".
   const double e = 1.0 + fu * fu, f = fu * fv, g = 1.0 + fv * fv;  // first fundamental form
-  const double l = fuu / w, m = fuv / w, n = fvv / w;                // second
+  const double l = fuu / w, m = fuv / w, n = fvv / w;              // second
   const double det_first = e * g - f * f;
   const double mean = (e * n - 2.0 * f * m + g * l) / (2.0 * det_first);
   const double gauss = (l * n - m * m) / det_first;
@@ -75,9 +75,11 @@ QuadricFit fitQuadric(const PlaneFit& plane, const Eigen::Matrix3Xd& points, int
   // umbilic, where any tangent is principal).
   const Eigen::Vector2d from_first(-(m - lowest * f), l - lowest * e);
   const Eigen::Vector2d from_second(n - lowest * g, -(m - lowest * f));
-  Eigen::Vector2d a = from_first.squaredNorm() >= from_second.squaredNorm() ? from_first : from_second;
+  Eigen::Vector2d a =
+      from_first.squaredNorm() >= from_second.squaredNorm() ? from_first : from_second;
   if (!(a.squaredNorm() > 0.0)) a = Eigen::Vector2d(1.0, 0.0);
-  const Eigen::Vector3d du = plane.tangent1 + fu * plane.normal, dv = plane.tangent2 + fv * plane.normal;
+  const Eigen::Vector3d du = plane.tangent1 + fu * plane.normal,
+                        dv = plane.tangent2 + fv * plane.normal;
   fit.direction1 = (a.x() * du + a.y() * dv).normalized();
   fit.direction2 = fit.normal.cross(fit.direction1);
   fit.valid = fit.normal.allFinite() && fit.direction1.allFinite() && std::isfinite(fit.kappa1) &&

@@ -22,7 +22,9 @@ class NearestK : public flann::ResultSet<float> {
     distances_.resize(k);
   }
   bool full() const override { return count_ == k_; }
-  float worstDist() const override { return count_ == k_ ? distances_[k_ - 1] : std::numeric_limits<float>::max(); }
+  float worstDist() const override {
+    return count_ == k_ ? distances_[k_ - 1] : std::numeric_limits<float>::max();
+  }
   void addPoint(float distance, std::size_t index) override {
     if (distance >= worstDist()) return;
     std::size_t i = count_ < k_ ? count_++ : k_ - 1;
@@ -67,7 +69,8 @@ class WithinRadius : public flann::ResultSet<float> {
 
 struct PointKdTree::Index {
   flann::KDTreeSingleIndex<flann::L2_Simple<float>> tree;
-  Index(const flann::Matrix<float>& points) : tree(points, flann::KDTreeSingleIndexParams(kLeafSize)) {}
+  Index(const flann::Matrix<float>& points)
+      : tree(points, flann::KDTreeSingleIndexParams(kLeafSize)) {}
 };
 
 PointKdTree::PointKdTree(std::vector<float> xyz, std::vector<pcl::index_t> ids)
@@ -95,7 +98,8 @@ int PointKdTree::nearestK(const float* query, int k, pcl::Indices& indices,
 }
 
 int PointKdTree::withinRadius(const float* query, double radius, pcl::Indices& indices,
-                              std::vector<float>& squared_distances, unsigned int max_nn, bool sorted) const {
+                              std::vector<float>& squared_distances, unsigned int max_nn,
+                              bool sorted) const {
   indices.clear();
   squared_distances.clear();
   if (!index_ || !(radius >= 0.0)) return 0;
@@ -109,7 +113,8 @@ int PointKdTree::withinRadius(const float* query, double radius, pcl::Indices& i
       return squared_distances[a] < squared_distances[b] ||
              (squared_distances[a] == squared_distances[b] && indices[a] < indices[b]);
     });
-    const std::size_t keep = max_nn > 0 ? std::min<std::size_t>(max_nn, order.size()) : order.size();
+    const std::size_t keep =
+        max_nn > 0 ? std::min<std::size_t>(max_nn, order.size()) : order.size();
     pcl::Indices sorted_indices(keep);
     std::vector<float> sorted_distances(keep);
     for (std::size_t i = 0; i < keep; ++i) {

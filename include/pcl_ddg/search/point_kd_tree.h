@@ -27,12 +27,13 @@ class PointKdTree {
 
   /** The k nearest points, sorted by squared distance; returns how many (fewer if the tree is
    *  smaller). */
-  int nearestK(const float* query, int k, pcl::Indices& indices, std::vector<float>& squared_distances) const;
+  int nearestK(const float* query, int k, pcl::Indices& indices,
+               std::vector<float>& squared_distances) const;
 
   /** All points within radius (squared distances below radius^2), sorted by distance if sorted;
    *  max_nn > 0 keeps that many (the nearest ones when sorted). */
-  int withinRadius(const float* query, double radius, pcl::Indices& indices, std::vector<float>& squared_distances,
-                   unsigned int max_nn, bool sorted) const;
+  int withinRadius(const float* query, double radius, pcl::Indices& indices,
+                   std::vector<float>& squared_distances, unsigned int max_nn, bool sorted) const;
 
  private:
   struct Index;

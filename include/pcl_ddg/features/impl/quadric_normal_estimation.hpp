@@ -10,7 +10,8 @@ namespace pcl_ddg {
 template <typename PointInT, typename PointOutT>
 void QuadricNormalEstimation<PointInT, PointOutT>::computeWithCurvatures(
     PointCloudOut& normals, CurvatureCloud& curvatures) {
-  curvatures_ = &curvatures;  // filled (not reallocated, when the size is unchanged) by computeFeature
+  curvatures_ =
+      &curvatures;  // filled (not reallocated, when the size is unchanged) by computeFeature
   try {
     this->compute(normals);
   } catch (...) {

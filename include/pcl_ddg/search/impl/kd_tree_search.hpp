@@ -6,7 +6,8 @@
 namespace pcl_ddg {
 
 template <typename PointT>
-void KdTreeSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud, const IndicesConstPtr& indices) {
+void KdTreeSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud,
+                                         const IndicesConstPtr& indices) {
   this->input_ = cloud;
   this->indices_ = indices;
   std::vector<float> xyz;
@@ -38,14 +39,16 @@ int KdTreeSearch<PointT>::nearestKSearch(const PointT& point, int k, pcl::Indice
 
 template <typename PointT>
 int KdTreeSearch<PointT>::radiusSearch(const PointT& point, double radius, pcl::Indices& k_indices,
-                                       std::vector<float>& k_sqr_distances, unsigned int max_nn) const {
+                                       std::vector<float>& k_sqr_distances,
+                                       unsigned int max_nn) const {
   if (!tree_ || !pcl::isXYZFinite(point)) {
     k_indices.clear();
     k_sqr_distances.clear();
     return 0;
   }
   const float query[3] = {point.x, point.y, point.z};
-  return tree_->withinRadius(query, radius, k_indices, k_sqr_distances, max_nn, this->sorted_results_);
+  return tree_->withinRadius(query, radius, k_indices, k_sqr_distances, max_nn,
+                             this->sorted_results_);
 }
 
 }  // namespace pcl_ddg
