@@ -48,6 +48,12 @@ const pcl::PCLPointField& namedField(const pcl::PCLPointCloud2& cloud, const std
   throw InvalidMeshException("vertex data has no '" + name + "' field");
 }
 
+template <typename T>
+void store(std::uint8_t* p, double value) {
+  const T typed = static_cast<T>(value);
+  std::memcpy(p, &typed, sizeof(T));
+}
+
 }  // namespace
 
 NonFiniteVertices findNonFiniteVertices(const Eigen::Matrix3Xd& positions) {
@@ -98,6 +104,31 @@ Eigen::Matrix3Xd vertexPositions(const pcl::PCLPointCloud2& cloud, NonFinitePoli
   positions.row(2) = vertexScalarField(cloud, "z").transpose();
   if (policy == NonFinitePolicy::Throw) requireFinite(positions);
   return positions;
+}
+
+void setVertexPositions(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions) {
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  if (static_cast<std::size_t>(positions.cols()) != n || cloud.data.size() < n * cloud.point_step) {
+    throw InvalidMeshException("positions do not match the vertex data");
+  }
+  const char* names[3] = {"x", "y", "z"};
+  for (int axis = 0; axis < 3; ++axis) {
+    const pcl::PCLPointField& field = namedField(cloud, names[axis]);
+    if (field.datatype != pcl::PCLPointField::FLOAT32 &&
+        field.datatype != pcl::PCLPointField::FLOAT64) {
+      throw InvalidMeshException(std::string("cannot write positions into an integer '") +
+                                 names[axis] + "' field");
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      std::uint8_t* p = cloud.data.data() + i * cloud.point_step + field.offset;
+      const double value = positions(axis, static_cast<Eigen::Index>(i));
+      if (field.datatype == pcl::PCLPointField::FLOAT32) {
+        store<float>(p, value);
+      } else {
+        store<double>(p, value);
+      }
+    }
+  }
 }
 
 }  // namespace pcl_ddg

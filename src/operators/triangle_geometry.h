@@ -51,8 +51,14 @@ inline CornerView viewFromCorner(const Eigen::Matrix3Xd& positions,
   c.p0 = positions.col(triangles(k, t));
   c.p1 = positions.col(triangles((k + 1) % 3, t));
   c.p2 = positions.col(triangles((k + 2) % 3, t));
-  if (isDegenerateTriangle(c.p0, c.p1, c.p2)) return c;
-  c.area_vector = 0.5 * (c.p1 - c.p0).cross(c.p2 - c.p0);
+  // Area and degeneracy from the triangle's first corner whatever the view, so that every corner
+  // sees bit-identical numbers: cotangents of a sliver computed from different corners would
+  // differ in their leading digits and make L unsymmetric.
+  const Eigen::Vector3d& a = positions.col(triangles(0, t));
+  const Eigen::Vector3d& b = positions.col(triangles(1, t));
+  const Eigen::Vector3d& d = positions.col(triangles(2, t));
+  if (isDegenerateTriangle(a, b, d)) return c;
+  c.area_vector = 0.5 * (b - a).cross(d - a);
   c.double_area = 2.0 * c.area_vector.norm();
   c.degenerate = false;
   return c;

@@ -27,6 +27,12 @@ NonFiniteVertices findNonFiniteVertices(const Eigen::Matrix3Xd& positions);
 Eigen::Matrix3Xd vertexPositions(const pcl::PCLPointCloud2& cloud,
                                  NonFinitePolicy policy = NonFinitePolicy::Throw);
 
+/**
+ * Writes positions into the cloud's existing x, y, z fields (float or double, kept as they are:
+ * a float mesh stays float). Throws InvalidMeshException on a size mismatch or integer fields.
+ */
+void setVertexPositions(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions);
+
 /** One numeric field of every point, in double; throws InvalidMeshException if it is missing. */
 Eigen::VectorXd vertexScalarField(const pcl::PCLPointCloud2& cloud, const std::string& name);
 

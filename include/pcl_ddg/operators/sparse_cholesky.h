@@ -1,0 +1,58 @@
+#pragma once
+// Sparse Cholesky factorisation of symmetric positive definite systems, for the implicit
+// smoothing steps: CHOLMOD's supernodal LLT (SuiteSparse, through Eigen's CholmodSupport) when the
+// library was built with it, Eigen's SimplicialLDLT otherwise or on request.
+//
+// The ordering and symbolic factorisation depend only on the sparsity pattern: analyzePattern()
+// once, then factorize() for every new matrix with that pattern (the values of L and M change
+// every smoothing step, the pattern does not). solve() takes several right-hand sides at once
+// (x, y, z as three columns).
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+
+namespace pcl_ddg {
+
+enum class CholeskyBackend {
+  Automatic,      ///< Cholmod when available, else SimplicialLDLT
+  Cholmod,        ///< CHOLMOD supernodal LLT; BadArgumentException if not built in
+  SimplicialLDLT  ///< Eigen's own
+};
+
+/** Whether this build of pcl_ddg has CHOLMOD. */
+bool cholmodAvailable();
+
+const char* toString(CholeskyBackend backend);
+
+class SparseCholesky {
+ public:
+  explicit SparseCholesky(CholeskyBackend backend = CholeskyBackend::Automatic);
+  ~SparseCholesky();
+  SparseCholesky(const SparseCholesky&) = delete;
+  SparseCholesky& operator=(const SparseCholesky&) = delete;
+
+  /** The backend in use (never Automatic). */
+  CholeskyBackend backend() const { return backend_; }
+
+  /** Fill-reducing ordering and symbolic factorisation of matrix's pattern (lower triangle read).
+   */
+  void analyzePattern(const Eigen::SparseMatrix<double>& matrix);
+
+  /** Numeric factorisation of a matrix with the analysed pattern; throws
+   *  pcl::ComputeFailedException if it is not positive definite. */
+  void factorize(const Eigen::SparseMatrix<double>& matrix);
+
+  /** analyzePattern + factorize. */
+  void compute(const Eigen::SparseMatrix<double>& matrix);
+
+  /** Solves for every column of rhs; throws pcl::ComputeFailedException before factorize(). */
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const;
+
+ private:
+  struct Backend;
+  CholeskyBackend backend_;
+  std::unique_ptr<Backend> impl_;
+  bool analysed_ = false, factorised_ = false;
+};
+
+}  // namespace pcl_ddg

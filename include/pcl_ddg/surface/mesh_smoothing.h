@@ -1,0 +1,125 @@
+#pragma once
+// Laplacian smoothing of a mesh's vertex positions: the mean-curvature-like flow dx/dt = M^-1 L x.
+//
+//   Explicit  x <- x + tau M^-1 L x per iteration (forward Euler). Cheap, but stable only for
+//             tau below about 2 / |lambda_max(M^-1 L)|, i.e. a fraction of h^2 (h = mean edge
+//             length): larger steps make every iteration amplify the finest wrinkles, and the
+//             positions blow up (raised as an exception naming the iteration).
+//   Implicit  (M - tau L) x' = M x (backward Euler, Desbrun et al. 1999): one sparse Cholesky
+//             solve per iteration, x, y, z as three right-hand sides. Stable for any tau, so one
+//             large step replaces thousands of small ones.
+// L is the summed uniform or cotangent Laplacian (laplacian.h), M the lumped mass of the chosen
+// type; both are rebuilt from the current positions every iteration (default) or frozen at the
+// input's. The system's pattern is analysed once per run and refactorised per iteration.
+//
+// Boundary vertices move (Free, default) or keep their position (Fixed). Vertices without mass
+// (isolated, or only on degenerate triangles) never move. Laplacian flow shrinks a surface; the
+// optional correction rescales the result about its mass-weighted centroid after every iteration
+// so that the enclosed volume (closed, consistently oriented meshes) or the surface area is that
+// of the input.
+//
+// Errors: InvalidMeshException for an empty mesh or non-finite input; pcl::BadArgumentException for
+// bad parameters (tau <= 0, iterations < 1, volume correction on an open mesh, a correction with a
+// fixed boundary); pcl::ComputeFailedException when an iteration produces a non-finite position
+// or a singular system, naming the iteration. The input is never modified.
+#include <pcl/PolygonMesh.h>
+
+#include <Eigen/Core>
+#include <functional>
+
+#include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/operators/laplacian.h"
+#include "pcl_ddg/operators/mass_matrix.h"
+#include "pcl_ddg/operators/sparse_cholesky.h"
+
+namespace pcl_ddg {
+
+enum class SmoothingScheme { Explicit, Implicit };
+enum class WeightUpdate { EveryIteration, Frozen };
+enum class BoundaryCondition { Free, Fixed };
+enum class ShrinkageCorrection { None, PreserveVolume, PreserveArea };
+
+struct MeshSmoothingParameters {
+  SmoothingScheme scheme = SmoothingScheme::Implicit;
+  LaplacianWeights weights = LaplacianWeights::Cotangent;
+  MassType mass = MassType::MixedVoronoi;
+  double time_step = 0.0;  ///< tau, in length^2 (e.g. 0.1 * h^2 explicit, 10 * h^2 implicit)
+  int iterations = 1;
+  WeightUpdate weight_update = WeightUpdate::EveryIteration;
+  BoundaryCondition boundary = BoundaryCondition::Free;
+  ShrinkageCorrection shrinkage = ShrinkageCorrection::None;
+  CholeskyBackend solver = CholeskyBackend::Automatic;
+};
+
+struct MeshSmoothingReport {
+  int iterations = 0;
+  CholeskyBackend solver = CholeskyBackend::Automatic;  ///< the one used (implicit)
+  int fixed_vertices = 0;                               ///< fixed boundary + massless
+  double volume_before = 0.0, volume_after = 0.0;       ///< closed meshes (else 0)
+  double area_before = 0.0, area_after = 0.0;
+};
+
+/** Called after every iteration with (iterations done, total). */
+using SmoothingProgress = std::function<void(int, int)>;
+
+/** Smoothed copy of positions (3 x N); see the header comment. */
+Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
+                                     const Eigen::Matrix3Xd& positions,
+                                     const MeshSmoothingParameters& parameters,
+                                     MeshSmoothingReport* report = nullptr,
+                                     const SmoothingProgress& progress = {});
+
+/**
+ * A time step up to which the explicit scheme is stable on this mesh: 2 / max_i sum_j |L_ij| / m_i,
+ * the Gershgorin bound on the spectrum of M^-1 L (sufficient; the sharp limit is usually 1-3x
+ * larger). In length^2; on scans often 1e-3 h^2 or less, because of tiny vertex areas.
+ */
+double explicitStabilityLimit(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+                              LaplacianWeights weights = LaplacianWeights::Cotangent,
+                              MassType mass = MassType::MixedVoronoi);
+
+/** Volume enclosed by a closed, consistently oriented mesh (divergence theorem; positive for
+ *  outward faces). */
+double enclosedVolume(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+
+/** Sum of the triangle areas. */
+double surfaceArea(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+
+/**
+ * The same as a mesh processor with pcl::MeshProcessing's shape (without its VTK dependency):
+ * setInputMesh, setters, process(output). The output is the input mesh with new x, y, z (in the
+ * input's field types; every other field and the polygons kept).
+ */
+class MeshSmoothing {
+ public:
+  void setInputMesh(const pcl::PolygonMeshConstPtr& mesh) { input_ = mesh; }
+  pcl::PolygonMeshConstPtr getInputMesh() const { return input_; }
+
+  void setParameters(const MeshSmoothingParameters& parameters) { parameters_ = parameters; }
+  const MeshSmoothingParameters& getParameters() const { return parameters_; }
+  void setScheme(SmoothingScheme scheme) { parameters_.scheme = scheme; }
+  void setWeights(LaplacianWeights weights) { parameters_.weights = weights; }
+  void setMassType(MassType mass) { parameters_.mass = mass; }
+  void setTimeStep(double tau) { parameters_.time_step = tau; }
+  void setNumberOfIterations(int iterations) { parameters_.iterations = iterations; }
+  void setWeightUpdate(WeightUpdate update) { parameters_.weight_update = update; }
+  void setBoundaryCondition(BoundaryCondition boundary) { parameters_.boundary = boundary; }
+  void setShrinkageCorrection(ShrinkageCorrection correction) {
+    parameters_.shrinkage = correction;
+  }
+  void setSolver(CholeskyBackend solver) { parameters_.solver = solver; }
+  void setProgressCallback(SmoothingProgress progress) { progress_ = std::move(progress); }
+
+  /** Throws as smoothMeshPositions; output is untouched on failure. */
+  void process(pcl::PolygonMesh& output);
+
+  const MeshSmoothingReport& getReport() const { return report_; }
+
+ private:
+  pcl::PolygonMeshConstPtr input_;
+  MeshSmoothingParameters parameters_;
+  SmoothingProgress progress_;
+  MeshSmoothingReport report_;
+};
+
+}  // namespace pcl_ddg

@@ -1,0 +1,111 @@
+#include "pcl_ddg/operators/sparse_cholesky.h"
+
+#include <pcl/exceptions.h>
+
+#include <Eigen/SparseCholesky>
+
+#ifdef PCL_DDG_HAVE_CHOLMOD
+#include <Eigen/CholmodSupport>
+#endif
+
+namespace pcl_ddg {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+struct SparseCholesky::Backend {
+  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> simplicial;
+#ifdef PCL_DDG_HAVE_CHOLMOD
+  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholmod;
+#endif
+};
+
+bool cholmodAvailable() {
+#ifdef PCL_DDG_HAVE_CHOLMOD
+  return true;
+#else
+  return false;
+#endif
+}
+
+const char* toString(CholeskyBackend backend) {
+  switch (backend) {
+    case CholeskyBackend::Automatic:
+      return "automatic";
+    case CholeskyBackend::Cholmod:
+      return "CHOLMOD";
+    case CholeskyBackend::SimplicialLDLT:
+      return "SimplicialLDLT";
+  }
+  return "?";
+}
+
+SparseCholesky::SparseCholesky(CholeskyBackend backend)
+    : backend_(backend), impl_(std::make_unique<Backend>()) {
+  if (backend_ == CholeskyBackend::Automatic) {
+    backend_ = cholmodAvailable() ? CholeskyBackend::Cholmod : CholeskyBackend::SimplicialLDLT;
+  }
+  if (backend_ == CholeskyBackend::Cholmod && !cholmodAvailable()) {
+    throw pcl::BadArgumentException(
+        "pcl_ddg was built without CHOLMOD (install libsuitesparse-dev)");
+  }
+#ifdef PCL_DDG_HAVE_CHOLMOD
+  // A matrix that is not positive definite is reported by exception, not printed by CHOLMOD.
+  impl_->cholmod.cholmod().print = 0;
+#endif
+}
+
+SparseCholesky::~SparseCholesky() = default;
+
+void SparseCholesky::analyzePattern(const SparseMatrix& matrix) {
+#ifdef PCL_DDG_HAVE_CHOLMOD
+  if (backend_ == CholeskyBackend::Cholmod) {
+    impl_->cholmod.analyzePattern(matrix);
+  } else
+#endif
+  {
+    impl_->simplicial.analyzePattern(matrix);
+  }
+  analysed_ = true;
+  factorised_ = false;
+}
+
+void SparseCholesky::factorize(const SparseMatrix& matrix) {
+  if (!analysed_) analyzePattern(matrix);
+  Eigen::ComputationInfo info;
+#ifdef PCL_DDG_HAVE_CHOLMOD
+  if (backend_ == CholeskyBackend::Cholmod) {
+    impl_->cholmod.factorize(matrix);
+    info = impl_->cholmod.info();
+  } else
+#endif
+  {
+    impl_->simplicial.factorize(matrix);
+    info = impl_->simplicial.info();
+    // LDLT also factorises indefinite matrices: positive definite means a positive diagonal D.
+    if (info == Eigen::Success && !(impl_->simplicial.vectorD().minCoeff() > 0.0)) {
+      info = Eigen::NumericalIssue;
+    }
+  }
+  factorised_ = info == Eigen::Success;
+  if (!factorised_) {
+    throw pcl::ComputeFailedException(std::string(toString(backend_)) +
+                                      ": the matrix is not positive definite");
+  }
+}
+
+void SparseCholesky::compute(const SparseMatrix& matrix) {
+  analyzePattern(matrix);
+  factorize(matrix);
+}
+
+Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
+  if (!factorised_) {
+    throw pcl::ComputeFailedException("solve() before a successful factorize()");
+  }
+#ifdef PCL_DDG_HAVE_CHOLMOD
+  if (backend_ == CholeskyBackend::Cholmod) return impl_->cholmod.solve(rhs);
+#endif
+  return impl_->simplicial.solve(rhs);
+}
+
+}  // namespace pcl_ddg

@@ -1,0 +1,62 @@
+#pragma once
+// Time steps of the Laplacian flow dX/dt = M^-1 L X of per-vertex values (n x c: positions as three
+// columns, or scalar fields), the engine under mesh and scalar-field smoothing.
+//
+//   explicit (forward Euler)   X <- X + tau M^-1 L X
+//   implicit (backward Euler)  (M - tau L) X' = M X       (symmetric positive definite)
+//
+// Constrained vertices (fixed boundary, and vertices of zero mass: isolated, or only on degenerate
+// triangles) keep their values; the implicit system is solved for the free vertices only, with
+// the constrained values moved to the right-hand side. The system's pattern is analysed once; a
+// new operator (same mesh, new values) or a new tau only refactorises.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "pcl_ddg/operators/sparse_cholesky.h"
+
+namespace pcl_ddg {
+namespace detail {
+
+class LaplacianFlow {
+ public:
+  /** fixed[v] != 0 keeps vertex v's values (empty: none fixed by the caller). */
+  LaplacianFlow(int num_vertices, std::vector<char> fixed, CholeskyBackend backend);
+
+  /** The summed (symmetric, negative semi-definite) Laplacian and the lumped masses. */
+  void setOperator(Eigen::SparseMatrix<double> laplacian, Eigen::VectorXd mass);
+
+  void explicitStep(Eigen::MatrixXd& values, double tau) const;
+
+  /** Throws pcl::ComputeFailedException when (M - tau L) on the free vertices is not positive
+   *  definite (a free vertex without mass and without edges). */
+  void implicitStep(Eigen::MatrixXd& values, double tau);
+
+  CholeskyBackend backend() const { return solver_.backend(); }
+  int numFree() const { return static_cast<int>(free_vertices_.size()); }
+
+ private:
+  void chooseFreeVertices();
+  void buildSystemPattern();
+  void fillSystem(double tau);
+
+  int num_vertices_;
+  std::vector<char> fixed_;
+  Eigen::SparseMatrix<double> laplacian_;
+  Eigen::VectorXd mass_;
+  bool have_free_set_ = false;
+  std::vector<int> free_vertices_;  ///< compact index -> vertex
+  std::vector<int> compact_;        ///< vertex -> compact index, or -1 if constrained
+
+  // (M - tau L) restricted to the free vertices, and for each of its entries the entry of L it
+  // comes from (the pattern is fixed, so refilling is a gather).
+  Eigen::SparseMatrix<double> system_;
+  std::vector<int> source_entry_;
+  std::vector<int> diagonal_entry_;  ///< per free vertex: its diagonal entry in system_
+  SparseCholesky solver_;
+  bool pattern_analysed_ = false, factor_current_ = false;
+  double factor_tau_ = 0.0;
+};
+
+}  // namespace detail
+}  // namespace pcl_ddg

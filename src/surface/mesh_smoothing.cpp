@@ -1,0 +1,176 @@
+#include "pcl_ddg/surface/mesh_smoothing.h"
+
+#include <pcl/exceptions.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "laplacian_flow.h"
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+
+namespace pcl_ddg {
+namespace {
+
+[[noreturn]] void badArgument(const std::string& what) {
+  throw pcl::BadArgumentException(what);
+}
+
+[[noreturn]] void failedAt(int iteration, const std::string& what) {
+  throw pcl::ComputeFailedException("smoothing iteration " + std::to_string(iteration) + ": " +
+                                    what);
+}
+
+bool isClosedAndOriented(const MeshTopology& topology) {
+  const TopologyCounts& counts = topology.counts();
+  return counts.boundary_edges == 0 && counts.nonmanifold_edges == 0 &&
+         counts.consistently_oriented && topology.numTriangles() > 0;
+}
+
+// Area-weighted centroid of the triangles: the point the shrinkage correction scales about.
+Eigen::Vector3d surfaceCentroid(const MeshTopology& topology, const Eigen::Matrix3Xd& x) {
+  Eigen::Vector3d weighted = Eigen::Vector3d::Zero();
+  double area = 0.0;
+  const Eigen::Matrix3Xi& t = topology.triangles();
+  for (Eigen::Index f = 0; f < t.cols(); ++f) {
+    const Eigen::Vector3d a = x.col(t(0, f)), b = x.col(t(1, f)), c = x.col(t(2, f));
+    const double triangle_area = 0.5 * (b - a).cross(c - a).norm();
+    weighted += triangle_area * (a + b + c) / 3.0;
+    area += triangle_area;
+  }
+  return area > 0.0 ? Eigen::Vector3d(weighted / area) : Eigen::Vector3d(x.rowwise().mean());
+}
+
+}  // namespace
+
+double explicitStabilityLimit(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+                              LaplacianWeights weights, MassType mass) {
+  const Eigen::SparseMatrix<double> l = laplacian(topology, positions, weights);
+  const Eigen::VectorXd m = lumpedMass(topology, positions, mass);
+  double largest = 0.0;  // max_i sum_j |L_ij| / m_i (L is symmetric: columns are rows)
+  for (Eigen::Index v = 0; v < l.outerSize(); ++v) {
+    if (!(m[v] > 0.0)) continue;
+    double row = 0.0;
+    for (Eigen::SparseMatrix<double>::InnerIterator it(l, v); it; ++it) row += std::abs(it.value());
+    largest = std::max(largest, row / m[v]);
+  }
+  return largest > 0.0 ? 2.0 / largest : std::numeric_limits<double>::infinity();
+}
+
+double enclosedVolume(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+  // Tetrahedra to a point near the surface, so that scans far from the origin lose no digits.
+  const Eigen::Vector3d origin = positions.rowwise().mean();
+  const Eigen::Matrix3Xi& t = topology.triangles();
+  double six_volume = 0.0;
+  for (Eigen::Index f = 0; f < t.cols(); ++f) {
+    const Eigen::Vector3d a = positions.col(t(0, f)) - origin, b = positions.col(t(1, f)) - origin,
+                          c = positions.col(t(2, f)) - origin;
+    six_volume += a.dot(b.cross(c));
+  }
+  return six_volume / 6.0;
+}
+
+double surfaceArea(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+  const Eigen::Matrix3Xi& t = topology.triangles();
+  double area = 0.0;
+  for (Eigen::Index f = 0; f < t.cols(); ++f) {
+    const Eigen::Vector3d a = positions.col(t(0, f));
+    area += 0.5 * (positions.col(t(1, f)) - a).cross(positions.col(t(2, f)) - a).norm();
+  }
+  return area;
+}
+
+Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
+                                     const Eigen::Matrix3Xd& positions,
+                                     const MeshSmoothingParameters& p, MeshSmoothingReport* report,
+                                     const SmoothingProgress& progress) {
+  const int n = topology.numVertices();
+  if (n == 0 || topology.numTriangles() == 0) throw InvalidMeshException("mesh has no triangles");
+  if (positions.cols() != n) throw InvalidMeshException("positions do not match the mesh");
+  requireFinite(positions);
+  if (!(p.time_step > 0.0) || !std::isfinite(p.time_step)) badArgument("time step must be > 0");
+  if (p.iterations < 1) badArgument("iterations must be at least 1");
+  if (p.shrinkage != ShrinkageCorrection::None && p.boundary == BoundaryCondition::Fixed) {
+    badArgument("a shrinkage correction rescales the whole mesh: it cannot keep a fixed boundary");
+  }
+  if (p.shrinkage == ShrinkageCorrection::PreserveVolume && !isClosedAndOriented(topology)) {
+    badArgument("volume preservation needs a closed, consistently oriented mesh");
+  }
+
+  std::vector<char> fixed(n, 0);
+  if (p.boundary == BoundaryCondition::Fixed) {
+    for (int v = 0; v < n; ++v) fixed[v] = topology.isBoundary(v);
+  }
+  detail::LaplacianFlow flow(n, std::move(fixed), p.solver);
+  const auto setOperator = [&](const Eigen::Matrix3Xd& at) {
+    flow.setOperator(laplacian(topology, at, p.weights, LaplacianForm::Summed),
+                     lumpedMass(topology, at, p.mass));
+  };
+
+  MeshSmoothingReport r;
+  r.solver = flow.backend();
+  r.area_before = surfaceArea(topology, positions);
+  if (isClosedAndOriented(topology)) r.volume_before = enclosedVolume(topology, positions);
+
+  Eigen::Matrix3Xd current = positions;
+  Eigen::MatrixXd values = positions.transpose();  // one column per coordinate
+  setOperator(current);
+  r.fixed_vertices = n - flow.numFree();
+  for (int iteration = 1; iteration <= p.iterations; ++iteration) {
+    if (iteration > 1 && p.weight_update == WeightUpdate::EveryIteration) setOperator(current);
+    if (p.scheme == SmoothingScheme::Explicit) {
+      flow.explicitStep(values, p.time_step);
+    } else {
+      try {
+        flow.implicitStep(values, p.time_step);
+      } catch (const pcl::ComputeFailedException& e) {
+        failedAt(iteration, e.what());
+      }
+    }
+    current = values.transpose();
+    if (!current.allFinite()) {
+      failedAt(iteration, p.scheme == SmoothingScheme::Explicit
+                              ? "non-finite positions (the explicit step is unstable: use a "
+                                "smaller time step or the implicit scheme)"
+                              : "non-finite positions");
+    }
+    if (p.shrinkage != ShrinkageCorrection::None) {
+      double scale;
+      if (p.shrinkage == ShrinkageCorrection::PreserveVolume) {
+        const double volume = enclosedVolume(topology, current);
+        if (!(volume * r.volume_before > 0.0)) failedAt(iteration, "the volume vanished");
+        scale = std::cbrt(r.volume_before / volume);
+      } else {
+        const double area = surfaceArea(topology, current);
+        if (!(area > 0.0)) failedAt(iteration, "the area vanished");
+        scale = std::sqrt(r.area_before / area);
+      }
+      const Eigen::Vector3d centre = surfaceCentroid(topology, current);
+      current = ((current.colwise() - centre) * scale).colwise() + centre;
+      values = current.transpose();
+    }
+    r.iterations = iteration;
+    if (progress) progress(iteration, p.iterations);
+  }
+  r.area_after = surfaceArea(topology, current);
+  if (isClosedAndOriented(topology)) r.volume_after = enclosedVolume(topology, current);
+  if (report) *report = r;
+  return current;
+}
+
+void MeshSmoothing::process(pcl::PolygonMesh& output) {
+  if (!input_) {
+    throw pcl::BadArgumentException("no input mesh");
+  }
+  const MeshTopology topology(*input_);
+  const Eigen::Matrix3Xd smoothed = smoothMeshPositions(topology, vertexPositions(input_->cloud),
+                                                        parameters_, &report_, progress_);
+  pcl::PolygonMesh result = *input_;
+  setVertexPositions(result.cloud, smoothed);
+  output = std::move(result);
+}
+
+}  // namespace pcl_ddg

@@ -1,0 +1,368 @@
+// Mesh smoothing: stability of the two schemes, noise removal on a sphere, shrinkage correction,
+// planes and fixed boundaries, the classic explicit-vs-implicit comparison on cow.off, solver
+// agreement, and the error policy.
+#include <gtest/gtest.h>
+#include <pcl/exceptions.h>
+
+#include <Eigen/SparseCholesky>
+#include <cmath>
+#include <random>
+
+#include "analytic_surfaces.h"
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/mesh_geometry.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/surface/mesh_smoothing.h"
+#include "test_data.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+MeshTopology topologyOf(const SurfaceSample& s) {
+  return MeshTopology(static_cast<int>(s.points.cols()), s.triangles);
+}
+
+double squaredEdge(const MeshTopology& topology, const Eigen::Matrix3Xd& x) {
+  const double h = meanEdgeLength(topology, x);
+  return h * h;
+}
+
+// RMS distance of the vertices to the unit sphere about the origin.
+double rmsDistanceToUnitSphere(const Eigen::Matrix3Xd& x) {
+  return std::sqrt((x.colwise().norm().array() - 1.0).square().mean());
+}
+
+// A unit icosphere with radial noise of sigma * h (h = mean edge length).
+Eigen::Matrix3Xd noisySphere(const SurfaceSample& sphere, double sigma, std::uint32_t seed) {
+  const MeshTopology topology = topologyOf(sphere);
+  const double h = meanEdgeLength(topology, sphere.points);
+  std::mt19937 random(seed);
+  std::normal_distribution<double> noise(0.0, sigma * h);
+  Eigen::Matrix3Xd x = sphere.points;
+  for (Eigen::Index v = 0; v < x.cols(); ++v) x.col(v) *= 1.0 + noise(random);
+  return x;
+}
+
+TEST(MeshSmoothing, ExplicitLargeStepBlowsUpWhileImplicitWithTheSameStepStaysBounded) {
+  const SurfaceSample sphere = makeIcosphere(3);
+  const MeshTopology topology = topologyOf(sphere);
+  const Eigen::Matrix3Xd noisy = noisySphere(sphere, 0.05, 11);
+  const double limit = explicitStabilityLimit(topology, noisy);
+  const double h2 = squaredEdge(topology, noisy);
+  std::printf("explicit stability bound: %.3f h^2\n", limit / h2);
+  MeshSmoothingParameters p;
+  p.time_step = 10.0 * limit;
+  p.iterations = 8;
+  p.weight_update = WeightUpdate::Frozen;
+
+  p.scheme = SmoothingScheme::Explicit;
+  const double explicit_radius =
+      smoothMeshPositions(topology, noisy, p).colwise().norm().maxCoeff();
+  p.scheme = SmoothingScheme::Implicit;
+  const double implicit_radius =
+      smoothMeshPositions(topology, noisy, p).colwise().norm().maxCoeff();
+  const double input_radius = noisy.colwise().norm().maxCoeff();
+  std::printf("8 steps of %.2f h^2: explicit max radius %.3g, implicit %.6f (input %.6f)\n",
+              p.time_step / h2, explicit_radius, implicit_radius, input_radius);
+  EXPECT_GT(explicit_radius, 1e3) << "documented: explicit steps above the limit amplify noise";
+  // Backward Euler with positive weights is a convex combination: no vertex leaves the ball.
+  EXPECT_LE(implicit_radius, input_radius + 1e-12);
+  EXPECT_GT(implicit_radius, 0.2) << "shrunk (as Laplacian flow does), not collapsed";
+
+  // Below the bound the explicit scheme is stable (and the bound is not absurdly pessimistic).
+  p.scheme = SmoothingScheme::Explicit;
+  p.time_step = limit;
+  p.iterations = 50;
+  EXPECT_LE(smoothMeshPositions(topology, noisy, p).colwise().norm().maxCoeff(), input_radius);
+  EXPECT_GT(limit, 0.01 * h2);
+
+  // Run long enough above it, the explicit flow overflows: an exception naming the iteration.
+  p.time_step = 10.0 * limit;
+  p.iterations = 1000;
+  try {
+    smoothMeshPositions(topology, noisy, p);
+    FAIL() << "expected a ComputeFailedException";
+  } catch (const pcl::ComputeFailedException& e) {
+    EXPECT_NE(std::string(e.what()).find("iteration"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("explicit"), std::string::npos) << e.what();
+  }
+}
+
+TEST(MeshSmoothing, SmoothingANoisySphereBringsItCloserToTheSphereInTheFirstSteps) {
+  const SurfaceSample sphere = makeIcosphere(4);
+  const MeshTopology topology = topologyOf(sphere);
+  const Eigen::Matrix3Xd noisy = noisySphere(sphere, 0.2, 7);
+  const double h2 = squaredEdge(topology, noisy);
+  for (const SmoothingScheme scheme : {SmoothingScheme::Explicit, SmoothingScheme::Implicit}) {
+    for (const LaplacianWeights weights :
+         {LaplacianWeights::Cotangent, LaplacianWeights::Uniform}) {
+      MeshSmoothingParameters p;
+      p.scheme = scheme;
+      p.weights = weights;
+      p.time_step = scheme == SmoothingScheme::Explicit
+                        ? 0.5 * explicitStabilityLimit(topology, noisy, weights)
+                        : 0.1 * h2;
+      const double initial = rmsDistanceToUnitSphere(noisy);
+      const Eigen::Matrix3Xd once = smoothMeshPositions(topology, noisy, p);
+      const Eigen::Matrix3Xd twice = smoothMeshPositions(topology, once, p);
+      const double after_one = rmsDistanceToUnitSphere(once),
+                   after_two = rmsDistanceToUnitSphere(twice);
+      std::printf("%s %s (tau %.3f h^2): RMS distance to the sphere %.3e -> %.3e -> %.3e\n",
+                  scheme == SmoothingScheme::Explicit ? "explicit" : "implicit",
+                  weights == LaplacianWeights::Cotangent ? "cotan" : "uniform", p.time_step / h2,
+                  initial, after_one, after_two);
+      EXPECT_LT(after_one, 0.85 * initial);
+      EXPECT_LT(after_two, after_one);
+    }
+  }
+}
+
+TEST(MeshSmoothing, VolumeAndAreaArePreservedWhenAsked) {
+  const SurfaceSample sphere = makeIcosphere(3);
+  const MeshTopology topology = topologyOf(sphere);
+  const Eigen::Matrix3Xd noisy = noisySphere(sphere, 0.1, 3);
+  MeshSmoothingParameters p;
+  p.time_step = 1.0 * squaredEdge(topology, noisy);
+  p.iterations = 5;
+  const double volume = enclosedVolume(topology, noisy), area = surfaceArea(topology, noisy);
+
+  MeshSmoothingReport plain;
+  smoothMeshPositions(topology, noisy, p, &plain);
+  EXPECT_LT(plain.volume_after, 0.9 * volume) << "without correction the flow shrinks";
+
+  p.shrinkage = ShrinkageCorrection::PreserveVolume;
+  const Eigen::Matrix3Xd kept = smoothMeshPositions(topology, noisy, p);
+  EXPECT_NEAR(enclosedVolume(topology, kept) / volume, 1.0, 1e-9);
+  EXPECT_LT(rmsDistanceToUnitSphere(kept), rmsDistanceToUnitSphere(noisy));
+
+  p.shrinkage = ShrinkageCorrection::PreserveArea;
+  const Eigen::Matrix3Xd same_area = smoothMeshPositions(topology, noisy, p);
+  EXPECT_NEAR(surfaceArea(topology, same_area) / area, 1.0, 1e-9);
+
+  // Far from the origin the correction is just as exact (tetrahedra to a nearby point).
+  Eigen::Matrix3Xd far = noisy.colwise() + Eigen::Vector3d(1e5, -2e5, 3e5);
+  p.shrinkage = ShrinkageCorrection::PreserveVolume;
+  const Eigen::Matrix3Xd kept_far = smoothMeshPositions(topology, far, p);
+  EXPECT_NEAR(enclosedVolume(topology, kept_far) / enclosedVolume(topology, far), 1.0, 1e-9);
+}
+
+TEST(MeshSmoothing, APlaneStaysAPlane) {
+  SurfaceSample plane = makePlane({16, 0.2, 5});
+  plane.rotateAndShiftFar();
+  const MeshTopology topology = topologyOf(plane);
+  const Eigen::Vector3d normal = plane.normals.col(0);
+  const Eigen::Vector3d on_plane = plane.points.col(0);
+  for (const SmoothingScheme scheme : {SmoothingScheme::Explicit, SmoothingScheme::Implicit}) {
+    for (const LaplacianWeights weights :
+         {LaplacianWeights::Cotangent, LaplacianWeights::Uniform}) {
+      MeshSmoothingParameters p;
+      p.scheme = scheme;
+      p.weights = weights;
+      p.time_step = scheme == SmoothingScheme::Explicit
+                        ? 0.9 * explicitStabilityLimit(topology, plane.points, weights)
+                        : 0.5 * squaredEdge(topology, plane.points);
+      p.iterations = 3;
+      const Eigen::Matrix3Xd x = smoothMeshPositions(topology, plane.points, p);
+      const double off_plane =
+          (normal.transpose() * (x.colwise() - on_plane)).cwiseAbs().maxCoeff();
+      // Coordinates are ~1e5 (double resolves 1.5e-11 there): flat to 1e-13 of them.
+      EXPECT_LT(off_plane, 1e-8) << "a 2-unit plane 1e5 from the origin";
+      EXPECT_GT((x - plane.points).norm(), 1e-3) << "it did move (within the plane)";
+    }
+  }
+}
+
+TEST(MeshSmoothing, FixedBoundaryVerticesDoNotMove) {
+  const SurfaceSample patch = makeSaddle({12, 0.2, 2});
+  const MeshTopology topology = topologyOf(patch);
+  for (const SmoothingScheme scheme : {SmoothingScheme::Explicit, SmoothingScheme::Implicit}) {
+    MeshSmoothingParameters p;
+    p.scheme = scheme;
+    p.boundary = BoundaryCondition::Fixed;
+    p.time_step = scheme == SmoothingScheme::Explicit
+                      ? 0.9 * explicitStabilityLimit(topology, patch.points)
+                      : 1.0 * squaredEdge(topology, patch.points);
+    p.iterations = 5;
+    MeshSmoothingReport report;
+    const Eigen::Matrix3Xd x = smoothMeshPositions(topology, patch.points, p, &report);
+    int boundary = 0;
+    for (int v = 0; v < topology.numVertices(); ++v) {
+      if (topology.isBoundary(v)) {
+        ++boundary;
+        EXPECT_EQ(x.col(v), patch.points.col(v)) << "boundary vertex " << v << " moved";
+      } else {
+        EXPECT_GT((x.col(v) - patch.points.col(v)).norm(), 0.0) << "interior vertex " << v;
+      }
+    }
+    EXPECT_EQ(report.fixed_vertices, boundary);
+    EXPECT_EQ(boundary, 4 * 12);
+  }
+}
+
+TEST(MeshSmoothing, CowExplicitManySmallStepsAndImplicitOneLargeStepGiveComparableShapes) {
+  // The classic comparison (libigl tutorial 205 uses this mesh): 1000 explicit steps of 0.001 h^2
+  // (below the stability limit, about 0.002 h^2 on this mesh) against one implicit step of h^2,
+  // with the operator of the input (frozen). Measured: each moves the vertices by 0.86% / 0.72% of
+  // the bounding-box diagonal (RMS), and they differ by 0.15%: backward Euler damps the
+  // intermediate frequencies a little less than the exact flow does.
+  const pcl::PolygonMesh mesh = loadMesh(sharedData("meshes/cow.off"));
+  const MeshTopology topology(mesh);
+  const Eigen::Matrix3Xd x = vertexPositions(mesh.cloud);
+  const double h2 = squaredEdge(topology, x);
+  const double diagonal = boundingBox(x).diagonal().norm();
+  const auto rms = [&](const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+    return std::sqrt((a - b).colwise().squaredNorm().mean()) / diagonal;
+  };
+
+  MeshSmoothingParameters small_steps;
+  small_steps.scheme = SmoothingScheme::Explicit;
+  small_steps.weight_update = WeightUpdate::Frozen;
+  small_steps.time_step = 0.001 * h2;
+  small_steps.iterations = 1000;
+  MeshSmoothingParameters one_step = small_steps;
+  one_step.scheme = SmoothingScheme::Implicit;
+  one_step.time_step = 1.0 * h2;
+  one_step.iterations = 1;
+
+  const Eigen::Matrix3Xd explicit_result = smoothMeshPositions(topology, x, small_steps);
+  const Eigen::Matrix3Xd implicit_result = smoothMeshPositions(topology, x, one_step);
+  const double moved_explicit = rms(explicit_result, x), moved_implicit = rms(implicit_result, x);
+  const double difference = rms(explicit_result, implicit_result);
+  std::printf("cow: explicit moved %.4f%%, implicit %.4f%%, difference %.4f%% of the diagonal\n",
+              100 * moved_explicit, 100 * moved_implicit, 100 * difference);
+  EXPECT_GT(moved_implicit, 0.005);
+  EXPECT_LT(difference, 0.25 * moved_implicit);
+  EXPECT_LT(difference, 0.003);
+}
+
+TEST(MeshSmoothing, FrozenImplicitStepsAreTheBackwardEulerOperatorAndBothSolversAgree) {
+  const SurfaceSample torus = makeTorus({24, 0.2, 4});
+  const MeshTopology topology = topologyOf(torus);
+  MeshSmoothingParameters p;
+  p.time_step = 0.5 * squaredEdge(topology, torus.points);
+  p.iterations = 3;
+  p.weight_update = WeightUpdate::Frozen;
+
+  // Reference: (M - tau L) x' = M x three times, by a dense-free independent Eigen LLT.
+  const Eigen::SparseMatrix<double> l = laplacian(topology, torus.points);
+  const Eigen::VectorXd m = lumpedMass(topology, torus.points);
+  Eigen::SparseMatrix<double> system = -p.time_step * l;
+  for (int v = 0; v < topology.numVertices(); ++v) system.coeffRef(v, v) += m[v];
+  const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> reference_solver(system);
+  Eigen::MatrixXd reference = torus.points.transpose();
+  for (int i = 0; i < p.iterations; ++i) {
+    const Eigen::MatrixXd rhs = m.asDiagonal() * reference;
+    reference = reference_solver.solve(rhs);
+  }
+
+  p.solver = CholeskyBackend::SimplicialLDLT;
+  const Eigen::Matrix3Xd simplicial = smoothMeshPositions(topology, torus.points, p);
+  EXPECT_LT((simplicial - reference.transpose()).cwiseAbs().maxCoeff(), 1e-12);
+  if (cholmodAvailable()) {
+    p.solver = CholeskyBackend::Cholmod;
+    MeshSmoothingReport report;
+    const Eigen::Matrix3Xd cholmod = smoothMeshPositions(topology, torus.points, p, &report);
+    EXPECT_EQ(report.solver, CholeskyBackend::Cholmod);
+    EXPECT_LT((cholmod - simplicial).cwiseAbs().maxCoeff(), 1e-12);
+  }
+}
+
+TEST(MeshSmoothing, IsolatedVerticesStayAndADegenerateFaceDoesNoHarm) {
+  // A square of two triangles, a sliver glued to one edge (zero area), and an isolated vertex.
+  Eigen::Matrix3Xd x(3, 6);
+  x << 0, 1, 1, 0, 0.5, 7,  //
+      0, 0, 1, 1, 0, 7,     //
+      0, 0, 0.3, 0, 0, 7;
+  const MeshTopology topology(6, std::vector<pcl::Vertices>{[] {
+                                                              pcl::Vertices a;
+                                                              a.vertices = {0, 1, 2};
+                                                              return a;
+                                                            }(),
+                                                            [] {
+                                                              pcl::Vertices b;
+                                                              b.vertices = {0, 2, 3};
+                                                              return b;
+                                                            }(),
+                                                            [] {
+                                                              pcl::Vertices c;
+                                                              c.vertices = {0, 4, 1};
+                                                              return c;
+                                                            }()});
+  for (const SmoothingScheme scheme : {SmoothingScheme::Explicit, SmoothingScheme::Implicit}) {
+    MeshSmoothingParameters p;
+    p.scheme = scheme;
+    p.time_step = 0.05;
+    p.iterations = 3;
+    const Eigen::Matrix3Xd y = smoothMeshPositions(topology, x, p);
+    EXPECT_TRUE(y.allFinite());
+    EXPECT_EQ(y.col(5), x.col(5)) << "isolated vertex";
+    EXPECT_EQ(y.col(4), x.col(4)) << "a vertex only on a zero-area triangle has no mass: it stays";
+    EXPECT_NE(y.col(2), x.col(2));
+  }
+}
+
+TEST(MeshSmoothing, BadInputAndParametersAreRejectedAndTheInputIsNeverModified) {
+  const SurfaceSample sphere = makeIcosphere(2);
+  const MeshTopology topology = topologyOf(sphere);
+  MeshSmoothingParameters p;
+  p.time_step = 0.01;
+  EXPECT_THROW(
+      smoothMeshPositions(MeshTopology(0, Eigen::Matrix3Xi(3, 0)), Eigen::Matrix3Xd(3, 0), p),
+      InvalidMeshException);
+  Eigen::Matrix3Xd with_nan = sphere.points;
+  with_nan(1, 7) = std::nan("");
+  EXPECT_THROW(smoothMeshPositions(topology, with_nan, p), InvalidMeshException);
+  EXPECT_THROW(smoothMeshPositions(topology, sphere.points.leftCols(5), p), InvalidMeshException);
+
+  MeshSmoothingParameters bad = p;
+  bad.time_step = 0.0;
+  EXPECT_THROW(smoothMeshPositions(topology, sphere.points, bad), pcl::BadArgumentException);
+  bad = p;
+  bad.iterations = 0;
+  EXPECT_THROW(smoothMeshPositions(topology, sphere.points, bad), pcl::BadArgumentException);
+  bad = p;
+  bad.shrinkage = ShrinkageCorrection::PreserveArea;
+  bad.boundary = BoundaryCondition::Fixed;
+  EXPECT_THROW(smoothMeshPositions(topology, sphere.points, bad), pcl::BadArgumentException);
+  const SurfaceSample open = makePlane({4, 0.0, 1});
+  bad = p;
+  bad.shrinkage = ShrinkageCorrection::PreserveVolume;
+  EXPECT_THROW(smoothMeshPositions(topologyOf(open), open.points, bad), pcl::BadArgumentException);
+
+  // The processor: a failing run leaves its output exactly as it was.
+  auto input = std::make_shared<pcl::PolygonMesh>(makeMesh(sphere.points, [&] {
+    std::vector<std::vector<int>> faces;
+    for (Eigen::Index t = 0; t < sphere.triangles.cols(); ++t) {
+      faces.push_back({sphere.triangles(0, t), sphere.triangles(1, t), sphere.triangles(2, t)});
+    }
+    return faces;
+  }()));
+  const pcl::PolygonMesh original = *input;
+  MeshSmoothing smoothing;
+  smoothing.setInputMesh(input);
+  smoothing.setScheme(SmoothingScheme::Explicit);
+  smoothing.setWeightUpdate(WeightUpdate::Frozen);
+  smoothing.setTimeStep(10.0);
+  smoothing.setNumberOfIterations(1000);
+  pcl::PolygonMesh output;
+  output.header.frame_id = "untouched";
+  EXPECT_THROW(smoothing.process(output), pcl::ComputeFailedException);
+  EXPECT_EQ(output.header.frame_id, "untouched");
+  EXPECT_TRUE(output.polygons.empty());
+  EXPECT_EQ(input->cloud.data, original.cloud.data);
+
+  smoothing.setScheme(SmoothingScheme::Implicit);
+  smoothing.setTimeStep(0.01);
+  smoothing.setNumberOfIterations(2);
+  smoothing.process(output);
+  EXPECT_EQ(output.polygons.size(), original.polygons.size());
+  EXPECT_EQ(output.cloud.fields.size(), original.cloud.fields.size());
+  EXPECT_NE(output.cloud.data, original.cloud.data);
+  EXPECT_EQ(smoothing.getReport().iterations, 2);
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
