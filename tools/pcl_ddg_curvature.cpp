@@ -6,7 +6,9 @@
 #include "common/tool_common.h"
 #include "pcl_ddg/io/color_map.h"
 #include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/operators/curvature.h"
+#include "pcl_ddg/surface/scalar_field_smoothing.h"
 
 namespace {
 
@@ -17,12 +19,14 @@ constexpr const char* kDescription =
     "as vertex properties: -method cotan (mesh; cotangent Laplacian and angle defect, also "
     "vertex_area)\n"
     "or quadric (mesh or cloud; quadric fitted to each point's neighbours, also the k1 direction\n"
-    "k1_direction_x/y/z and the normal).";
+    "k1_direction_x/y/z and the normal). -smooth t first smooths the four curvature fields by the\n"
+    "implicit heat flow on the mesh for a time t in units of h^2 (h = mean edge length).";
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk,pcd} output.{ply,pcd} [-method cotan|quadric (default: cotan on "
     "meshes)]\n"
     "         [-area mixed|voronoi|barycentric (cotan)]\n"
     "         [-neighbours bfs|knn] [-k N (default 20)] [-radius r or 2.5h] (quadric)\n"
+    "         [-smooth t (heat flow time in h^2, meshes)]\n"
     "         [-color mean|gauss|k1|k2] [-percentile p (colour scale clamp, default 2)]\n"
     "         [-precision float|double]";
 
@@ -30,7 +34,8 @@ int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(
       argc, argv,
-      {"method", "area", "neighbours", "k", "radius", "color", "percentile", "precision"}, {});
+      {"method", "area", "neighbours", "k", "radius", "smooth", "color", "percentile", "precision"},
+      {});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
   const std::string color = args.choice("color", {"none", "mean", "gauss", "k1", "k2"}, "none");
@@ -99,6 +104,23 @@ int run(int argc, char** argv) {
     for (int d = 0; d < 3; ++d)
       setVertexField(in.mesh.cloud, names[d], direction.row(d).transpose(), precision);
     tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
+  }
+  if (args.has("smooth")) {
+    const double time = args.number("smooth", 0.0);
+    if (!(time > 0.0)) throw tools::UsageError("-smooth must be > 0");
+    if (!in.topology) throw tools::UsageError("-smooth needs a mesh; this input is a point cloud");
+    const double h = meanEdgeLength(*in.topology, in.positions);
+    HeatFlowParameters heat;
+    heat.diffusion_time = time * h * h;
+    Eigen::MatrixXd curvatures(mean.size(), 4);
+    curvatures << mean, gauss, kappa1, kappa2;
+    tools::Timer timer("Smoothing curvatures");
+    curvatures = smoothScalarFields(*in.topology, in.positions, curvatures, heat);
+    timer.done(static_cast<std::size_t>(mean.size()));
+    mean = curvatures.col(0);
+    gauss = curvatures.col(1);
+    kappa1 = curvatures.col(2);
+    kappa2 = curvatures.col(3);
   }
   const std::pair<const char*, const Eigen::VectorXd*> fields[] = {
       {"mean_curvature", &mean}, {"gauss_curvature", &gauss}, {"k1", &kappa1}, {"k2", &kappa2}};

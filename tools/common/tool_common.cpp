@@ -1,10 +1,13 @@
 #include "common/tool_common.h"
 
 #include <pcl/exceptions.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <utility>
 
 namespace pcl_ddg {
 namespace tools {
@@ -106,6 +109,24 @@ int runTool(const char* name, const char* description, const char* syntax,
     std::cerr << name << ": error: " << e.what() << "\n";
     return 1;
   }
+}
+
+ProgressBar::ProgressBar(std::string label)
+    : label_(std::move(label)), enabled_(isatty(fileno(stderr)) != 0) {}
+
+void ProgressBar::update(int done, int total) {
+  if (!enabled_ || total < 2) return;
+  constexpr int kWidth = 30;
+  const int filled = static_cast<int>(static_cast<long long>(kWidth) * done / total);
+  std::fprintf(stderr, "\r%s [%s%s] %d/%d", label_.c_str(), std::string(filled, '#').c_str(),
+               std::string(kWidth - filled, '.').c_str(), done, total);
+  std::fflush(stderr);
+  drawn_ = true;
+}
+
+void ProgressBar::finish() {
+  if (drawn_) std::fprintf(stderr, "\r%s \033[K", label_.c_str());
+  drawn_ = false;
 }
 
 Timer::Timer(const std::string& what) {

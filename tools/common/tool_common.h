@@ -52,6 +52,21 @@ class ToolArguments {
 int runTool(const char* name, const char* description, const char* syntax,
             const std::function<int()>& body);
 
+/** A progress bar on stderr for long loops, drawn over the current Timer line, and only when
+ *  stderr is a terminal (logs and pipes get the timing line alone). */
+class ProgressBar {
+ public:
+  explicit ProgressBar(std::string label);
+  void update(int done, int total);
+  /** Restores the label, so that the Timer's "[done, ...]" follows it. */
+  void finish();
+
+ private:
+  std::string label_;
+  bool enabled_;
+  bool drawn_ = false;
+};
+
 /** Prints "[done, 12 ms : 35947 points]" style lines, as PCL's tools do. */
 class Timer {
  public:

@@ -1,0 +1,177 @@
+// pcl_ddg_smooth, pcl_ddg_smooth_organized and pcl_ddg_curvature -smooth as a user runs them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "analytic_surfaces.h"
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/surface/mesh_smoothing.h"
+#include "test_data.h"
+#include "tool_runner.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+class SmoothingTools : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = scratchFolder(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+  std::string path(const std::string& name) const { return dir_ + "/" + name; }
+  void expectNoLeftovers() const {
+    for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+      EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+    }
+  }
+  std::string dir_;
+};
+
+pcl::PolygonMesh meshOf(const SurfaceSample& s) {
+  std::vector<std::vector<int>> faces;
+  for (Eigen::Index t = 0; t < s.triangles.cols(); ++t) {
+    faces.push_back({s.triangles(0, t), s.triangles(1, t), s.triangles(2, t)});
+  }
+  return makeMesh(s.points, faces);
+}
+
+TEST_F(SmoothingTools, SmoothSharedMeshesBothSchemesKeepTheMeshAndPreserveVolume) {
+  for (const char* file : {"cow.off", "bunny.off", "bun_zipper_res4.ply", "horse.ply"}) {
+    SCOPED_TRACE(file);
+    const std::string input = sharedData(std::string("meshes/") + file);
+    const pcl::PolygonMesh original = loadMesh(input);
+    const MeshTopology topology(original);
+    const Eigen::Matrix3Xd before = vertexPositions(original.cloud);
+    for (const char* options :
+         {"", "-method explicit -iterations 20", "-lambda_dt 5 -weights uniform"}) {
+      SCOPED_TRACE(options);
+      const ToolRun run =
+          runTool(PCL_DDG_SMOOTH_TOOL, input + " " + path("out.ply") + " " + options);
+      ASSERT_EQ(run.exit_code, 0) << run.err;
+      EXPECT_NE(run.err.find("Smoothing [done"), std::string::npos) << run.err;
+      const pcl::PolygonMesh out = loadMesh(path("out.ply"));
+      ASSERT_EQ(out.polygons.size(), original.polygons.size());
+      const Eigen::Matrix3Xd after = vertexPositions(out.cloud);
+      ASSERT_EQ(after.cols(), before.cols());
+      EXPECT_TRUE(after.allFinite());
+      EXPECT_GT((after - before).norm(), 0.0);
+    }
+    if (topology.counts().boundary_edges == 0) {
+      const ToolRun run = runTool(PCL_DDG_SMOOTH_TOOL, input + " " + path("vol.ply") +
+                                                           " -lambda_dt 3 -iterations 2 -preserve "
+                                                           "volume -precision double");
+      ASSERT_EQ(run.exit_code, 0) << run.err;
+      const Eigen::Matrix3Xd after = vertexPositions(loadMesh(path("vol.ply")).cloud);
+      EXPECT_NEAR(enclosedVolume(topology, after) / enclosedVolume(topology, before), 1.0, 1e-9);
+    }
+  }
+  expectNoLeftovers();
+}
+
+TEST_F(SmoothingTools, ExplicitStepsReportTheStabilityBoundAndWarnAboveIt) {
+  const std::string cow = sharedData("meshes/cow.off");
+  const ToolRun safe =
+      runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("a.ply") + " -method explicit");
+  ASSERT_EQ(safe.exit_code, 0) << safe.err;
+  EXPECT_NE(safe.err.find("stability bound"), std::string::npos) << safe.err;
+  EXPECT_EQ(safe.err.find("warning"), std::string::npos) << safe.err;
+  const ToolRun risky =
+      runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("b.ply") + " -method explicit -lambda_dt 1");
+  EXPECT_NE(risky.err.find("warning: the step exceeds the explicit stability bound"),
+            std::string::npos)
+      << risky.err;
+}
+
+TEST_F(SmoothingTools, BadInputAndOptionsGiveOneLineAndNoOutput) {
+  writeText(path("nan.obj"), "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n");
+  writeText(path("cloud.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+  writeText(path("garbage.ply"), "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1\n");
+  for (const char* input : {"nan.obj", "cloud.obj", "garbage.ply", "missing.off"}) {
+    SCOPED_TRACE(input);
+    const ToolRun run = runTool(PCL_DDG_SMOOTH_TOOL, path(input) + " " + path("out.ply"));
+    EXPECT_EQ(run.exit_code, 1);
+    EXPECT_NE(run.err.find("pcl_ddg_smooth: error: "), std::string::npos) << run.err;
+  }
+  const std::string cow = sharedData("meshes/cow.off");
+  for (const char* options : {"-method magic", "-lambda_dt 0", "-iterations 0", "-absolute_time",
+                              "-preserve mass", "-bogus"}) {
+    SCOPED_TRACE(options);
+    EXPECT_EQ(runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("out.ply") + " " + options).exit_code,
+              2);
+  }
+  // A volume correction on an open scan, or with a fixed boundary: one line, exit 2.
+  const ToolRun open = runTool(PCL_DDG_SMOOTH_TOOL, sharedData("meshes/bun_zipper.ply") + " " +
+                                                        path("out.ply") + " -preserve volume");
+  EXPECT_EQ(open.exit_code, 2);
+  EXPECT_NE(open.err.find("closed"), std::string::npos) << open.err;
+  EXPECT_EQ(
+      runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("out.ply") + " -preserve area -fix_boundary")
+          .exit_code,
+      2);
+  EXPECT_FALSE(std::filesystem::exists(path("out.ply")));
+  expectNoLeftovers();
+}
+
+TEST_F(SmoothingTools, OrganizedCloudKeepsItsGridHolesAndRays) {
+  const std::string input = sharedData("clouds/table_scene_mug_stereo_textured.pcd");
+  const ToolRun run =
+      runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL, input + " " + path("out.pcd") + " -lambda_dt 4");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const pcl::PolygonMesh before = loadMesh(input), after = loadMesh(path("out.pcd"));
+  EXPECT_EQ(after.cloud.width, 640u);
+  EXPECT_EQ(after.cloud.height, 480u);
+  EXPECT_EQ(after.cloud.fields.size(), before.cloud.fields.size()) << "rgb kept";
+  const Eigen::Matrix3Xd p = vertexPositions(before.cloud, NonFinitePolicy::Keep);
+  const Eigen::Matrix3Xd q = vertexPositions(after.cloud, NonFinitePolicy::Keep);
+  int moved = 0;
+  for (Eigen::Index i = 0; i < p.cols(); ++i) {
+    ASSERT_EQ(p.col(i).allFinite(), q.col(i).allFinite()) << "pixel " << i;
+    if (!p.col(i).allFinite()) continue;
+    // On the same ray from the sensor (the origin here), to float precision.
+    EXPECT_LT(p.col(i).normalized().cross(q.col(i).normalized()).norm(), 1e-6) << "pixel " << i;
+    moved += (p.col(i) - q.col(i)).norm() > 0.0;
+  }
+  EXPECT_GT(moved, p.cols() / 2);
+
+  const ToolRun flat =
+      runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL, sharedData("clouds/rs1.pcd") + " " + path("flat.pcd"));
+  EXPECT_EQ(flat.exit_code, 1);
+  EXPECT_NE(flat.err.find("not organized"), std::string::npos) << flat.err;
+  EXPECT_EQ(
+      runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL, sharedData("meshes/cow.off") + " " + path("c.pcd"))
+          .exit_code,
+      2);
+  EXPECT_EQ(runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL, input + " " + path("x.pcd") + " -max_jump 0")
+                .exit_code,
+            2);
+  EXPECT_FALSE(std::filesystem::exists(path("flat.pcd")));
+  expectNoLeftovers();
+}
+
+TEST_F(SmoothingTools, CurvatureSmoothingReducesTheNoiseOfANoisySphere) {
+  saveMesh(path("sphere.ply"), meshOf(makeIcosphere(4, 2.0, 0.15)));
+  const ToolRun raw = runTool(PCL_DDG_CURVATURE_TOOL, path("sphere.ply") + " " + path("raw.ply"));
+  const ToolRun smooth =
+      runTool(PCL_DDG_CURVATURE_TOOL, path("sphere.ply") + " " + path("smooth.ply") + " -smooth 3");
+  ASSERT_EQ(raw.exit_code, 0) << raw.err;
+  ASSERT_EQ(smooth.exit_code, 0) << smooth.err;
+  const auto rmsError = [](const std::string& file) {
+    const Eigen::VectorXd h = vertexScalarField(loadMesh(file).cloud, "mean_curvature");
+    return std::sqrt((h.array() - 0.5).square().mean());
+  };
+  const double raw_error = rmsError(path("raw.ply")), smooth_error = rmsError(path("smooth.ply"));
+  std::printf("jittered sphere r = 2: H RMS error %.3e raw, %.3e with -smooth 3\n", raw_error,
+              smooth_error);
+  EXPECT_LT(smooth_error, 0.5 * raw_error);
+  EXPECT_EQ(runTool(PCL_DDG_CURVATURE_TOOL,
+                    sharedData("clouds/bun0.pcd") + " " + path("c.ply") + " -smooth 1")
+                .exit_code,
+            2);
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg

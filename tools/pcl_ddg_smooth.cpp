@@ -1,0 +1,125 @@
+// pcl_ddg_smooth: Laplacian smoothing of a mesh's vertex positions, explicit (many small steps)
+// or implicit (few large ones), with the time step in units of the squared mean edge length.
+#include <cmath>
+#include <iostream>
+
+#include "common/mesh_job.h"
+#include "common/tool_common.h"
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/mesh_geometry.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/surface/mesh_smoothing.h"
+
+namespace {
+
+constexpr const char* kName = "pcl_ddg_smooth";
+constexpr const char* kDescription =
+    "Smooths a mesh by Laplacian flow dx/dt = M^-1 L x: explicit (forward Euler; stable only for\n"
+    "small steps, the bound is printed) or implicit (backward Euler, one sparse Cholesky solve "
+    "per\n"
+    "iteration; any step). The time step -lambda_dt is in units of h^2 (h = mean edge length), so\n"
+    "one command line works on any scan; -absolute_time takes it in length^2.";
+constexpr const char* kSyntax =
+    "input.{ply,obj,off,stl,vtk} output.{ply,obj,off,pcd}\n"
+    "         [-method explicit|implicit (default implicit)] [-weights uniform|cotan (default "
+    "cotan)]\n"
+    "         [-mass mixed|voronoi|barycentric] [-lambda_dt t (default: implicit 1, explicit half "
+    "the stability bound)]\n"
+    "         [-iterations n (default 1)] [-absolute_time] [-freeze_weights] [-fix_boundary]\n"
+    "         [-preserve volume|area] [-solver auto|cholmod|ldlt] [-precision float|double]";
+
+int run(int argc, char** argv) {
+  using namespace pcl_ddg;
+  const tools::ToolArguments args(
+      argc, argv,
+      {"method", "weights", "mass", "lambda_dt", "iterations", "preserve", "solver", "precision"},
+      {"absolute_time", "freeze_weights", "fix_boundary"});
+  if (args.positional().size() != 2)
+    throw tools::UsageError("expected an input and an output file");
+  MeshSmoothingParameters p;
+  p.scheme = args.choice("method", {"explicit", "implicit"}, "implicit") == "explicit"
+                 ? SmoothingScheme::Explicit
+                 : SmoothingScheme::Implicit;
+  p.weights = args.choice("weights", {"uniform", "cotan"}, "cotan") == "uniform"
+                  ? LaplacianWeights::Uniform
+                  : LaplacianWeights::Cotangent;
+  const std::string mass = args.choice("mass", {"mixed", "voronoi", "barycentric"}, "mixed");
+  p.mass = mass == "voronoi"       ? MassType::Voronoi
+           : mass == "barycentric" ? MassType::Barycentric
+                                   : MassType::MixedVoronoi;
+  p.iterations = args.integer("iterations", 1);
+  if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
+  if (args.has("freeze_weights")) p.weight_update = WeightUpdate::Frozen;
+  if (args.has("fix_boundary")) p.boundary = BoundaryCondition::Fixed;
+  const std::string preserve = args.choice("preserve", {"none", "volume", "area"}, "none");
+  p.shrinkage = preserve == "volume" ? ShrinkageCorrection::PreserveVolume
+                : preserve == "area" ? ShrinkageCorrection::PreserveArea
+                                     : ShrinkageCorrection::None;
+  const std::string solver = args.choice("solver", {"auto", "cholmod", "ldlt"}, "auto");
+  p.solver = solver == "cholmod" ? CholeskyBackend::Cholmod
+             : solver == "ldlt"  ? CholeskyBackend::SimplicialLDLT
+                                 : CholeskyBackend::Automatic;
+  if (args.has("absolute_time") && !args.has("lambda_dt"))
+    throw tools::UsageError("-absolute_time needs -lambda_dt");
+  const double lambda_dt = args.number("lambda_dt", 1.0);
+  if (!(lambda_dt > 0.0) || !std::isfinite(lambda_dt))
+    throw tools::UsageError("-lambda_dt must be > 0");
+  const bool double_output = tools::precisionArgument(args) == FieldPrecision::Double;
+
+  tools::SurfaceMesh in = tools::loadSurfaceMesh(args.positional()[0], kName);
+  const double h = meanEdgeLength(in.topology, in.positions);
+  if (!(h > 0.0)) throw std::runtime_error("the mesh has no edge of positive length");
+  if (p.scheme == SmoothingScheme::Explicit) {
+    const double bound = explicitStabilityLimit(in.topology, in.positions, p.weights, p.mass);
+    p.time_step = args.has("lambda_dt")
+                      ? (args.has("absolute_time") ? lambda_dt : lambda_dt * h * h)
+                      : 0.5 * bound;
+    std::cerr << kName << ": explicit step " << p.time_step / (h * h) << " h^2; stability bound "
+              << bound / (h * h) << " h^2\n";
+    if (p.time_step > bound) {
+      tools::warn(kName,
+                  "the step exceeds the explicit stability bound: expect the surface to "
+                  "blow up (use -method implicit for large steps)");
+    }
+  } else {
+    p.time_step = args.has("absolute_time") ? lambda_dt : lambda_dt * h * h;
+  }
+
+  const std::size_t points = static_cast<std::size_t>(in.positions.cols());
+  tools::Timer timer("Smoothing");
+  tools::ProgressBar progress("Smoothing");
+  MeshSmoothingReport report;
+  const Eigen::Matrix3Xd smoothed =
+      smoothMeshPositions(in.topology, in.positions, p, &report,
+                          [&](int done, int total) { progress.update(done, total); });
+  progress.finish();
+  timer.done(points);
+  if (p.scheme == SmoothingScheme::Implicit) {
+    std::cerr << kName << ": " << report.iterations << " implicit step(s) of "
+              << p.time_step / (h * h) << " h^2, solver " << toString(report.solver) << "\n";
+  }
+  if (report.fixed_vertices > 0)
+    std::cerr << kName << ": " << report.fixed_vertices << " vertices kept in place\n";
+  if (report.volume_before != 0.0) {
+    std::cerr << kName << ": volume " << report.volume_before << " -> " << report.volume_after
+              << ", area " << report.area_before << " -> " << report.area_after << "\n";
+  } else {
+    std::cerr << kName << ": area " << report.area_before << " -> " << report.area_after << "\n";
+  }
+
+  if (double_output) {
+    const char* names[] = {"x", "y", "z"};
+    for (int d = 0; d < 3; ++d)
+      setVertexField(in.mesh.cloud, names[d], smoothed.row(d).transpose(), FieldPrecision::Double);
+  } else {
+    setVertexPositions(in.mesh.cloud, smoothed);
+  }
+  tools::saveResult(args.positional()[1], in.mesh);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  return pcl_ddg::tools::runTool(kName, kDescription, kSyntax, [&] { return run(argc, argv); });
+}
