@@ -87,7 +87,7 @@ int run(int argc, char** argv) {
 
   const std::size_t points = static_cast<std::size_t>(in.positions.cols());
   tools::Timer timer("Smoothing");
-  tools::ProgressBar progress("Smoothing");
+  tools::ProgressBar progress("> Smoothing");  // redrawn over the Timer's line
   MeshSmoothingReport report;
   const Eigen::Matrix3Xd smoothed =
       smoothMeshPositions(in.topology, in.positions, p, &report,
