@@ -3,6 +3,7 @@
 #include <pcl/exceptions.h>
 
 #include <Eigen/SparseCholesky>
+#include <string>
 
 #ifdef PCL_DDG_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>

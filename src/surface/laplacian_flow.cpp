@@ -2,6 +2,7 @@
 
 #include <pcl/exceptions.h>
 
+#include <algorithm>
 #include <string>
 #include <utility>
 
