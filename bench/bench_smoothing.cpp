@@ -66,7 +66,11 @@ void tenSteps(benchmark::State& state) {
     benchmark::DoNotOptimize(x.data());
   }
 }
-BENCHMARK(tenSteps)->Name("ours/ten_implicit_steps")->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(1);
+BENCHMARK(tenSteps)
+    ->Name("ours/ten_implicit_steps")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 void refactorise(benchmark::State& state, bool reuse_pattern) {
   const Fixture& f = fixture();

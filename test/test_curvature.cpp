@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "analytic_surfaces.h"
+#include "estimator_support.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/operators/curvature.h"
@@ -23,10 +24,6 @@ struct Errors {
 Errors errors(const Eigen::VectorXd& value, const Eigen::VectorXd& exact) {
   const Eigen::VectorXd d = value - exact;
   return {d.cwiseAbs().maxCoeff(), std::sqrt(d.squaredNorm() / static_cast<double>(d.size()))};
-}
-
-MeshTopology topologyOf(const SurfaceSample& s) {
-  return MeshTopology(static_cast<int>(s.points.cols()), s.triangles);
 }
 
 TEST(Curvature, GaussBonnetOnAnalyticMeshesOpenAndClosed) {

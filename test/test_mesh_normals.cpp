@@ -6,6 +6,7 @@
 
 #include <pcl/exceptions.h>
 #include "analytic_surfaces.h"
+#include "estimator_support.h"
 
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -25,10 +26,6 @@ double maxAngleDegrees(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
     worst = std::max(worst, std::acos(std::clamp(a.col(i).dot(b.col(i)), -1.0, 1.0)));
   }
   return worst * 180.0 / 3.14159265358979323846;
-}
-
-MeshTopology topologyOf(const SurfaceSample& s) {
-  return MeshTopology(static_cast<int>(s.points.cols()), s.triangles);
 }
 
 TEST(MeshNormals, EveryWeightingMatchesTheExactNormalOnRegularMeshes) {

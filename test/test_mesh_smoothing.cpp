@@ -9,6 +9,7 @@
 #include <random>
 
 #include "analytic_surfaces.h"
+#include "estimator_support.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
@@ -19,10 +20,6 @@
 namespace pcl_ddg {
 namespace test {
 namespace {
-
-MeshTopology topologyOf(const SurfaceSample& s) {
-  return MeshTopology(static_cast<int>(s.points.cols()), s.triangles);
-}
 
 double squaredEdge(const MeshTopology& topology, const Eigen::Matrix3Xd& x) {
   const double h = meanEdgeLength(topology, x);
@@ -275,21 +272,11 @@ TEST(MeshSmoothing, IsolatedVerticesStayAndADegenerateFaceDoesNoHarm) {
   x << 0, 1, 1, 0, 0.5, 7,  //
       0, 0, 1, 1, 0, 7,     //
       0, 0, 0.3, 0, 0, 7;
-  const MeshTopology topology(6, std::vector<pcl::Vertices>{[] {
-                                                              pcl::Vertices a;
-                                                              a.vertices = {0, 1, 2};
-                                                              return a;
-                                                            }(),
-                                                            [] {
-                                                              pcl::Vertices b;
-                                                              b.vertices = {0, 2, 3};
-                                                              return b;
-                                                            }(),
-                                                            [] {
-                                                              pcl::Vertices c;
-                                                              c.vertices = {0, 4, 1};
-                                                              return c;
-                                                            }()});
+  Eigen::Matrix3Xi triangles(3, 3);
+  triangles << 0, 0, 0,  //
+      1, 2, 4,           //
+      2, 3, 1;
+  const MeshTopology topology(6, triangles);
   for (const SmoothingScheme scheme : {SmoothingScheme::Explicit, SmoothingScheme::Implicit}) {
     MeshSmoothingParameters p;
     p.scheme = scheme;
@@ -332,13 +319,7 @@ TEST(MeshSmoothing, BadInputAndParametersAreRejectedAndTheInputIsNeverModified) 
   EXPECT_THROW(smoothMeshPositions(topologyOf(open), open.points, bad), pcl::BadArgumentException);
 
   // The processor: a failing run leaves its output exactly as it was.
-  auto input = std::make_shared<pcl::PolygonMesh>(makeMesh(sphere.points, [&] {
-    std::vector<std::vector<int>> faces;
-    for (Eigen::Index t = 0; t < sphere.triangles.cols(); ++t) {
-      faces.push_back({sphere.triangles(0, t), sphere.triangles(1, t), sphere.triangles(2, t)});
-    }
-    return faces;
-  }()));
+  auto input = std::make_shared<pcl::PolygonMesh>(polygonMeshOf(sphere));
   const pcl::PolygonMesh original = *input;
   MeshSmoothing smoothing;
   smoothing.setInputMesh(input);

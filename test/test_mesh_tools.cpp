@@ -86,12 +86,7 @@ TEST_F(MeshTools, CurvatureOnEverySharedMeshWritesAllFields) {
 
 TEST_F(MeshTools, CurvatureOfASphereFileIsItsInverseRadius) {
   const SurfaceSample sphere = makeIcosphere(4, 2.0);
-  pcl::PolygonMesh mesh = makeMesh(sphere.points, {});
-  for (Eigen::Index t = 0; t < sphere.triangles.cols(); ++t) {
-    pcl::Vertices v;
-    v.vertices = {sphere.triangles(0, t), sphere.triangles(1, t), sphere.triangles(2, t)};
-    mesh.polygons.push_back(v);
-  }
+  const pcl::PolygonMesh mesh = polygonMeshOf(sphere);
   saveMesh(path("sphere.ply"), mesh);
   for (const char* area : {"mixed", "voronoi", "barycentric"}) {
     const ToolRun run = runTool(PCL_DDG_CURVATURE_TOOL, path("sphere.ply") + " " + path("k.ply") +
@@ -235,12 +230,7 @@ TEST_F(MeshTools, FittedNormalsOnEverySharedCloud) {
 
 TEST_F(MeshTools, QuadricCurvatureOfASphereFileIsItsInverseRadius) {
   const SurfaceSample sphere = makeIcosphere(4, 2.0);
-  pcl::PolygonMesh mesh = makeMesh(sphere.points, {});
-  for (Eigen::Index t = 0; t < sphere.triangles.cols(); ++t) {
-    pcl::Vertices v;
-    v.vertices = {sphere.triangles(0, t), sphere.triangles(1, t), sphere.triangles(2, t)};
-    mesh.polygons.push_back(v);
-  }
+  const pcl::PolygonMesh mesh = polygonMeshOf(sphere);
   saveMesh(path("sphere.ply"), mesh);
   for (const char* neighbours : {"bfs", "knn"}) {
     const ToolRun run =
@@ -261,12 +251,7 @@ TEST_F(MeshTools, QuadricCurvatureOfASphereFileIsItsInverseRadius) {
 
 TEST_F(MeshTools, CompareNeighbourhoodsShowsAThinTwoSheetSurface) {
   const SurfaceSample sheets = makeTwoSheets(1.5 / 12);
-  pcl::PolygonMesh mesh = makeMesh(sheets.points, {});
-  for (Eigen::Index t = 0; t < sheets.triangles.cols(); ++t) {
-    pcl::Vertices v;
-    v.vertices = {sheets.triangles(0, t), sheets.triangles(1, t), sheets.triangles(2, t)};
-    mesh.polygons.push_back(v);
-  }
+  const pcl::PolygonMesh mesh = polygonMeshOf(sheets);
   saveMesh(path("sheets.ply"), mesh);
   const ToolRun run =
       runTool(PCL_DDG_COMPARE_TOOL, path("sheets.ply") + " " + path("cmp.ply") + " -k 16");

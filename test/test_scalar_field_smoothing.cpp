@@ -8,6 +8,7 @@
 #include <random>
 
 #include "analytic_surfaces.h"
+#include "estimator_support.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/operators/curvature.h"
 #include "pcl_ddg/surface/scalar_field_smoothing.h"
@@ -15,10 +16,6 @@
 namespace pcl_ddg {
 namespace test {
 namespace {
-
-MeshTopology topologyOf(const SurfaceSample& s) {
-  return MeshTopology(static_cast<int>(s.points.cols()), s.triangles);
-}
 
 Eigen::VectorXd noise(Eigen::Index n, std::uint32_t seed) {
   std::mt19937 random(seed);

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "analytic_surfaces.h"
+#include "estimator_support.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -29,14 +30,6 @@ class SmoothingTools : public ::testing::Test {
   }
   std::string dir_;
 };
-
-pcl::PolygonMesh meshOf(const SurfaceSample& s) {
-  std::vector<std::vector<int>> faces;
-  for (Eigen::Index t = 0; t < s.triangles.cols(); ++t) {
-    faces.push_back({s.triangles(0, t), s.triangles(1, t), s.triangles(2, t)});
-  }
-  return makeMesh(s.points, faces);
-}
 
 TEST_F(SmoothingTools, SmoothSharedMeshesBothSchemesKeepTheMeshAndPreserveVolume) {
   for (const char* file : {"cow.off", "bunny.off", "bun_zipper_res4.ply", "horse.ply"}) {
@@ -152,7 +145,7 @@ TEST_F(SmoothingTools, OrganizedCloudKeepsItsGridHolesAndRays) {
 }
 
 TEST_F(SmoothingTools, CurvatureSmoothingReducesTheNoiseOfANoisySphere) {
-  saveMesh(path("sphere.ply"), meshOf(makeIcosphere(4, 2.0, 0.15)));
+  saveMesh(path("sphere.ply"), polygonMeshOf(makeIcosphere(4, 2.0, 0.15)));
   const ToolRun raw = runTool(PCL_DDG_CURVATURE_TOOL, path("sphere.ply") + " " + path("raw.ply"));
   const ToolRun smooth =
       runTool(PCL_DDG_CURVATURE_TOOL, path("sphere.ply") + " " + path("smooth.ply") + " -smooth 3");

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "test_data.h"
+
 namespace pcl_ddg {
 namespace test {
 
@@ -16,6 +18,19 @@ pcl::PointCloud<pcl::PointXYZ>::Ptr toCloud(const Eigen::Matrix3Xd& points) {
   cloud->height = 1;
   cloud->is_dense = points.allFinite();
   return cloud;
+}
+
+MeshTopology topologyOf(const SurfaceSample& surface) {
+  return MeshTopology(static_cast<int>(surface.points.cols()), surface.triangles);
+}
+
+pcl::PolygonMesh polygonMeshOf(const SurfaceSample& surface) {
+  std::vector<std::vector<int>> faces;
+  faces.reserve(surface.triangles.cols());
+  for (Eigen::Index t = 0; t < surface.triangles.cols(); ++t) {
+    faces.push_back({surface.triangles(0, t), surface.triangles(1, t), surface.triangles(2, t)});
+  }
+  return makeMesh(surface.points, faces);
 }
 
 std::shared_ptr<const MeshTopology> topologyPtrOf(const SurfaceSample& surface) {

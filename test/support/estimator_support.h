@@ -1,5 +1,6 @@
 #pragma once
 // Glue between the analytic surfaces and PCL's estimator API: clouds, searches, angle errors.
+#include <pcl/PolygonMesh.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
@@ -14,7 +15,11 @@ namespace test {
 
 pcl::PointCloud<pcl::PointXYZ>::Ptr toCloud(const Eigen::Matrix3Xd& points);
 
+MeshTopology topologyOf(const SurfaceSample& surface);
 std::shared_ptr<const MeshTopology> topologyPtrOf(const SurfaceSample& surface);
+
+/** The sampled mesh as a PCL mesh (float x, y, z; its triangles as polygons), e.g. to save it. */
+pcl::PolygonMesh polygonMeshOf(const SurfaceSample& surface);
 
 /** A thin two-sheet surface: two jittered 24 x 24 plates over [-1,1]^2 (h = 1/12), the top one
  *  facing +z, the bottom one gap below it facing -z, as one mesh of two components. */
