@@ -54,7 +54,7 @@ int run(int argc, char** argv) {
   if (requested == "cotan" && (args.has("neighbours") || args.has("k") || args.has("radius"))) {
     throw tools::UsageError("-neighbours, -k and -radius apply to -method quadric");
   }
-  const std::string area = args.choice("area", {"mixed", "voronoi", "barycentric"}, "mixed");
+  const MassType mass = tools::massTypeArgument(args, "area");  // validated before loading
 
   tools::SurfaceInput in = tools::loadSurfaceInput(args.positional()[0], kName);
   const std::string method = !requested.empty() ? requested : (in.topology ? "cotan" : "quadric");
@@ -62,9 +62,6 @@ int run(int argc, char** argv) {
   if (method == "cotan") {
     if (!in.topology)
       throw tools::UsageError("-method cotan needs a mesh; this input is a point cloud");
-    const MassType mass = area == "voronoi"       ? MassType::Voronoi
-                          : area == "barycentric" ? MassType::Barycentric
-                                                  : MassType::MixedVoronoi;
     tools::Timer timer("Computing curvatures");
     const VertexCurvatures c = computeCurvatures(*in.topology, in.positions, mass);
     timer.done(static_cast<std::size_t>(in.positions.cols()));

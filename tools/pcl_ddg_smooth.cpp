@@ -43,10 +43,7 @@ int run(int argc, char** argv) {
   p.weights = args.choice("weights", {"uniform", "cotan"}, "cotan") == "uniform"
                   ? LaplacianWeights::Uniform
                   : LaplacianWeights::Cotangent;
-  const std::string mass = args.choice("mass", {"mixed", "voronoi", "barycentric"}, "mixed");
-  p.mass = mass == "voronoi"       ? MassType::Voronoi
-           : mass == "barycentric" ? MassType::Barycentric
-                                   : MassType::MixedVoronoi;
+  p.mass = tools::massTypeArgument(args, "mass");
   p.iterations = args.integer("iterations", 1);
   if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
   if (args.has("freeze_weights")) p.weight_update = WeightUpdate::Frozen;
@@ -55,10 +52,7 @@ int run(int argc, char** argv) {
   p.shrinkage = preserve == "volume" ? ShrinkageCorrection::PreserveVolume
                 : preserve == "area" ? ShrinkageCorrection::PreserveArea
                                      : ShrinkageCorrection::None;
-  const std::string solver = args.choice("solver", {"auto", "cholmod", "ldlt"}, "auto");
-  p.solver = solver == "cholmod" ? CholeskyBackend::Cholmod
-             : solver == "ldlt"  ? CholeskyBackend::SimplicialLDLT
-                                 : CholeskyBackend::Automatic;
+  p.solver = tools::solverArgument(args);
   if (args.has("absolute_time") && !args.has("lambda_dt"))
     throw tools::UsageError("-absolute_time needs -lambda_dt");
   const double lambda_dt = args.number("lambda_dt", 1.0);

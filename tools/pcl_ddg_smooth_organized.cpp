@@ -45,10 +45,7 @@ int run(int argc, char** argv) {
   if (!(p.time_step > 0.0)) throw tools::UsageError("-lambda_dt must be > 0");
   if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
   if (!(p.max_depth_jump > 0.0)) throw tools::UsageError("-max_jump must be > 0");
-  const std::string solver = args.choice("solver", {"auto", "cholmod", "ldlt"}, "auto");
-  p.solver = solver == "cholmod" ? CholeskyBackend::Cholmod
-             : solver == "ldlt"  ? CholeskyBackend::SimplicialLDLT
-                                 : CholeskyBackend::Automatic;
+  p.solver = tools::solverArgument(args);
   if (p.scheme == SmoothingScheme::Explicit && p.time_step >= 0.25) {
     tools::warn(kName, "explicit steps of 0.25 pixel^2 or more are unstable: expect noise to grow");
   }

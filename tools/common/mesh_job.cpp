@@ -38,6 +38,20 @@ SurfaceMesh checkSurfaceMesh(pcl::PolygonMesh mesh, const char* tool_name) {
   return {std::move(mesh), std::move(topology), std::move(positions)};
 }
 
+MassType massTypeArgument(const ToolArguments& args, const std::string& option) {
+  const std::string area = args.choice(option, {"mixed", "voronoi", "barycentric"}, "mixed");
+  return area == "voronoi"       ? MassType::Voronoi
+         : area == "barycentric" ? MassType::Barycentric
+                                 : MassType::MixedVoronoi;
+}
+
+CholeskyBackend solverArgument(const ToolArguments& args) {
+  const std::string solver = args.choice("solver", {"auto", "cholmod", "ldlt"}, "auto");
+  return solver == "cholmod" ? CholeskyBackend::Cholmod
+         : solver == "ldlt"  ? CholeskyBackend::SimplicialLDLT
+                             : CholeskyBackend::Automatic;
+}
+
 FieldPrecision precisionArgument(const ToolArguments& args) {
   return args.choice("precision", {"float", "double"}, "float") == "double" ? FieldPrecision::Double
                                                                             : FieldPrecision::Float;

@@ -9,6 +9,8 @@
 #include "common/tool_common.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/operators/mass_matrix.h"
+#include "pcl_ddg/operators/sparse_cholesky.h"
 
 namespace pcl_ddg {
 namespace tools {
@@ -25,6 +27,12 @@ SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name);
 
 /** The checks and warnings of loadSurfaceMesh, for a mesh already loaded. */
 SurfaceMesh checkSurfaceMesh(pcl::PolygonMesh mesh, const char* tool_name);
+
+/** A vertex-area option (-area or -mass): mixed|voronoi|barycentric, default mixed. */
+MassType massTypeArgument(const ToolArguments& args, const std::string& option);
+
+/** -solver auto|cholmod|ldlt. */
+CholeskyBackend solverArgument(const ToolArguments& args);
 
 /** -precision float|double. */
 FieldPrecision precisionArgument(const ToolArguments& args);
