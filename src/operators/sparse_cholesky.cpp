@@ -54,8 +54,19 @@ SparseCholesky::SparseCholesky(CholeskyBackend backend)
   impl_->cholmod.cholmod().print = 0;
   // Nested dissection (METIS) alone: on surface meshes it leaves far less fill than AMD, which
   // CHOLMOD would try first.
-  impl_->cholmod.cholmod().nmethods = 1;
-  impl_->cholmod.cholmod().method[0].ordering = CHOLMOD_METIS;
+  cholmod_common& common = impl_->cholmod.cholmod();
+  common.nmethods = 1;
+  common.method[0].ordering = CHOLMOD_METIS;
+  // Coarser supernodes than CHOLMOD's defaults ({4, 16, 48} columns, {0.8, 0.1, 0.05} explicit
+  // zeros): a mesh's elimination tree is mostly small separators, where a few stored zeros buy
+  // larger dense BLAS blocks. Refactorising a 1.15M-vertex cotan system drops from 4.7 s to 3.4 s
+  // on two cores (bench_smoothing), a 100k-vertex one from 0.41 s to 0.21 s.
+  common.nrelax[0] = 16;
+  common.nrelax[1] = 64;
+  common.nrelax[2] = 128;
+  common.zrelax[0] = 0.8;
+  common.zrelax[1] = 0.2;
+  common.zrelax[2] = 0.1;
 #endif
 }
 
