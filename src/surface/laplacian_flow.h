@@ -54,6 +54,7 @@ class LaplacianFlow {
   std::vector<int> source_entry_;
   std::vector<int> diagonal_entry_;  ///< per free vertex: its diagonal entry in system_
   SparseCholesky solver_;
+  Eigen::MatrixXd rhs_, solution_;  ///< implicit step buffers, free vertices x value columns
   bool pattern_analysed_ = false, factor_current_ = false;
   double factor_tau_ = 0.0;
 };

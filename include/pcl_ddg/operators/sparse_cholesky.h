@@ -47,6 +47,8 @@ class SparseCholesky {
 
   /** Solves for every column of rhs; throws pcl::ComputeFailedException before factorize(). */
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const;
+  /** The same into solution, whose storage is reused when it has the right size. */
+  void solve(const Eigen::MatrixXd& rhs, Eigen::MatrixXd& solution) const;
 
  private:
   struct Backend;
