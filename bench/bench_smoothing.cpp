@@ -9,6 +9,7 @@
 
 #include "bench_support.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
+#include "pcl_ddg/operators/sparse_cholesky.h"
 #include "pcl_ddg/surface/mesh_smoothing.h"
 
 namespace pcl_ddg {
