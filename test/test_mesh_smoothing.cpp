@@ -26,6 +26,20 @@ double squaredEdge(const MeshTopology& topology, const Eigen::Matrix3Xd& x) {
   return h * h;
 }
 
+// Parameters for scheme and weights with a step relative to the mesh: explicit as a fraction of
+// its stability bound, implicit in units of h^2.
+MeshSmoothingParameters relativeStep(SmoothingScheme scheme, LaplacianWeights weights,
+                                     const MeshTopology& topology, const Eigen::Matrix3Xd& x,
+                                     double fraction_of_bound, double h2_units) {
+  MeshSmoothingParameters p;
+  p.scheme = scheme;
+  p.weights = weights;
+  p.time_step = scheme == SmoothingScheme::Explicit
+                    ? fraction_of_bound * explicitStabilityLimit(topology, x, weights)
+                    : h2_units * squaredEdge(topology, x);
+  return p;
+}
+
 // RMS distance of the vertices to the unit sphere about the origin.
 double rmsDistanceToUnitSphere(const Eigen::Matrix3Xd& x) {
   return std::sqrt((x.colwise().norm().array() - 1.0).square().mean());
@@ -95,12 +109,7 @@ TEST(MeshSmoothing, SmoothingANoisySphereBringsItCloserToTheSphereInTheFirstStep
   for (const SmoothingScheme scheme : {SmoothingScheme::Explicit, SmoothingScheme::Implicit}) {
     for (const LaplacianWeights weights :
          {LaplacianWeights::Cotangent, LaplacianWeights::Uniform}) {
-      MeshSmoothingParameters p;
-      p.scheme = scheme;
-      p.weights = weights;
-      p.time_step = scheme == SmoothingScheme::Explicit
-                        ? 0.5 * explicitStabilityLimit(topology, noisy, weights)
-                        : 0.1 * h2;
+      const MeshSmoothingParameters p = relativeStep(scheme, weights, topology, noisy, 0.5, 0.1);
       const double initial = rmsDistanceToUnitSphere(noisy);
       const Eigen::Matrix3Xd once = smoothMeshPositions(topology, noisy, p);
       const Eigen::Matrix3Xd twice = smoothMeshPositions(topology, once, p);
@@ -154,12 +163,7 @@ TEST(MeshSmoothing, APlaneStaysAPlane) {
   for (const SmoothingScheme scheme : {SmoothingScheme::Explicit, SmoothingScheme::Implicit}) {
     for (const LaplacianWeights weights :
          {LaplacianWeights::Cotangent, LaplacianWeights::Uniform}) {
-      MeshSmoothingParameters p;
-      p.scheme = scheme;
-      p.weights = weights;
-      p.time_step = scheme == SmoothingScheme::Explicit
-                        ? 0.9 * explicitStabilityLimit(topology, plane.points, weights)
-                        : 0.5 * squaredEdge(topology, plane.points);
+      MeshSmoothingParameters p = relativeStep(scheme, weights, topology, plane.points, 0.9, 0.5);
       p.iterations = 3;
       const Eigen::Matrix3Xd x = smoothMeshPositions(topology, plane.points, p);
       const double off_plane =
@@ -175,12 +179,9 @@ TEST(MeshSmoothing, FixedBoundaryVerticesDoNotMove) {
   const SurfaceSample patch = makeSaddle({12, 0.2, 2});
   const MeshTopology topology = topologyOf(patch);
   for (const SmoothingScheme scheme : {SmoothingScheme::Explicit, SmoothingScheme::Implicit}) {
-    MeshSmoothingParameters p;
-    p.scheme = scheme;
+    MeshSmoothingParameters p =
+        relativeStep(scheme, LaplacianWeights::Cotangent, topology, patch.points, 0.9, 1.0);
     p.boundary = BoundaryCondition::Fixed;
-    p.time_step = scheme == SmoothingScheme::Explicit
-                      ? 0.9 * explicitStabilityLimit(topology, patch.points)
-                      : 1.0 * squaredEdge(topology, patch.points);
     p.iterations = 5;
     MeshSmoothingReport report;
     const Eigen::Matrix3Xd x = smoothMeshPositions(topology, patch.points, p, &report);
