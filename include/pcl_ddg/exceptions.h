@@ -18,6 +18,7 @@
 #include <pcl/exceptions.h>
 
 #include <string>
+#include <string_view>
 
 namespace pcl_ddg {
 
@@ -32,5 +33,19 @@ class FileFormatException : public pcl::IOException {
  public:
   explicit FileFormatException(const std::string& description) : pcl::IOException(description) {}
 };
+
+/**
+ * The text of an exception for a message. pcl::PCLException's what() prefixes the description
+ * with its source location, or with ": " when it has none; that prefix is left out here.
+ */
+inline std::string errorDescription(const std::exception& e) {
+  std::string_view text = e.what();
+  const auto* pcl_exception = dynamic_cast<const pcl::PCLException*>(&e);
+  if (pcl_exception != nullptr && pcl_exception->getFileName() == nullptr &&
+      pcl_exception->getFunctionName() == nullptr && text.substr(0, 2) == ": ") {
+    text.remove_prefix(2);
+  }
+  return std::string(text);
+}
 
 }  // namespace pcl_ddg

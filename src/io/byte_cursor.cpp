@@ -1,6 +1,10 @@
 #include "byte_cursor.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cctype>
 #include <charconv>
 #include <fstream>
@@ -17,12 +21,21 @@ bool isSpace(char c) {
 }  // namespace
 
 std::string readWholeFile(const std::string& path) {
+  // Only regular files: a directory has no data, and a device or pipe (/dev/zero) may never end.
+  struct stat status {};
+  if (stat(path.c_str(), &status) != 0) throw FileFormatException(std::strerror(errno));
+  if (S_ISDIR(status.st_mode)) throw FileFormatException("is a directory, not a file");
+  if (!S_ISREG(status.st_mode)) {
+    throw FileFormatException("not a regular file (a device, pipe or socket cannot be read)");
+  }
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileFormatException("cannot open '" + path + "'");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw FileFormatException("cannot read '" + path + "'");
-  return std::move(buffer).str();
+  if (!in) throw FileFormatException(std::string("cannot open: ") + std::strerror(errno));
+  std::string data(static_cast<std::size_t>(status.st_size), '\0');
+  in.read(data.data(), static_cast<std::streamsize>(data.size()));
+  if (static_cast<std::size_t>(in.gcount()) != data.size()) {
+    throw FileFormatException("cannot read the whole file (it changed while being read?)");
+  }
+  return data;
 }
 
 std::string_view ByteCursor::token() {
@@ -102,6 +115,21 @@ std::size_t ByteCursor::lineNumber(std::size_t offset) const {
 
 void ByteCursor::fail(const std::string& message) const {
   throw FileFormatException("line " + std::to_string(lineNumber(pos_)) + ": " + message);
+}
+
+void ByteCursor::failOutOfRange(double v, const char* what) const {
+  std::ostringstream text;
+  text << "value " << v << " is out of range for " << what;
+  fail(text.str());
+}
+
+std::int64_t ByteCursor::product(std::int64_t a, std::int64_t b, const char* what) const {
+  std::int64_t result = 0;
+  if (a < 0 || b < 0 || __builtin_mul_overflow(a, b, &result)) {
+    fail(std::string("impossible ") + what + " (" + std::to_string(a) + " x " +
+         std::to_string(b) + ")");
+  }
+  return result;
 }
 
 void ByteCursor::reverse(char* bytes, std::size_t n) {

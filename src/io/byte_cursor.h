@@ -1,10 +1,13 @@
 #pragma once
 // A bounds-checked reader over a whole file held in memory, for the text and binary mesh formats.
 // Every read past the end or of a malformed number throws FileFormatException with the line.
+#include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <string_view>
+#include <type_traits>
 
 #include "pcl_ddg/exceptions.h"
 
@@ -46,6 +49,33 @@ class ByteCursor {
   double readDouble(const char* what) { return parseDouble(requireToken(what), what); }
   std::int64_t readInt(const char* what) { return parseInt(requireToken(what), what); }
 
+  /** v as a T, refused (with the line) unless the conversion is exact for an integer type (an
+   *  integral value in range) or within range for float; a cast outside the range would be
+   *  undefined behaviour. */
+  template <typename T>
+  T convert(double v, const char* what) const {
+    if constexpr (std::is_same_v<T, double>) {
+      return v;
+    } else if constexpr (std::is_floating_point_v<T>) {
+      if (std::isfinite(v) && std::abs(v) > static_cast<double>(std::numeric_limits<T>::max()))
+        failOutOfRange(v, what);
+      return static_cast<T>(v);
+    } else {
+      const double end = std::ldexp(1.0, std::numeric_limits<T>::digits);  // max() + 1, exact
+      const double lowest = std::is_signed_v<T> ? -end : 0.0;
+      if (!(v == std::trunc(v) && v >= lowest && v < end)) failOutOfRange(v, what);
+      return static_cast<T>(v);
+    }
+  }
+  /** Stores convert<T>(v) at dst. */
+  template <typename T>
+  void store(double v, std::uint8_t* dst, const char* what) const {
+    const T value = convert<T>(v, what);
+    std::memcpy(dst, &value, sizeof(T));
+  }
+  /** a * b for non-negative counts, refused when it overflows. */
+  std::int64_t product(std::int64_t a, std::int64_t b, const char* what) const;
+
   /** Raw bytes of a T in the given byte order. */
   template <typename T>
   T readBinary(ByteOrder order, const char* what) {
@@ -65,6 +95,7 @@ class ByteCursor {
   [[noreturn]] void fail(const std::string& message) const;
 
  private:
+  [[noreturn]] void failOutOfRange(double v, const char* what) const;
   static void reverse(char* bytes, std::size_t n);
   std::size_t lineNumber(std::size_t offset) const;
   std::string_view data_;

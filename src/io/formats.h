@@ -25,6 +25,8 @@ pcl::PolygonMesh parseSTL(std::string_view data);
 /** Legacy VTK POLYDATA, ascii or binary, classic or 5.x (OFFSETS/CONNECTIVITY) cell layout;
  *  POLYGONS and TRIANGLE_STRIPS become faces, other cells and attributes are ignored. */
 pcl::PolygonMesh parseVTK(std::string_view data);
+/** PCD, ascii, binary or binary_compressed (padding fields "_" kept as in PCL's reader). */
+pcl::PolygonMesh parsePCD(std::string_view data);
 
 void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding);
 

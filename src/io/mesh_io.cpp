@@ -14,56 +14,6 @@
 namespace pcl_ddg {
 namespace {
 
-// PCL's PCD reader crashes on empty, garbage or truncated files, so the header and the data size
-// are checked here first.
-void checkPCD(const std::string& data) {
-  detail::ByteCursor cursor(data);
-  std::int64_t points = -1, point_size = 0;
-  for (;;) {
-    if (cursor.atEnd()) cursor.fail("not a PCD file (no DATA line)");
-    detail::ByteCursor line = cursor.within(cursor.line());
-    const std::string_view key = line.token();
-    if (key.empty() || key.front() == '#' || key == "VERSION" || key == "FIELDS" || key == "TYPE" ||
-        key == "WIDTH" || key == "HEIGHT" || key == "VIEWPOINT") {
-      continue;
-    }
-    if (key == "SIZE" || key == "COUNT") {
-      std::vector<std::int64_t> values;
-      for (std::string_view t = line.token(); !t.empty(); t = line.token()) {
-        values.push_back(line.parseInt(t, "SIZE/COUNT"));
-      }
-      if (key == "SIZE") {
-        point_size = 0;
-        for (std::int64_t v : values) point_size += v;
-      }
-    } else if (key == "POINTS") {
-      points = line.readInt("POINTS");
-    } else if (key == "DATA") {
-      const std::string_view kind = line.requireToken("DATA kind");
-      if (points <= 0) cursor.fail("PCD file has no points");
-      if (kind == "binary" && cursor.remaining() < static_cast<std::size_t>(points * point_size)) {
-        cursor.fail("PCD data shorter than POINTS x point size (truncated?)");
-      }
-      if (kind == "ascii") {
-        std::int64_t rows = 0;
-        while (!cursor.atEnd()) rows += !cursor.line().empty();
-        if (rows < points) cursor.fail("PCD data has fewer rows than POINTS (truncated?)");
-      }
-      return;
-    } else {
-      cursor.fail("not a PCD file (unknown header line '" + std::string(key.substr(0, 20)) + "')");
-    }
-  }
-}
-
-pcl::PolygonMesh loadPCD(const std::string& path) {
-  checkPCD(detail::readWholeFile(path));
-  pcl::PolygonMesh mesh;
-  pcl::PCDReader reader;
-  if (reader.read(path, mesh.cloud) < 0) throw FileFormatException("not a readable PCD file");
-  return mesh;
-}
-
 void savePCD(const std::string& path, const pcl::PolygonMesh& mesh) {
   pcl::PCDWriter writer;
   if (writer.writeBinary(path, mesh.cloud) < 0) throw FileFormatException("PCD writer failed");
@@ -91,9 +41,6 @@ std::string fileExtension(const std::string& path) {
 pcl::PolygonMesh loadMesh(const std::string& path) {
   const std::string ext = fileExtension(path);
   try {
-    if (ext == "pcd") {
-      return loadPCD(path);
-    }
     using Parser = pcl::PolygonMesh (*)(std::string_view);
     Parser parse = nullptr;
     if (ext == "ply") parse = detail::parsePLY;
@@ -101,19 +48,19 @@ pcl::PolygonMesh loadMesh(const std::string& path) {
     if (ext == "obj") parse = detail::parseOBJ;
     if (ext == "stl") parse = detail::parseSTL;
     if (ext == "vtk") parse = detail::parseVTK;
+    if (ext == "pcd") parse = detail::parsePCD;
     if (parse == nullptr) {
-      throw FileFormatException("unknown file type '." + ext +
-                                "' (expected ply, obj, off, stl, vtk or pcd)");
+      throw FileFormatException(
+          (ext.empty() ? std::string("no file extension") : "unknown file type '." + ext + "'") +
+          " (expected .ply, .obj, .off, .stl, .vtk or .pcd)");
     }
     const std::string data = detail::readWholeFile(path);
     pcl::PolygonMesh mesh = parse(data);
     if (mesh.cloud.width * mesh.cloud.height == 0)
       throw FileFormatException("file has no vertices");
     return mesh;
-  } catch (const FileFormatException& e) {
-    throw FileFormatException(path + ": " + e.what());
   } catch (const pcl::PCLException& e) {
-    throw FileFormatException(path + ": " + e.what());
+    throw FileFormatException(path + ": " + errorDescription(e));
   }
 }
 
@@ -132,7 +79,7 @@ void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh,
     }
     file.commit();
   } catch (const pcl::PCLException& e) {
-    throw FileFormatException(path + ": " + e.what());
+    throw FileFormatException(path + ": " + errorDescription(e));
   }
 }
 

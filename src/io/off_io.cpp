@@ -1,5 +1,5 @@
 // Object File Format (Geomview): "OFF" header, counts, vertices, faces. Colour and normal variants
-// (COFF, NOFF, CNOFF) carry extra values per line, which are ignored; "OFF BINARY" is big-endian.
+// (COFF, NOFF, CNOFF) carry extra values per line, which are ignored; "OFF BINARY" in either byte order.
 #include <vector>
 
 #include "byte_cursor.h"
@@ -21,30 +21,51 @@ std::string_view contentLine(ByteCursor& cursor, const char* what) {
   }
 }
 
+// Binary OFF exists in both byte orders: Geomview's spec says big-endian, pmp-library writes the
+// host's (little-endian). The order is the one whose reading of the three counts fits the file:
+// every vertex takes 12 bytes and every face at least 8 (its size and its colour count).
+ByteOrder binaryOffByteOrder(const ByteCursor& cursor) {
+  const auto fits = [&](ByteOrder order) {
+    ByteCursor probe = cursor;
+    std::int64_t counts[3];
+    for (std::int64_t& n : counts) {
+      if (probe.remaining() < 4) return false;
+      n = probe.readBinary<std::int32_t>(order, "count");
+      if (n < 0) return false;
+    }
+    return 12 * counts[0] + 8 * counts[1] <= static_cast<std::int64_t>(probe.remaining());
+  };
+  if (fits(ByteOrder::Big)) return ByteOrder::Big;
+  if (fits(ByteOrder::Little)) return ByteOrder::Little;
+  cursor.fail("binary OFF counts fit the file in neither byte order (truncated or not OFF?)");
+}
+
 pcl::PolygonMesh parseBinaryOFF(ByteCursor& cursor) {
-  const auto read_count = [&](const char* what) {
-    const std::int32_t n = cursor.readBinary<std::int32_t>(ByteOrder::Big, what);
+  const ByteOrder order = binaryOffByteOrder(cursor);
+  // A count of n items of at least `bytes` each, which the remaining data must be able to hold.
+  const auto read_count = [&](const char* what, std::size_t bytes) {
+    const std::int32_t n = cursor.readBinary<std::int32_t>(order, what);
     if (n < 0) cursor.fail(std::string("negative ") + what);
+    if (static_cast<std::size_t>(n) > cursor.remaining() / bytes) {
+      cursor.fail(std::string(what) + " " + std::to_string(n) + " is more than the file holds");
+    }
     return n;
   };
-  const std::int32_t num_vertices = read_count("vertex count");
-  const std::int32_t num_faces = read_count("face count");
-  read_count("edge count");
-  if (static_cast<std::size_t>(num_vertices) * 12 > cursor.remaining()) {
-    cursor.fail("binary OFF is shorter than its vertex count says");
-  }
-  std::vector<double> xyz(3 * static_cast<std::size_t>(num_vertices));
-  for (double& v : xyz) v = cursor.readBinary<float>(ByteOrder::Big, "vertex");
+  const std::int32_t num_vertices = cursor.readBinary<std::int32_t>(order, "vertex count");
+  const std::int32_t num_faces = cursor.readBinary<std::int32_t>(order, "face count");
+  cursor.skip(4, "edge count");
+  std::vector<double> xyz(3 * static_cast<std::size_t>(num_vertices));  // fits: checked above
+  for (double& v : xyz) v = cursor.readBinary<float>(order, "vertex");
   pcl::PolygonMesh mesh;
   mesh.cloud = makeXYZCloud(xyz);
-  mesh.polygons.resize(num_faces);
+  mesh.polygons.resize(static_cast<std::size_t>(num_faces));
   for (auto& polygon : mesh.polygons) {
-    const std::int32_t n = read_count("face size");
-    for (std::int32_t k = 0; k < n; ++k) {
-      polygon.vertices.push_back(
-          cornerIndex(cursor.readBinary<std::int32_t>(ByteOrder::Big, "face")));
+    const std::int32_t n = read_count("face size", 4);
+    polygon.vertices.resize(static_cast<std::size_t>(n));
+    for (auto& corner : polygon.vertices) {
+      corner = cornerIndex(cursor.readBinary<std::int32_t>(order, "face"));
     }
-    const std::int32_t colour_values = read_count("face colour count");
+    const std::int32_t colour_values = read_count("face colour count", 4);
     cursor.skip(4 * static_cast<std::size_t>(colour_values), "face colour");
   }
   return mesh;
@@ -69,8 +90,11 @@ pcl::PolygonMesh parseOFF(std::string_view data) {
   const std::int64_t num_vertices = counts.readInt("vertex count");
   const std::int64_t num_faces = counts.readInt("face count");
   if (num_vertices < 0 || num_faces < 0) cursor.fail("negative vertex or face count");
-  if (num_vertices > static_cast<std::int64_t>(data.size())) {
-    cursor.fail("vertex count larger than the file");
+  // A vertex line takes at least 6 bytes ("0 0 0\n"), a face line 2 ("0\n"): a count beyond
+  // that is a lie, refused before anything is allocated.
+  const auto remaining = static_cast<std::int64_t>(cursor.remaining());
+  if (num_vertices > remaining / 6 || num_faces > remaining / 2) {
+    cursor.fail("vertex or face count larger than the file can hold (truncated?)");
   }
 
   std::vector<double> xyz(3 * static_cast<std::size_t>(num_vertices));
@@ -84,7 +108,9 @@ pcl::PolygonMesh parseOFF(std::string_view data) {
   for (auto& polygon : mesh.polygons) {
     ByteCursor values = cursor.within(contentLine(cursor, "faces"));
     const std::int64_t n = values.readInt("face size");
-    if (n < 0) cursor.fail("negative face size");
+    if (n < 0 || n > static_cast<std::int64_t>(values.remaining())) {
+      values.fail("face size " + std::to_string(n) + " does not fit its line");
+    }
     polygon.vertices.reserve(static_cast<std::size_t>(n));
     for (std::int64_t k = 0; k < n; ++k) {
       polygon.vertices.push_back(cornerIndex(values.readInt("face index")));

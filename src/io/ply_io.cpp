@@ -126,7 +126,7 @@ PlyHeader parseHeader(ByteCursor& cursor) {
     } else if (keyword == "element") {
       PlyElement element;
       if (!(words >> element.name >> element.count) || element.count < 0) {
-        cursor.fail("malformed PLY element line");
+        cursor.fail("malformed PLY element line (a name and a count >= 0)");
       }
       header.elements.push_back(element);
     } else if (keyword == "property") {
@@ -150,7 +150,22 @@ PlyHeader parseHeader(ByteCursor& cursor) {
     }
   }
   if (!has_format) cursor.fail("PLY header has no format line");
+  for (const PlyElement& element : header.elements) {
+    if (element.count > 0 && element.properties.empty()) {
+      cursor.fail("PLY element '" + element.name + "' has rows but no properties");
+    }
+  }
   return header;
+}
+
+// The fewest bytes one row of the element can take: its binary sizes (lists empty), or in ascii
+// a character and a separator per value.
+std::int64_t minimumRowBytes(const PlyElement& element, PlyFormat format) {
+  std::int64_t bytes = 0;
+  for (const auto& p : element.properties) {
+    bytes += format == PlyFormat::Ascii ? 2 : typeSize(p.is_list ? p.count_type : p.type);
+  }
+  return bytes;
 }
 
 /** Reads the values of a PLY body in either encoding. */
@@ -184,12 +199,20 @@ class PlyValueReader {
     return 0.0;
   }
 
-  std::int64_t count(PlyType type, const char* what) {
+  /** A list length: a non-negative integer whose items fit in the bytes that remain. */
+  std::int64_t count(PlyType type, PlyType item_type, const char* what) {
     const double n = number(type, what);
-    if (!(n >= 0.0) || n != std::floor(n) || n > 1e9) {
-      cursor_.fail(std::string("invalid list length in ") + what);
+    const std::uint32_t item_bytes = format_ == PlyFormat::Ascii ? 2 : typeSize(item_type);
+    if (!(n >= 0.0) || n != std::floor(n) ||
+        n > static_cast<double>(cursor_.remaining() / item_bytes + 1)) {
+      cursor_.fail(std::string("invalid list length in ") + what + " (more items than the file holds)");
     }
     return static_cast<std::int64_t>(n);
+  }
+
+  /** A vertex index: an integer value (of any stored type). */
+  std::int64_t index(PlyType type, const char* what) {
+    return cursor_.convert<std::int64_t>(number(type, what), "a vertex index");
   }
 
   /** Stores one scalar in its PLY type at dst (host byte order). */
@@ -201,51 +224,41 @@ class PlyValueReader {
       return;
     }
     const double v = cursor_.readDouble(what);
+    const char* range = "the PLY property type";
     switch (type) {
       case PlyType::Int8:
-        store<std::int8_t>(v, dst);
-        break;
+        return cursor_.store<std::int8_t>(v, dst, range);
       case PlyType::UInt8:
-        store<std::uint8_t>(v, dst);
-        break;
+        return cursor_.store<std::uint8_t>(v, dst, range);
       case PlyType::Int16:
-        store<std::int16_t>(v, dst);
-        break;
+        return cursor_.store<std::int16_t>(v, dst, range);
       case PlyType::UInt16:
-        store<std::uint16_t>(v, dst);
-        break;
+        return cursor_.store<std::uint16_t>(v, dst, range);
       case PlyType::Int32:
-        store<std::int32_t>(v, dst);
-        break;
+        return cursor_.store<std::int32_t>(v, dst, range);
       case PlyType::UInt32:
-        store<std::uint32_t>(v, dst);
-        break;
+        return cursor_.store<std::uint32_t>(v, dst, range);
       case PlyType::Float32:
-        store<float>(v, dst);
-        break;
+        return cursor_.store<float>(v, dst, range);
       case PlyType::Float64:
-        store<double>(v, dst);
-        break;
+        return cursor_.store<double>(v, dst, range);
     }
   }
 
   void skip(const PlyProperty& property, const char* what) {
-    const std::int64_t n = property.is_list ? count(property.count_type, what) : 1;
+    const std::int64_t n =
+        property.is_list ? count(property.count_type, property.type, what) : 1;
     for (std::int64_t i = 0; i < n; ++i) number(property.type, what);
   }
 
  private:
-  template <typename T>
-  static void store(double v, std::uint8_t* dst) {
-    const T value = static_cast<T>(v);
-    std::memcpy(dst, &value, sizeof(T));
-  }
   ByteCursor& cursor_;
   PlyFormat format_;
   ByteOrder order_;
 };
 
-void readVertices(const PlyElement& element, PlyValueReader& reader, pcl::PCLPointCloud2& cloud) {
+void readVertices(const PlyElement& element, PlyValueReader& reader, const ByteCursor& cursor,
+                  pcl::PCLPointCloud2& cloud) {
   std::uint32_t offset = 0;
   for (const auto& p : element.properties) {
     if (p.is_list) continue;  // per-vertex lists have no place in a point cloud
@@ -256,6 +269,11 @@ void readVertices(const PlyElement& element, PlyValueReader& reader, pcl::PCLPoi
     field.count = 1;
     cloud.fields.push_back(field);
     offset += typeSize(p.type);
+  }
+  // PCLPointCloud2 counts bytes in 32 bits (row_step).
+  if (cursor.product(element.count, offset, "vertex count x vertex size") >
+      std::numeric_limits<std::uint32_t>::max()) {
+    cursor.fail("PLY vertex data too large for a pcl::PCLPointCloud2 (4 GiB)");
   }
   cloud.width = static_cast<std::uint32_t>(element.count);
   cloud.height = 1;
@@ -296,11 +314,9 @@ void readIndexLists(const PlyElement& element, PlyValueReader& reader, ByteCurso
         reader.skip(p, element.name.c_str());
         continue;
       }
-      const std::int64_t n = reader.count(p.count_type, element.name.c_str());
+      const std::int64_t n = reader.count(p.count_type, p.type, element.name.c_str());
       indices.resize(static_cast<std::size_t>(n));
-      for (auto& index : indices) {
-        index = static_cast<std::int64_t>(reader.number(p.type, element.name.c_str()));
-      }
+      for (auto& index : indices) index = reader.index(p.type, element.name.c_str());
       on_list(indices);
     }
   }
@@ -349,8 +365,14 @@ pcl::PolygonMesh parsePLY(std::string_view data) {
   std::vector<std::int64_t> grid_cells;
   bool has_grid = false;
   for (const PlyElement& element : header.elements) {
+    // A count the remaining bytes cannot hold is a lie: refused before anything is reserved.
+    if (cursor.product(element.count, minimumRowBytes(element, header.format), "element size") >
+        static_cast<std::int64_t>(cursor.remaining())) {
+      cursor.fail("PLY element '" + element.name + "' claims " + std::to_string(element.count) +
+                  " rows, more than the file holds (truncated?)");
+    }
     if (element.name == "vertex") {
-      readVertices(element, reader, mesh.cloud);
+      readVertices(element, reader, cursor, mesh.cloud);
       has_vertices = true;
     } else if (element.name == "face") {
       mesh.polygons.reserve(mesh.polygons.size() + static_cast<std::size_t>(element.count));
@@ -378,8 +400,10 @@ pcl::PolygonMesh parsePLY(std::string_view data) {
   }
   if (!has_vertices) cursor.fail("PLY file has no vertex element");
   if (has_grid && mesh.polygons.empty()) {
-    if (header.grid_columns <= 0 || header.grid_rows <= 0 ||
-        header.grid_columns * header.grid_rows != static_cast<std::int64_t>(grid_cells.size())) {
+    const auto cells = static_cast<std::int64_t>(grid_cells.size());
+    if (header.grid_columns <= 0 || header.grid_rows <= 0 || header.grid_columns > cells ||
+        header.grid_rows > cells / header.grid_columns ||
+        header.grid_columns * header.grid_rows != cells) {
       cursor.fail("range_grid size does not match obj_info num_cols x num_rows");
     }
     mesh.cloud = organizeOnGrid(mesh.cloud, grid_cells, header, cursor);

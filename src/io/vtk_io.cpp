@@ -17,7 +17,8 @@ class VtkReader {
  public:
   VtkReader(ByteCursor& cursor, VtkEncoding encoding) : cursor_(cursor), encoding_(encoding) {}
 
-  /** Reads n values of the named VTK type; binary data begins on the next line. */
+  /** Reads n values of the named VTK type; binary data begins on the next line. Every value
+   *  takes at least one byte, so a count beyond the remaining bytes is refused unallocated. */
   std::vector<double> values(std::int64_t n, std::string_view type, const char* what) {
     if (n < 0 || n > static_cast<std::int64_t>(cursor_.remaining())) {
       cursor_.fail(std::string("impossible value count for ") + what);
@@ -57,6 +58,15 @@ class VtkReader {
   VtkEncoding encoding_;
 };
 
+// Cell data as integers; a value that is not one is refused.
+std::vector<std::int64_t> integers(const std::vector<double>& values, const ByteCursor& cursor) {
+  std::vector<std::int64_t> out(values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    out[i] = cursor.convert<std::int64_t>(values[i], "a VTK cell index");
+  }
+  return out;
+}
+
 // Calls on_cell(indices, count) for every cell of a cell section.
 void readCells(ByteCursor& cursor, VtkReader& reader,
                const std::function<void(const std::int64_t*, std::size_t)>& on_cell) {
@@ -65,15 +75,14 @@ void readCells(ByteCursor& cursor, VtkReader& reader,
   const std::size_t mark = cursor.position();
   std::vector<std::int64_t> indices;
   if (cursor.token() == "OFFSETS") {
-    const std::vector<double> offsets =
-        reader.values(first, cursor.requireToken("offset type"), "offsets");
+    const std::vector<std::int64_t> offsets =
+        integers(reader.values(first, cursor.requireToken("offset type"), "offsets"), cursor);
     if (cursor.token() != "CONNECTIVITY") cursor.fail("VTK OFFSETS without CONNECTIVITY");
-    const std::vector<double> connectivity =
-        reader.values(second, cursor.requireToken("connectivity type"), "connectivity");
-    indices.assign(connectivity.begin(), connectivity.end());
+    indices = integers(
+        reader.values(second, cursor.requireToken("connectivity type"), "connectivity"), cursor);
     for (std::size_t c = 0; c + 1 < offsets.size(); ++c) {
-      const auto begin = static_cast<std::int64_t>(offsets[c]);
-      const auto end = static_cast<std::int64_t>(offsets[c + 1]);
+      const std::int64_t begin = offsets[c];
+      const std::int64_t end = offsets[c + 1];
       if (begin < 0 || end < begin || end > static_cast<std::int64_t>(indices.size())) {
         cursor.fail("VTK cell offsets out of range");
       }
@@ -83,13 +92,12 @@ void readCells(ByteCursor& cursor, VtkReader& reader,
   }
   // Classic layout: `second` integers as (n, i0 .. in-1) runs.
   cursor.seek(mark);
-  const std::vector<double> runs = reader.values(second, "int", "cells");
-  indices.assign(runs.begin(), runs.end());
+  indices = integers(reader.values(second, "int", "cells"), cursor);
   std::size_t at = 0;
   for (std::int64_t c = 0; c < first; ++c) {
     if (at >= indices.size()) cursor.fail("VTK cell list shorter than its cell count");
     const std::int64_t n = indices[at];
-    if (n < 0 || at + 1 + static_cast<std::size_t>(n) > indices.size()) {
+    if (n < 0 || n >= static_cast<std::int64_t>(indices.size() - at)) {
       cursor.fail("VTK cell runs past the end of its list");
     }
     on_cell(indices.data() + at + 1, static_cast<std::size_t>(n));
@@ -123,7 +131,8 @@ pcl::PolygonMesh parseVTK(std::string_view data) {
     if (keyword == "POINTS") {
       const std::int64_t n = cursor.readInt("point count");
       const std::vector<double> xyz =
-          reader.values(3 * n, cursor.requireToken("point type"), "points");
+          reader.values(cursor.product(n, 3, "point count"), cursor.requireToken("point type"),
+                        "points");
       mesh.cloud = makeXYZCloud(xyz);
       has_points = true;
     } else if (keyword == "POLYGONS" || keyword == "TRIANGLE_STRIPS" || keyword == "VERTICES" ||

@@ -3,13 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 namespace pcl_ddg {
 namespace detail {
 
 pcl::PCLPointCloud2 makeXYZCloud(const std::vector<double>& xyz) {
   const bool fits_float = std::all_of(xyz.begin(), xyz.end(), [](double v) {
-    return std::isnan(v) || static_cast<double>(static_cast<float>(v)) == v;
+    // (beyond float's range the cast itself would be undefined)
+    return !std::isfinite(v) || (std::abs(v) <= std::numeric_limits<float>::max() &&
+                                 static_cast<double>(static_cast<float>(v)) == v);
   });
   const std::uint8_t datatype =
       fits_float ? pcl::PCLPointField::FLOAT32 : pcl::PCLPointField::FLOAT64;

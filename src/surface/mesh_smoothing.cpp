@@ -127,7 +127,7 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
       try {
         flow.implicitStep(values, p.time_step);
       } catch (const pcl::ComputeFailedException& e) {
-        failedAt(iteration, e.what());
+        failedAt(iteration, errorDescription(e));
       }
     }
     current = values.transpose();

@@ -9,10 +9,6 @@
 namespace pcl_ddg {
 namespace tools {
 
-void warn(const char* tool_name, const std::string& message) {
-  std::cerr << tool_name << ": warning: " << message << "\n";
-}
-
 SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name) {
   Timer timer("Loading " + path);
   pcl::PolygonMesh mesh = loadMesh(path);

@@ -40,8 +40,5 @@ FieldPrecision precisionArgument(const ToolArguments& args);
 /** Saves through saveMesh (format by extension, atomic), with a timing line. */
 void saveResult(const std::string& path, const pcl::PolygonMesh& mesh);
 
-/** Prints "tool: warning: message" on stderr. */
-void warn(const char* tool_name, const std::string& message);
-
 }  // namespace tools
 }  // namespace pcl_ddg

@@ -3,15 +3,41 @@
 #include <pcl/exceptions.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <utility>
 
+#include "pcl_ddg/exceptions.h"
+
 namespace pcl_ddg {
 namespace tools {
 namespace {
+
+// Whether stderr holds a line that has not been ended yet (a Timer label or a progress bar), and
+// what it shows.
+struct OpenLine {
+  bool open = false;
+  std::string label;
+};
+OpenLine& openLine() {
+  static OpenLine line;
+  return line;
+}
+
+bool stderrIsTerminal() { return isatty(fileno(stderr)) != 0; }
+
+void endOpenLine() {
+  if (openLine().open) std::fputc('\n', stderr);
+  openLine().open = false;
+}
+
+void printLabel(const std::string& label) {
+  pcl::console::print_highlight(stderr, "%s ", label.c_str());
+  openLine() = {true, label};
+}
 
 bool isOption(const std::string& arg) {
   // "-k" is an option; "-1.5" is a (negative) number.
@@ -99,20 +125,36 @@ int runTool(const char* name, const char* description, const char* syntax,
     std::cout << description << "\nSyntax is: " << name << " " << syntax << "\n";
     return 0;
   } catch (const UsageError& e) {
-    std::cerr << name << ": error: " << e.what() << "\n"
-              << description << "\nSyntax is: " << name << " " << syntax << "\n";
+    printError(name, e.what());
+    std::cerr << description << "\nSyntax is: " << name << " " << syntax << "\n";
     return 2;
   } catch (const pcl::BadArgumentException& e) {
-    std::cerr << name << ": error: " << e.what() << "\n";
+    printError(name, errorDescription(e));
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << name << ": error: " << e.what() << "\n";
+    printError(name, errorDescription(e));
+    return 1;
+  } catch (...) {
+    printError(name, "unknown internal error");
     return 1;
   }
 }
 
+void printError(const char* tool_name, const std::string& message) {
+  endOpenLine();
+  std::string line = message.empty() ? std::string("unknown error") : message;
+  std::replace(line.begin(), line.end(), '\n', ' ');
+  std::fprintf(stderr, "%s: error: %s\n", tool_name, line.c_str());
+  std::fflush(stderr);
+}
+
+void warn(const char* tool_name, const std::string& message) {
+  endOpenLine();
+  std::fprintf(stderr, "%s: warning: %s\n", tool_name, message.c_str());
+}
+
 ProgressBar::ProgressBar(std::string label)
-    : label_(std::move(label)), enabled_(isatty(fileno(stderr)) != 0) {}
+    : label_(std::move(label)), enabled_(stderrIsTerminal()) {}
 
 void ProgressBar::update(int done, int total) {
   if (!enabled_ || total < 2) return;
@@ -121,6 +163,7 @@ void ProgressBar::update(int done, int total) {
   std::fprintf(stderr, "\r%s [%s%s] %d/%d", label_.c_str(), std::string(filled, '#').c_str(),
                std::string(kWidth - filled, '.').c_str(), done, total);
   std::fflush(stderr);
+  openLine().open = true;
   drawn_ = true;
 }
 
@@ -129,12 +172,18 @@ void ProgressBar::finish() {
   drawn_ = false;
 }
 
-Timer::Timer(const std::string& what) {
-  pcl::console::print_highlight(stderr, "%s ", what.c_str());
+Timer::Timer(std::string what) : label_(std::move(what)) {
+  if (stderrIsTerminal()) printLabel(label_);
   clock_.tic();
 }
 
 void Timer::done(std::size_t points) {
+  // Re-labelled when something else was printed since (or nothing was, off a terminal).
+  if (!openLine().open || openLine().label != label_) {
+    endOpenLine();
+    printLabel(label_);
+  }
+  openLine().open = false;
   pcl::console::print_info(stderr, "[done, ");
   pcl::console::print_value(stderr, "%g", clock_.toc());
   pcl::console::print_info(stderr, " ms : ");

@@ -52,6 +52,13 @@ class ToolArguments {
 int runTool(const char* name, const char* description, const char* syntax,
             const std::function<int()>& body);
 
+/** Prints "tool: error: message" as one line of its own on stderr (newlines in the message become
+ *  spaces; an unfinished progress line is ended first). */
+void printError(const char* tool_name, const std::string& message);
+
+/** Prints "tool: warning: message" on a line of its own on stderr. */
+void warn(const char* tool_name, const std::string& message);
+
 /** A progress bar on stderr for long loops, drawn over the current Timer line, and only when
  *  stderr is a terminal (logs and pipes get the timing line alone). */
 class ProgressBar {
@@ -67,13 +74,18 @@ class ProgressBar {
   bool drawn_ = false;
 };
 
-/** Prints "[done, 12 ms : 35947 points]" style lines, as PCL's tools do. */
+/**
+ * Prints "> Loading x [done, 12 ms : 35947 points]" lines, as PCL's tools do. On a terminal the
+ * label appears at once (the user sees what is running); elsewhere (logs, pipes, tests) the whole
+ * line is written by done(), so that a failure leaves exactly one line: the error.
+ */
 class Timer {
  public:
-  explicit Timer(const std::string& what);
+  explicit Timer(std::string what);
   void done(std::size_t points);
 
  private:
+  std::string label_;
   pcl::console::TicToc clock_;
 };
 

@@ -1,0 +1,267 @@
+// PCD (PCL's own format), read here rather than by pcl::PCDReader: PCL's reader trusts the header
+// (negative or huge COUNT, WIDTH x HEIGHT != POINTS, lying compressed sizes) and crashes on it.
+// Every size is checked against the bytes the file really holds before anything is allocated.
+#include <pcl/io/lzf.h>
+
+#include <cstring>
+#include <limits>
+#include <vector>
+
+#include "byte_cursor.h"
+#include "formats.h"
+
+namespace pcl_ddg {
+namespace detail {
+namespace {
+
+enum class PcdData { Ascii, Binary, BinaryCompressed };
+
+struct PcdHeader {
+  std::vector<pcl::PCLPointField> fields;
+  std::vector<std::int64_t> sizes;
+  std::vector<char> types;
+  std::vector<std::int64_t> counts;
+  std::int64_t width = -1;
+  std::int64_t height = 1;
+  std::int64_t points = -1;
+  std::int64_t point_size = 0;  ///< bytes of one point, all fields (padding "_" included)
+  PcdData data = PcdData::Ascii;
+};
+
+std::uint8_t pcdDatatype(char type, std::int64_t size, const ByteCursor& cursor) {
+  if (type == 'F' && size == 4) return pcl::PCLPointField::FLOAT32;
+  if (type == 'F' && size == 8) return pcl::PCLPointField::FLOAT64;
+  if (type == 'I' && size == 1) return pcl::PCLPointField::INT8;
+  if (type == 'I' && size == 2) return pcl::PCLPointField::INT16;
+  if (type == 'I' && size == 4) return pcl::PCLPointField::INT32;
+  if (type == 'I' && size == 8) return pcl::PCLPointField::INT64;
+  if (type == 'U' && size == 1) return pcl::PCLPointField::UINT8;
+  if (type == 'U' && size == 2) return pcl::PCLPointField::UINT16;
+  if (type == 'U' && size == 4) return pcl::PCLPointField::UINT32;
+  if (type == 'U' && size == 8) return pcl::PCLPointField::UINT64;
+  cursor.fail("unsupported PCD field type " + std::string(1, type) + " of size " +
+              std::to_string(size));
+}
+
+// The values after a header keyword, as integers in [low, high].
+std::vector<std::int64_t> integers(ByteCursor& line, const char* what, std::int64_t low,
+                                   std::int64_t high) {
+  std::vector<std::int64_t> values;
+  for (std::string_view t = line.token(); !t.empty(); t = line.token()) {
+    const std::int64_t v = line.parseInt(t, what);
+    if (v < low || v > high) {
+      line.fail(std::string(what) + " " + std::to_string(v) + " is out of range " +
+                std::to_string(low) + ".." + std::to_string(high));
+    }
+    values.push_back(v);
+  }
+  return values;
+}
+
+PcdHeader parseHeader(ByteCursor& cursor) {
+  PcdHeader header;
+  std::vector<std::string> names;
+  for (;;) {
+    if (cursor.atEnd()) cursor.fail("not a PCD file (no DATA line)");
+    ByteCursor line = cursor.within(cursor.line());
+    const std::string_view key = line.token();
+    if (key.empty() || key.front() == '#' || key == "VERSION" || key == "VIEWPOINT") continue;
+    if (key == "FIELDS" || key == "COLUMNS") {
+      for (std::string_view t = line.token(); !t.empty(); t = line.token()) names.emplace_back(t);
+    } else if (key == "SIZE") {
+      header.sizes = integers(line, "SIZE", 1, 8);
+    } else if (key == "TYPE") {
+      for (std::string_view t = line.token(); !t.empty(); t = line.token()) {
+        if (t.size() != 1) line.fail("PCD TYPE must be F, I or U, not '" + std::string(t) + "'");
+        header.types.push_back(t.front());
+      }
+    } else if (key == "COUNT") {
+      // A field of more than 2^20 values per point is not a point attribute; it also keeps
+      // SIZE x COUNT x fields far from overflowing.
+      header.counts = integers(line, "COUNT", 1, 1 << 20);
+    } else if (key == "WIDTH") {
+      header.width = line.readInt("WIDTH");
+    } else if (key == "HEIGHT") {
+      header.height = line.readInt("HEIGHT");
+    } else if (key == "POINTS") {
+      header.points = line.readInt("POINTS");
+    } else if (key == "DATA") {
+      const std::string_view kind = line.requireToken("DATA kind");
+      if (kind == "ascii") {
+        header.data = PcdData::Ascii;
+      } else if (kind == "binary") {
+        header.data = PcdData::Binary;
+      } else if (kind == "binary_compressed") {
+        header.data = PcdData::BinaryCompressed;
+      } else {
+        line.fail("unknown PCD DATA kind '" + std::string(kind.substr(0, 40)) + "'");
+      }
+      break;
+    } else {
+      line.fail("not a PCD file (unknown header line '" + std::string(key.substr(0, 20)) + "')");
+    }
+  }
+
+  if (names.empty()) cursor.fail("PCD header has no FIELDS");
+  if (header.counts.empty()) header.counts.assign(names.size(), 1);
+  if (header.sizes.size() != names.size() || header.types.size() != names.size() ||
+      header.counts.size() != names.size()) {
+    cursor.fail("PCD header: FIELDS, SIZE, TYPE and COUNT have different lengths");
+  }
+  constexpr std::int64_t kMaxUInt32 = std::numeric_limits<std::uint32_t>::max();
+  if (header.width < 0 || header.width > kMaxUInt32 || header.height < 0 ||
+      header.height > kMaxUInt32) {
+    cursor.fail("PCD WIDTH or HEIGHT is missing or out of range");
+  }
+  const std::int64_t grid = cursor.product(header.width, header.height, "WIDTH x HEIGHT");
+  if (header.points < 0) header.points = grid;
+  if (header.points != grid) {
+    cursor.fail("PCD POINTS " + std::to_string(header.points) + " is not WIDTH x HEIGHT = " +
+                std::to_string(grid));
+  }
+  if (header.points == 0) cursor.fail("PCD file has no points");
+
+  std::int64_t offset = 0;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    pcl::PCLPointField field;
+    field.name = names[i];
+    field.offset = static_cast<std::uint32_t>(offset);
+    field.datatype = pcdDatatype(header.types[i], header.sizes[i], cursor);
+    field.count = static_cast<std::uint32_t>(header.counts[i]);
+    header.fields.push_back(field);
+    offset += header.sizes[i] * header.counts[i];  // each term <= 2^23: no overflow
+    if (offset > kMaxUInt32) cursor.fail("PCD point size exceeds 4 GiB");
+  }
+  header.point_size = offset;
+  return header;
+}
+
+// Stores an ascii value in its field's type; a value the type cannot hold is refused.
+void storeText(const ByteCursor& line, std::string_view token, std::uint8_t datatype,
+               std::uint8_t* dst) {
+  const char* what = "the PCD field type";
+  const double v = line.parseDouble(token, "PCD value");
+  switch (datatype) {
+    case pcl::PCLPointField::INT8:
+      return line.store<std::int8_t>(v, dst, what);
+    case pcl::PCLPointField::UINT8:
+      return line.store<std::uint8_t>(v, dst, what);
+    case pcl::PCLPointField::INT16:
+      return line.store<std::int16_t>(v, dst, what);
+    case pcl::PCLPointField::UINT16:
+      return line.store<std::uint16_t>(v, dst, what);
+    case pcl::PCLPointField::INT32:
+      return line.store<std::int32_t>(v, dst, what);
+    case pcl::PCLPointField::UINT32:
+      return line.store<std::uint32_t>(v, dst, what);
+    case pcl::PCLPointField::INT64:
+      return line.store<std::int64_t>(v, dst, what);
+    case pcl::PCLPointField::UINT64:
+      return line.store<std::uint64_t>(v, dst, what);
+    case pcl::PCLPointField::FLOAT32:
+      return line.store<float>(v, dst, what);
+    default:
+      return line.store<double>(v, dst, what);
+  }
+}
+
+void readAscii(ByteCursor& cursor, const PcdHeader& header, pcl::PCLPointCloud2& cloud) {
+  std::int64_t point = 0;
+  while (point < header.points) {
+    if (cursor.atEnd()) cursor.fail("PCD data has fewer rows than POINTS (truncated?)");
+    ByteCursor line = cursor.within(cursor.line());
+    if (line.lineEnded()) continue;  // blank line
+    std::uint8_t* dst = cloud.data.data() + point * cloud.point_step;
+    for (std::size_t f = 0; f < header.fields.size(); ++f) {
+      const pcl::PCLPointField& field = header.fields[f];
+      for (std::uint32_t c = 0; c < field.count; ++c) {
+        storeText(line, line.requireToken("PCD value"), field.datatype,
+                  dst + field.offset + c * header.sizes[f]);
+      }
+    }
+    if (!line.token().empty()) line.fail("PCD row has more values than FIELDS x COUNT");
+    ++point;
+  }
+}
+
+// binary_compressed: two uint32 sizes, then LZF data that decompress to one array per field
+// (padding fields "_" are not stored).
+void readCompressed(ByteCursor& cursor, const PcdHeader& header, pcl::PCLPointCloud2& cloud) {
+  const auto compressed = cursor.readBinary<std::uint32_t>(ByteOrder::Little, "compressed size");
+  const auto uncompressed =
+      cursor.readBinary<std::uint32_t>(ByteOrder::Little, "uncompressed size");
+  std::uint64_t expected = 0;
+  for (std::size_t f = 0; f < header.fields.size(); ++f) {
+    if (header.fields[f].name != "_")
+      expected += static_cast<std::uint64_t>(header.sizes[f] * header.counts[f]) *
+                  static_cast<std::uint64_t>(header.points);
+  }
+  if (uncompressed != expected) {
+    cursor.fail("PCD uncompressed size " + std::to_string(uncompressed) +
+                " is not POINTS x point size = " + std::to_string(expected));
+  }
+  const char* packed = cursor.take(compressed, "compressed PCD data");
+  if (compressed == 0) cursor.fail("PCD compressed data is empty");
+  std::vector<char> unpacked(uncompressed);
+  if (uncompressed > 0 &&
+      pcl::lzfDecompress(packed, compressed, unpacked.data(), uncompressed) != uncompressed) {
+    cursor.fail("PCD compressed data is corrupt");
+  }
+  const char* src = unpacked.data();
+  for (std::size_t f = 0; f < header.fields.size(); ++f) {
+    if (header.fields[f].name == "_") continue;
+    const std::size_t size = static_cast<std::size_t>(header.sizes[f] * header.counts[f]);
+    for (std::int64_t i = 0; i < header.points; ++i, src += size) {
+      std::memcpy(cloud.data.data() + i * cloud.point_step + header.fields[f].offset, src, size);
+    }
+  }
+}
+
+}  // namespace
+
+pcl::PolygonMesh parsePCD(std::string_view data) {
+  ByteCursor cursor(data);
+  const PcdHeader header = parseHeader(cursor);
+  const std::int64_t point_size = header.point_size;
+  const std::int64_t remaining = static_cast<std::int64_t>(cursor.remaining());
+  // What the body must hold at least: all of it (binary), a digit and a separator per point
+  // (ascii), or what LZF (at most ~90x expansion) can give. Checked before allocating anything,
+  // so that a small file never costs more than a small multiple of its size.
+  const std::int64_t bytes = cursor.product(point_size, header.points, "POINTS x point size");
+  if ((header.data == PcdData::Binary && bytes > remaining) ||
+      (header.data == PcdData::Ascii && header.points > remaining / 2) ||
+      (header.data == PcdData::BinaryCompressed && bytes / 128 > remaining)) {
+    cursor.fail("PCD data shorter than POINTS x point size (truncated?)");
+  }
+  if (bytes > std::numeric_limits<std::uint32_t>::max()) {
+    cursor.fail("PCD cloud too large for a pcl::PCLPointCloud2 (4 GiB)");
+  }
+
+  pcl::PolygonMesh mesh;
+  pcl::PCLPointCloud2& cloud = mesh.cloud;
+  cloud.fields = header.fields;
+  cloud.width = static_cast<std::uint32_t>(header.width);
+  cloud.height = static_cast<std::uint32_t>(header.height);
+  cloud.point_step = static_cast<std::uint32_t>(point_size);
+  cloud.row_step = static_cast<std::uint32_t>(point_size * header.width);
+  cloud.is_dense = false;  // unknown until checked; consumers test finiteness themselves
+  switch (header.data) {
+    case PcdData::Ascii:
+      cloud.data.resize(static_cast<std::size_t>(bytes));
+      readAscii(cursor, header, cloud);
+      break;
+    case PcdData::Binary: {
+      const char* body = cursor.take(static_cast<std::size_t>(bytes), "data");
+      cloud.data.assign(body, body + bytes);
+      break;
+    }
+    case PcdData::BinaryCompressed:
+      cloud.data.resize(static_cast<std::size_t>(bytes));
+      readCompressed(cursor, header, cloud);
+      break;
+  }
+  return mesh;
+}
+
+}  // namespace detail
+}  // namespace pcl_ddg
