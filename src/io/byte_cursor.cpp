@@ -3,10 +3,10 @@
 #include <sys/stat.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
 #include <cctype>
+#include <cerrno>
 #include <charconv>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 
@@ -126,8 +126,8 @@ void ByteCursor::failOutOfRange(double v, const char* what) const {
 std::int64_t ByteCursor::product(std::int64_t a, std::int64_t b, const char* what) const {
   std::int64_t result = 0;
   if (a < 0 || b < 0 || __builtin_mul_overflow(a, b, &result)) {
-    fail(std::string("impossible ") + what + " (" + std::to_string(a) + " x " +
-         std::to_string(b) + ")");
+    fail(std::string("impossible ") + what + " (" + std::to_string(a) + " x " + std::to_string(b) +
+         ")");
   }
   return result;
 }

@@ -41,6 +41,7 @@ std::string fileExtension(const std::string& path) {
 pcl::PolygonMesh loadMesh(const std::string& path) {
   const std::string ext = fileExtension(path);
   try {
+    const std::string data = detail::readWholeFile(path);  // first: a missing file says so
     using Parser = pcl::PolygonMesh (*)(std::string_view);
     Parser parse = nullptr;
     if (ext == "ply") parse = detail::parsePLY;
@@ -54,7 +55,6 @@ pcl::PolygonMesh loadMesh(const std::string& path) {
           (ext.empty() ? std::string("no file extension") : "unknown file type '." + ext + "'") +
           " (expected .ply, .obj, .off, .stl, .vtk or .pcd)");
     }
-    const std::string data = detail::readWholeFile(path);
     pcl::PolygonMesh mesh = parse(data);
     if (mesh.cloud.width * mesh.cloud.height == 0)
       throw FileFormatException("file has no vertices");

@@ -1,5 +1,6 @@
 // Object File Format (Geomview): "OFF" header, counts, vertices, faces. Colour and normal variants
-// (COFF, NOFF, CNOFF) carry extra values per line, which are ignored; "OFF BINARY" in either byte order.
+// (COFF, NOFF, CNOFF) carry extra values per line, which are ignored; "OFF BINARY" in either byte
+// order.
 #include <vector>
 
 #include "byte_cursor.h"

@@ -116,8 +116,8 @@ PcdHeader parseHeader(ByteCursor& cursor) {
   const std::int64_t grid = cursor.product(header.width, header.height, "WIDTH x HEIGHT");
   if (header.points < 0) header.points = grid;
   if (header.points != grid) {
-    cursor.fail("PCD POINTS " + std::to_string(header.points) + " is not WIDTH x HEIGHT = " +
-                std::to_string(grid));
+    cursor.fail("PCD POINTS " + std::to_string(header.points) +
+                " is not WIDTH x HEIGHT = " + std::to_string(grid));
   }
   if (header.points == 0) cursor.fail("PCD file has no points");
 

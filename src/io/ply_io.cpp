@@ -205,7 +205,8 @@ class PlyValueReader {
     const std::uint32_t item_bytes = format_ == PlyFormat::Ascii ? 2 : typeSize(item_type);
     if (!(n >= 0.0) || n != std::floor(n) ||
         n > static_cast<double>(cursor_.remaining() / item_bytes + 1)) {
-      cursor_.fail(std::string("invalid list length in ") + what + " (more items than the file holds)");
+      cursor_.fail(std::string("invalid list length in ") + what +
+                   " (more items than the file holds)");
     }
     return static_cast<std::int64_t>(n);
   }
@@ -246,8 +247,7 @@ class PlyValueReader {
   }
 
   void skip(const PlyProperty& property, const char* what) {
-    const std::int64_t n =
-        property.is_list ? count(property.count_type, property.type, what) : 1;
+    const std::int64_t n = property.is_list ? count(property.count_type, property.type, what) : 1;
     for (std::int64_t i = 0; i < n; ++i) number(property.type, what);
   }
 

@@ -130,9 +130,8 @@ pcl::PolygonMesh parseVTK(std::string_view data) {
   for (std::string_view keyword = cursor.token(); !keyword.empty(); keyword = cursor.token()) {
     if (keyword == "POINTS") {
       const std::int64_t n = cursor.readInt("point count");
-      const std::vector<double> xyz =
-          reader.values(cursor.product(n, 3, "point count"), cursor.requireToken("point type"),
-                        "points");
+      const std::vector<double> xyz = reader.values(cursor.product(n, 3, "point count"),
+                                                    cursor.requireToken("point type"), "points");
       mesh.cloud = makeXYZCloud(xyz);
       has_points = true;
     } else if (keyword == "POLYGONS" || keyword == "TRIANGLE_STRIPS" || keyword == "VERTICES" ||

@@ -27,7 +27,9 @@ OpenLine& openLine() {
   return line;
 }
 
-bool stderrIsTerminal() { return isatty(fileno(stderr)) != 0; }
+bool stderrIsTerminal() {
+  return isatty(fileno(stderr)) != 0;
+}
 
 void endOpenLine() {
   if (openLine().open) std::fputc('\n', stderr);

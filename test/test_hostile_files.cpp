@@ -1,0 +1,296 @@
+// Files made to crash, hang or exhaust a loader (each seen in an attack on the tools): every one
+// must fail with a FileFormatException naming the problem, at a cost of a small multiple of its
+// size. Each case is a tiny file written by the test.
+#include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <filesystem>
+#include <functional>
+
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+#include "test_data.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+// Peak resident memory (MiB) of running `work` in a child process (so that an allocation storm
+// cannot take the test runner down); -1 if the child crashed.
+long childPeakMiB(const std::function<void()>& work) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    try {
+      work();
+    } catch (...) {
+    }
+    _exit(0);
+  }
+  int status = 0;
+  rusage usage{};
+  wait4(pid, &status, 0, &usage);
+  if (!WIFEXITED(status)) return -1;
+  return usage.ru_maxrss / 1024;
+}
+
+template <typename T>
+std::string bytesOf(T value, bool big_endian = false) {
+  std::string bytes(sizeof(T), '\0');
+  std::memcpy(bytes.data(), &value, sizeof(T));
+  if (big_endian) std::reverse(bytes.begin(), bytes.end());
+  return bytes;
+}
+
+class HostileFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = scratchFolder(::testing::UnitTest::GetInstance()->current_test_info()->name());
+    baseline_mib_ = childPeakMiB([] {});
+  }
+  std::string write(const std::string& name, const std::string& content) const {
+    const std::string path = dir_ + "/" + name;
+    writeText(path, content);
+    return path;
+  }
+  // The file is refused with a message containing `expected`, without a crash and without
+  // costing more than 64 MiB over an idle child.
+  void expectRefused(const std::string& name, const std::string& content,
+                     const std::string& expected) const {
+    SCOPED_TRACE(name);
+    const std::string path = write(name, content);
+    try {
+      loadMesh(path);
+      ADD_FAILURE() << "loaded without error";
+    } catch (const FileFormatException& e) {
+      const std::string message = errorDescription(e);
+      EXPECT_NE(message.find(expected), std::string::npos) << message;
+      EXPECT_EQ(message.find(": :"), std::string::npos) << message;
+      EXPECT_EQ(message.rfind(path, 0), 0u) << message;  // starts with the file's name
+    }
+    const long peak = childPeakMiB([&] { loadMesh(path); });
+    EXPECT_GE(peak, 0) << "the loader crashed";
+    EXPECT_LT(peak, baseline_mib_ + 64) << "MiB for a " << content.size() << "-byte file";
+  }
+  std::string dir_;
+  long baseline_mib_ = 0;
+};
+
+const std::string kPlyVertexHeader =
+    "ply\nformat binary_little_endian 1.0\nelement vertex 357913942\n"
+    "property float x\nproperty float y\nproperty float z\nend_header\n";
+
+TEST_F(HostileFiles, PlyVertexCountsThatWrapOrExceedTheFile) {
+  // 357913942 x 12 bytes wraps a 32-bit row_step to 8; this once wrote past the buffer.
+  expectRefused("wrap.ply", kPlyVertexHeader + std::string(24, '\0'), "more than the file holds");
+  std::string huge = kPlyVertexHeader;
+  huge.replace(huge.find("357913942"), 9, "4294967297");
+  expectRefused("huge.ply", huge + std::string(24, '\0'), "more than the file holds");
+  expectRefused("intmax.ply",
+                "ply\nformat ascii 1.0\nelement vertex 2147483647\nproperty float x\n"
+                "property float y\nproperty float z\nend_header\n0 0 0\n",
+                "more than the file holds");
+  expectRefused("nopropertiesvertices.ply",
+                "ply\nformat ascii 1.0\nelement vertex 1000000000000\nend_header\n",
+                "no properties");
+}
+
+TEST_F(HostileFiles, PlyListLengthsThatExceedTheFile) {
+  // 187 bytes asking for a face of 10^9 corners (was 7.8 GB).
+  expectRefused("biglist.ply",
+                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                "property float z\nelement face 1\nproperty list uint int vertex_indices\n"
+                "end_header\n0 0 0\n1 0 0\n0 1 0\n1000000000 0 1 2\n",
+                "invalid list length");
+  std::string binary =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\n"
+      "element face 1\nproperty list uint int vertex_indices\nend_header\n";
+  binary += bytesOf<std::uint32_t>(4000000000u) + std::string(12, '\0');
+  expectRefused("biglist_binary.ply", binary, "invalid list length");
+}
+
+TEST_F(HostileFiles, PlyValuesOutsideTheirTypeAreRefusedWithTheLine) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty uchar x\nproperty float y\n"
+      "property float z\nend_header\n1 0 0\n";
+  expectRefused("uchar300.ply", header + "300 0 0\n", "line 9: value 300 is out of range");
+  expectRefused("ucharneg.ply", header + "-5 0 0\n", "line 9: value -5 is out of range");
+  expectRefused("uchar1e30.ply", header + "1e30 0 0\n", "out of range");
+  expectRefused("ucharfrac.ply", header + "1.5 0 0\n", "out of range");
+  expectRefused("float1e300.ply", header + "1 1e300 0\n", "line 9: value 1e+300 is out of range");
+  expectRefused("float_index.ply",
+                "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                "property float z\nelement face 1\nproperty list uchar float vertex_indices\n"
+                "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1e30\n",
+                "out of range for a vertex index");
+}
+
+TEST_F(HostileFiles, PlyRangeGridSizesThatOverflow) {
+  expectRefused("grid.ply",
+                "ply\nformat ascii 1.0\nobj_info num_cols 4611686018427387904\n"
+                "obj_info num_rows 4\nelement vertex 1\nproperty float x\nproperty float y\n"
+                "property float z\nelement range_grid 1\nproperty list uchar int vertex_indices\n"
+                "end_header\n0 0 0\n1 0\n",
+                "range_grid size");
+}
+
+const std::string kPcdHeader =
+    "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\n"
+    "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\n";
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  text.replace(text.find(from), from.size(), to);
+  return text;
+}
+
+TEST_F(HostileFiles, PcdHeadersThatLie) {
+  const std::string body = "DATA binary\n" + std::string(24, '\0');
+  expectRefused("count_negative.pcd", replaced(kPcdHeader, "COUNT 1 1 1", "COUNT 1 1 -1") + body,
+                "COUNT -1 is out of range");
+  expectRefused("count_huge.pcd",
+                replaced(kPcdHeader, "COUNT 1 1 1", "COUNT 1 1 2147483648") + body, "out of range");
+  expectRefused("points.pcd", replaced(kPcdHeader, "POINTS 2", "POINTS 3") + body,
+                "is not WIDTH x HEIGHT");
+  expectRefused("width.pcd",
+                replaced(replaced(kPcdHeader, "WIDTH 2", "WIDTH 4294967295"), "POINTS 2",
+                         "POINTS 4294967295") +
+                    body,
+                "shorter than POINTS");
+  expectRefused("width_overflow.pcd",
+                replaced(replaced(kPcdHeader, "WIDTH 2", "WIDTH 4294967295"), "HEIGHT 1",
+                         "HEIGHT 4294967295") +
+                    body,
+                "impossible WIDTH x HEIGHT");
+  expectRefused("size.pcd", replaced(kPcdHeader, "SIZE 4 4 4", "SIZE 4 4 3") + body,
+                "unsupported PCD field type F of size 3");
+  expectRefused("truncated.pcd", kPcdHeader + "DATA binary\n" + std::string(23, '\0'),
+                "shorter than POINTS");
+  expectRefused("ascii_short.pcd", kPcdHeader + "DATA ascii\n1 2 3\n", "fewer rows than POINTS");
+  expectRefused("ascii_range.pcd",
+                replaced(kPcdHeader, "TYPE F F F", "TYPE F F U") + "DATA ascii\n1 2 3\n1 2 -3\n",
+                "out of range");
+}
+
+TEST_F(HostileFiles, PcdCompressedSizesThatLie) {
+  const std::string header = kPcdHeader + "DATA binary_compressed\n";
+  expectRefused("zero.pcd", header + bytesOf<std::uint32_t>(4) + bytesOf<std::uint32_t>(0) + "abcd",
+                "uncompressed size 0 is not");
+  expectRefused("empty.pcd", header + bytesOf<std::uint32_t>(0) + bytesOf<std::uint32_t>(24),
+                "compressed data is empty");
+  expectRefused(
+      "corrupt.pcd",
+      header + bytesOf<std::uint32_t>(4) + bytesOf<std::uint32_t>(24) + "\xff\xff\xff\xff",
+      "corrupt");
+  expectRefused("beyond.pcd",
+                header + bytesOf<std::uint32_t>(100) + bytesOf<std::uint32_t>(24) + "abcd",
+                "unexpected end of file");
+  const std::string absurd =
+      replaced(replaced(header, "WIDTH 2", "WIDTH 1000000000"), "POINTS 2", "POINTS 1000000000");
+  expectRefused("absurd.pcd",
+                absurd + bytesOf<std::uint32_t>(4) + bytesOf<std::uint32_t>(24) + "abcd",
+                "shorter than POINTS");
+}
+
+TEST_F(HostileFiles, OffCountsThatExceedTheFile) {
+  expectRefused("faces.off", "OFF\n3 900000000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                "larger than the file can hold");
+  expectRefused("facesize.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4611686018427387904 0 1 2\n",
+                "does not fit its line");
+  std::string binary = "OFF BINARY\n";
+  for (std::int32_t n : {3, 900000000, 0}) binary += bytesOf(n, true);
+  expectRefused("faces_binary.off", binary + std::string(36, '\0'), "neither byte order");
+}
+
+TEST_F(HostileFiles, BinaryOffIsReadInBothByteOrders) {
+  for (const bool big : {true, false}) {
+    std::string data = "OFF BINARY\n";
+    for (std::int32_t n : {3, 1, 0}) data += bytesOf(n, big);
+    for (float v : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 2.f, 0.f}) data += bytesOf(v, big);
+    for (std::int32_t n : {3, 0, 1, 2, 0}) data += bytesOf(n, big);
+    const pcl::PolygonMesh mesh = loadMesh(write(big ? "big.off" : "little.off", data));
+    ASSERT_EQ(mesh.polygons.size(), 1u);
+    EXPECT_EQ(vertexPositions(mesh.cloud).col(2), Eigen::Vector3d(0, 2, 0));
+  }
+}
+
+TEST_F(HostileFiles, VtkCountsThatOverflow) {
+  expectRefused("points.vtk",
+                "# vtk DataFile Version 3.0\nx\nASCII\nDATASET POLYDATA\n"
+                "POINTS 4611686018427387904 float\n0 0 0\n",
+                "impossible point count");
+  expectRefused("offsets.vtk",
+                "# vtk DataFile Version 5.1\nx\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n"
+                "0 0 0 1 0 0 0 1 0\nPOLYGONS 2 3\nOFFSETS vtktypeint64\n0 1e30\n"
+                "CONNECTIVITY vtktypeint64\n0 1 2\n",
+                "out of range for a VTK cell index");
+}
+
+TEST_F(HostileFiles, OnlyRegularFilesAreRead) {
+  for (const char* device : {"/dev/zero", "/dev/null"}) {
+    SCOPED_TRACE(device);
+    std::filesystem::create_symlink(device, dir_ + "/device.ply");
+    try {
+      loadMesh(dir_ + "/device.ply");
+      ADD_FAILURE() << "a device was read";
+    } catch (const FileFormatException& e) {
+      EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+    }
+    std::filesystem::remove(dir_ + "/device.ply");
+  }
+  std::filesystem::create_directory(dir_ + "/folder.ply");
+  try {
+    loadMesh(dir_ + "/folder.ply");
+    ADD_FAILURE() << "a directory was read";
+  } catch (const FileFormatException& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+  try {
+    loadMesh(write("noextension", "OFF\n"));
+    ADD_FAILURE();
+  } catch (const FileFormatException& e) {
+    EXPECT_NE(std::string(e.what()).find("no file extension"), std::string::npos) << e.what();
+  }
+}
+
+// Our PCD reader against PCL's on every shared cloud (PCL's is trusted on well-formed files),
+// and on binary_compressed files that PCL's writer makes.
+TEST_F(HostileFiles, PcdReaderAgreesWithPclOnWellFormedFiles) {
+  for (const char* name :
+       {"bun0.pcd", "milk.pcd", "office1.pcd", "rs1.pcd", "table_scene_mug_stereo_textured.pcd",
+        "terrain_CSite1_red2-utm.pcd", "tutorials_room_scan1.pcd"}) {
+    SCOPED_TRACE(name);
+    pcl::PCLPointCloud2 expected;
+    ASSERT_EQ(pcl::PCDReader().read(sharedData(std::string("clouds/") + name), expected), 0);
+    pcl::PCDWriter writer;
+    const std::string compressed = dir_ + "/compressed.pcd";
+    ASSERT_EQ(writer.writeBinaryCompressed(compressed, expected), 0);
+    for (const std::string& path : {sharedData(std::string("clouds/") + name), compressed}) {
+      const pcl::PCLPointCloud2 ours = loadMesh(path).cloud;
+      EXPECT_EQ(ours.width, expected.width);
+      EXPECT_EQ(ours.height, expected.height);
+      EXPECT_EQ(ours.point_step, expected.point_step);
+      ASSERT_EQ(ours.fields.size(), expected.fields.size());
+      for (std::size_t f = 0; f < ours.fields.size(); ++f) {
+        EXPECT_EQ(ours.fields[f].name, expected.fields[f].name);
+        EXPECT_EQ(ours.fields[f].offset, expected.fields[f].offset);
+        EXPECT_EQ(ours.fields[f].datatype, expected.fields[f].datatype);
+        EXPECT_EQ(ours.fields[f].count, expected.fields[f].count);
+      }
+      // Byte for byte, except padding ("_") which PCL's compressed writer does not store.
+      const Eigen::Matrix3Xd a = vertexPositions(ours, NonFinitePolicy::Keep);
+      const Eigen::Matrix3Xd b = vertexPositions(expected, NonFinitePolicy::Keep);
+      EXPECT_TRUE(((a.array() == b.array()) || (a.array().isNaN() && b.array().isNaN())).all());
+      bool has_padding = false;
+      for (const auto& f : ours.fields) has_padding |= f.name == "_";
+      if (!has_padding) EXPECT_EQ(ours.data, expected.data);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
