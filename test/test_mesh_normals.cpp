@@ -10,6 +10,7 @@
 
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/operators/curvature.h"
 #include "pcl_ddg/surface/mesh_normals.h"
 #include "test_data.h"
 
@@ -98,6 +99,40 @@ TEST(MeshNormals, IsolatedAndSliverOnlyVerticesAreNaNAndMasked) {
     EXPECT_TRUE(std::isnan(n.normals(0, 4)));
     EXPECT_EQ(n.normals.col(0), Eigen::Vector3d(0, 0, 1));
   }
+}
+
+TEST(MeshNormals, FaceNormalsThatCancelGiveNaNAndACountForEveryWeightingAndForH) {
+  // A square (two triangles) with the first triangle repeated in reverse, 1e5 from the origin:
+  // vertex 1 lies only on the triangle and its reverse, so its face normals cancel and any
+  // direction (or sign of H) would be rounding noise. Vertices 0 and 2 keep a normal.
+  Eigen::Matrix3Xd x(3, 4);
+  x << 0, 1, 1, 0,   //
+      0, 0, 1.3, 1,  //
+      0, 0.1, 0, 0.2;
+  x.array() += 1e5;
+  Eigen::Matrix3Xi faces(3, 3);
+  faces << 0, 0, 0,  //
+      1, 2, 2,       //
+      2, 3, 1;
+  const MeshTopology topology(4, faces);
+  for (const NormalWeighting weighting : {NormalWeighting::Uniform, NormalWeighting::Area,
+                                          NormalWeighting::Angle, NormalWeighting::MeanCurvature}) {
+    SCOPED_TRACE(static_cast<int>(weighting));
+    MeshNormalOptions options;
+    options.weighting = weighting;
+    const MeshNormals n = computeMeshNormals(topology, x, options);
+    EXPECT_TRUE(n.normals.col(1).array().isNaN().all()) << n.normals.col(1).transpose();
+    EXPECT_EQ(n.valid[1], 0);
+    EXPECT_EQ(n.cancelled_vertices, 1);
+    EXPECT_EQ(n.invalid_vertices, 1);
+    for (const int v : {0, 2, 3}) EXPECT_NEAR(n.normals.col(v).norm(), 1.0, 1e-12);
+  }
+  const VertexCurvatures c = computeCurvatures(topology, x);
+  EXPECT_TRUE(std::isnan(c.mean[1]) && std::isnan(c.kappa1[1]) && std::isnan(c.kappa2[1]));
+  EXPECT_TRUE(std::isfinite(c.gauss[1]));  // the angle defect needs no orientation
+  EXPECT_EQ(c.valid[1], 0);
+  EXPECT_EQ(c.unoriented_vertices, 1);
+  for (const int v : {0, 2, 3}) EXPECT_TRUE(std::isfinite(c.mean[v]));
 }
 
 TEST(MeshNormals, RealScansGiveUnitFiniteNormalsWhereValid) {

@@ -64,18 +64,49 @@ TEST_F(SmoothingTools, SmoothSharedMeshesBothSchemesKeepTheMeshAndPreserveVolume
   expectNoLeftovers();
 }
 
-TEST_F(SmoothingTools, ExplicitStepsReportTheStabilityBoundAndWarnAboveIt) {
+TEST_F(SmoothingTools, ExplicitStepsAboveTheStabilityBoundAreRefusedUnlessAllowed) {
   const std::string cow = sharedData("meshes/cow.off");
   const ToolRun safe =
       runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("a.ply") + " -method explicit");
   ASSERT_EQ(safe.exit_code, 0) << safe.err;
   EXPECT_NE(safe.err.find("stability bound"), std::string::npos) << safe.err;
   EXPECT_EQ(safe.err.find("warning"), std::string::npos) << safe.err;
-  const ToolRun risky =
+  const ToolRun refused =
       runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("b.ply") + " -method explicit -lambda_dt 1");
-  EXPECT_NE(risky.err.find("warning: the step exceeds the explicit stability bound"),
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("pcl_ddg_smooth: error: the explicit step 1"), std::string::npos)
+      << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(path("b.ply")));
+  const ToolRun allowed = runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("c.ply") +
+                                                           " -method explicit -lambda_dt 1 "
+                                                           "-iterations 2 -allow_unstable");
+  EXPECT_NE(allowed.err.find("warning: the step exceeds the explicit stability bound"),
             std::string::npos)
-      << risky.err;
+      << allowed.err;
+}
+
+TEST_F(SmoothingTools, MeshQualityIsReportedAndAnOpenScanWarnsAboutItsShrinkingBoundary) {
+  const std::string scan = sharedData("meshes/bun045_rangegrid_tri.ply");
+  const ToolRun free_boundary =
+      runTool(PCL_DDG_SMOOTH_TOOL, scan + " " + path("a.ply") + " -lambda_dt 2 -iterations 3");
+  ASSERT_EQ(free_boundary.exit_code, 0) << free_boundary.err;
+  EXPECT_NE(free_boundary.err.find("smallest angle"), std::string::npos) << free_boundary.err;
+  EXPECT_NE(free_boundary.err.find("warning: the free boundary of this open mesh shrank"),
+            std::string::npos)
+      << free_boundary.err;
+  const ToolRun fixed =
+      runTool(PCL_DDG_SMOOTH_TOOL,
+              scan + " " + path("b.ply") + " -lambda_dt 2 -iterations 3 -fix_boundary");
+  ASSERT_EQ(fixed.exit_code, 0) << fixed.err;
+  EXPECT_EQ(fixed.err.find("shrank"), std::string::npos) << fixed.err;
+  // One triangle with a fixed boundary: nothing to solve for, said so, input written back.
+  writeText(path("triangle.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const ToolRun triangle =
+      runTool(PCL_DDG_SMOOTH_TOOL, path("triangle.obj") + " " + path("t.ply") + " -fix_boundary");
+  ASSERT_EQ(triangle.exit_code, 0) << triangle.err;
+  EXPECT_NE(triangle.err.find("no vertex is free to move"), std::string::npos) << triangle.err;
+  EXPECT_EQ(vertexPositions(loadMesh(path("t.ply")).cloud),
+            vertexPositions(loadMesh(path("triangle.obj")).cloud));
 }
 
 TEST_F(SmoothingTools, BadInputAndOptionsGiveOneLineAndNoOutput) {
@@ -141,6 +172,44 @@ TEST_F(SmoothingTools, OrganizedCloudKeepsItsGridHolesAndRays) {
                 .exit_code,
             2);
   EXPECT_FALSE(std::filesystem::exists(path("flat.pcd")));
+  expectNoLeftovers();
+}
+
+TEST_F(SmoothingTools, OrganizedSmoothingNeverWritesInfinitiesAndKeepsPointsAtTheSensor) {
+  const std::string input = sharedData("clouds/table_scene_mug_stereo_textured.pcd");
+  const ToolRun refused =
+      runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL,
+              input + " " + path("a.pcd") + " -method explicit -lambda_dt 1e300");
+  EXPECT_EQ(refused.exit_code, 2) << refused.err;
+  const ToolRun blown =
+      runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL,
+              input + " " + path("b.pcd") + " -method explicit -lambda_dt 1e300 -allow_unstable");
+  EXPECT_EQ(blown.exit_code, 1) << blown.err;
+  EXPECT_NE(blown.err.find("pcl_ddg_smooth_organized: error: "), std::string::npos) << blown.err;
+  EXPECT_FALSE(std::filesystem::exists(path("a.pcd")));
+  EXPECT_FALSE(std::filesystem::exists(path("b.pcd")));
+
+  // A 3 x 2 frame: a point at the sensor origin, a hole, four points on a plane.
+  const std::string header =
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 2\n"
+      "POINTS 6\nDATA ascii\n";
+  writeText(path("frame.pcd"), header + "0 0 0\nnan nan nan\n1 0 2\n0 1 2.2\n1 1 1.9\n2 1 2\n");
+  const ToolRun frame =
+      runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL, path("frame.pcd") + " " + path("frame_out.pcd"));
+  ASSERT_EQ(frame.exit_code, 0) << frame.err;
+  const Eigen::Matrix3Xd q =
+      vertexPositions(loadMesh(path("frame_out.pcd")).cloud, NonFinitePolicy::Keep);
+  EXPECT_EQ(q.col(0), Eigen::Vector3d::Zero()) << "the point at the sensor stays";
+  EXPECT_TRUE(q.col(1).array().isNaN().all()) << "the hole stays a hole";
+  EXPECT_TRUE(q.rightCols(4).allFinite());
+
+  writeText(path("empty.pcd"), header +
+                                   "nan nan nan\nnan nan nan\nnan nan nan\nnan nan nan\n"
+                                   "nan nan nan\nnan nan nan\n");
+  const ToolRun empty =
+      runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL, path("empty.pcd") + " " + path("empty_out.pcd"));
+  ASSERT_EQ(empty.exit_code, 0) << empty.err;
+  EXPECT_NE(empty.err.find("no valid pixel"), std::string::npos) << empty.err;
   expectNoLeftovers();
 }
 

@@ -65,8 +65,15 @@ int run(int argc, char** argv) {
     tools::Timer timer("Computing curvatures");
     const VertexCurvatures c = computeCurvatures(*in.topology, in.positions, mass);
     timer.done(static_cast<std::size_t>(in.positions.cols()));
-    if (c.invalid_vertices > 0)
-      tools::warn(kName, std::to_string(c.invalid_vertices) + " vertices without area (NaN)");
+    if (c.invalid_vertices > c.unoriented_vertices) {
+      tools::warn(kName, std::to_string(c.invalid_vertices - c.unoriented_vertices) +
+                             " vertices without area (NaN)");
+    }
+    if (c.unoriented_vertices > 0) {
+      tools::warn(kName, std::to_string(c.unoriented_vertices) +
+                             " vertices whose face normals cancel (reversed duplicate faces?): "
+                             "H, k1, k2 NaN there");
+    }
     if (c.clamped_vertices > 0) {
       tools::warn(kName, std::to_string(c.clamped_vertices) +
                              " vertices with H^2 < K (umbilic or noisy): k1 = k2 = H there");

@@ -73,8 +73,11 @@ int run(int argc, char** argv) {
     const MeshNormals normals = computeMeshNormals(*in.topology, positions, options);
     timer.done(static_cast<std::size_t>(positions.cols()));
     if (normals.invalid_vertices > 0) {
-      tools::warn(kName,
-                  std::to_string(normals.invalid_vertices) + " vertices without a normal (NaN)");
+      tools::warn(kName, std::to_string(normals.invalid_vertices) +
+                             " vertices without a normal (NaN), " +
+                             std::to_string(normals.cancelled_vertices) +
+                             " of them because their face normals cancel (reversed duplicate "
+                             "faces?)");
     }
     if (options.weighting == NormalWeighting::MeanCurvature) {
       tools::warn(kName, std::to_string(normals.fallback_vertices) +

@@ -1,5 +1,7 @@
 // pcl_ddg_smooth: Laplacian smoothing of a mesh's vertex positions, explicit (many small steps)
 // or implicit (few large ones), with the time step in units of the squared mean edge length.
+#include <pcl/exceptions.h>
+
 #include <cmath>
 #include <iostream>
 
@@ -25,7 +27,8 @@ constexpr const char* kSyntax =
     "cotan)]\n"
     "         [-mass mixed|voronoi|barycentric] [-lambda_dt t (default: implicit 1, explicit half "
     "the stability bound)]\n"
-    "         [-iterations n (default 1)] [-absolute_time] [-freeze_weights] [-fix_boundary]\n"
+    "         [-iterations n (default 1)] [-absolute_time] [-freeze_weights | -rebuild_weights]\n"
+    "         [-fix_boundary] [-allow_unstable]\n"
     "         [-preserve volume|area] [-solver auto|cholmod|ldlt] [-precision float|double]";
 
 int run(int argc, char** argv) {
@@ -33,7 +36,7 @@ int run(int argc, char** argv) {
   const tools::ToolArguments args(
       argc, argv,
       {"method", "weights", "mass", "lambda_dt", "iterations", "preserve", "solver", "precision"},
-      {"absolute_time", "freeze_weights", "fix_boundary"});
+      {"absolute_time", "freeze_weights", "rebuild_weights", "fix_boundary", "allow_unstable"});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
   MeshSmoothingParameters p;
@@ -46,7 +49,11 @@ int run(int argc, char** argv) {
   p.mass = tools::massTypeArgument(args, "mass");
   p.iterations = args.integer("iterations", 1);
   if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
+  // Default: stiffness frozen at the input, mass updated (see mesh_smoothing.h).
+  if (args.has("freeze_weights") && args.has("rebuild_weights"))
+    throw tools::UsageError("-freeze_weights and -rebuild_weights exclude each other");
   if (args.has("freeze_weights")) p.weight_update = WeightUpdate::Frozen;
+  if (args.has("rebuild_weights")) p.weight_update = WeightUpdate::EveryIteration;
   if (args.has("fix_boundary")) p.boundary = BoundaryCondition::Fixed;
   const std::string preserve = args.choice("preserve", {"none", "volume", "area"}, "none");
   p.shrinkage = preserve == "volume" ? ShrinkageCorrection::PreserveVolume
@@ -71,9 +78,16 @@ int run(int argc, char** argv) {
     std::cerr << kName << ": explicit step " << p.time_step / (h * h) << " h^2; stability bound "
               << bound / (h * h) << " h^2\n";
     if (p.time_step > bound) {
+      if (!args.has("allow_unstable")) {
+        throw pcl::BadArgumentException(
+            "the explicit step " + std::to_string(p.time_step / (h * h)) +
+            " h^2 exceeds the stability bound " + std::to_string(bound / (h * h)) +
+            " h^2: the surface would blow up (use -method implicit for large steps, or "
+            "-allow_unstable)");
+      }
       tools::warn(kName,
                   "the step exceeds the explicit stability bound: expect the surface to "
-                  "blow up (use -method implicit for large steps)");
+                  "blow up");
     }
   } else {
     p.time_step = args.has("absolute_time") ? lambda_dt : lambda_dt * h * h;
@@ -92,13 +106,37 @@ int run(int argc, char** argv) {
     std::cerr << kName << ": " << report.iterations << " implicit step(s) of "
               << p.time_step / (h * h) << " h^2, solver " << toString(report.solver) << "\n";
   }
-  if (report.fixed_vertices > 0)
+  if (report.fixed_vertices == in.topology.numVertices()) {
+    tools::warn(kName,
+                "no vertex is free to move (all on the fixed boundary or without area): "
+                "the output equals the input");
+  } else if (report.fixed_vertices > 0) {
     std::cerr << kName << ": " << report.fixed_vertices << " vertices kept in place\n";
+  }
   if (report.volume_before != 0.0) {
     std::cerr << kName << ": volume " << report.volume_before << " -> " << report.volume_after
               << ", area " << report.area_before << " -> " << report.area_after << "\n";
   } else {
     std::cerr << kName << ": area " << report.area_before << " -> " << report.area_after << "\n";
+  }
+  std::cerr << kName << ": smallest angle " << report.quality_before.min_angle_degrees << " -> "
+            << report.quality_after.min_angle_degrees << " deg, slivers (a corner < "
+            << kSliverAngleDegrees << " deg) " << report.quality_before.slivers << " -> "
+            << report.quality_after.slivers << "\n";
+  if (report.quality_after.slivers > report.quality_before.slivers) {
+    tools::warn(kName,
+                std::to_string(report.quality_after.slivers - report.quality_before.slivers) +
+                    " slivers created (smaller steps keep the mesh healthier" +
+                    (p.weight_update == WeightUpdate::EveryIteration
+                         ? "; rebuilt cotangent weights pinch triangles: drop -rebuild_weights)"
+                         : ")"));
+  }
+  const double area_loss = 1.0 - report.area_after / report.area_before;
+  if (p.boundary == BoundaryCondition::Free && in.topology.counts().boundary_edges > 0 &&
+      area_loss > 0.01) {
+    tools::warn(kName, "the free boundary of this open mesh shrank its area by " +
+                           std::to_string(static_cast<int>(100.0 * area_loss + 0.5)) +
+                           "% (-fix_boundary keeps the boundary in place)");
   }
 
   if (double_output) {

@@ -25,12 +25,12 @@ constexpr const char* kDescription =
 constexpr const char* kSyntax =
     "input.pcd output.{pcd,ply} [-method explicit|implicit (default implicit)]\n"
     "         [-lambda_dt t (default: implicit 1, explicit 0.2)] [-iterations n (default 1)]\n"
-    "         [-max_jump f (default 0.05)] [-solver auto|cholmod|ldlt]";
+    "         [-max_jump f (default 0.05)] [-solver auto|cholmod|ldlt] [-allow_unstable]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
-  const tools::ToolArguments args(argc, argv,
-                                  {"method", "lambda_dt", "iterations", "max_jump", "solver"}, {});
+  const tools::ToolArguments args(
+      argc, argv, {"method", "lambda_dt", "iterations", "max_jump", "solver"}, {"allow_unstable"});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
   const std::string input = args.positional()[0];
@@ -47,6 +47,11 @@ int run(int argc, char** argv) {
   if (!(p.max_depth_jump > 0.0)) throw tools::UsageError("-max_jump must be > 0");
   p.solver = tools::solverArgument(args);
   if (p.scheme == SmoothingScheme::Explicit && p.time_step >= 0.25) {
+    if (!args.has("allow_unstable")) {
+      throw pcl::BadArgumentException(
+          "explicit steps of 0.25 pixel^2 or more are unstable (use -method implicit for large "
+          "steps, or -allow_unstable)");
+    }
     tools::warn(kName, "explicit steps of 0.25 pixel^2 or more are unstable: expect noise to grow");
   }
 
@@ -74,6 +79,12 @@ int run(int argc, char** argv) {
   timer.done(points);
   std::cerr << kName << ": " << report.valid_pixels << " pixels, " << report.holes << " holes, "
             << report.cut_pairs << " neighbour pairs cut at depth jumps\n";
+  if (report.valid_pixels == 0)
+    tools::warn(kName, "no valid pixel to smooth: the output equals the input");
+  if (report.points_at_origin > 0) {
+    tools::warn(kName, std::to_string(report.points_at_origin) +
+                           " points at the sensor origin kept in place (no ray to move along)");
+  }
   setVertexPositions(cloud.cloud, smoothed);
   tools::saveResult(args.positional()[1], cloud);
   return 0;

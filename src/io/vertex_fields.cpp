@@ -6,6 +6,8 @@
 #include <pcl/common/io.h>
 #include <pcl/exceptions.h>
 
+#include "pcl_ddg/mesh/vertex_positions.h"
+
 namespace pcl_ddg {
 namespace {
 
@@ -82,7 +84,7 @@ void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
       const double v = values[static_cast<Eigen::Index>(i)];
       std::memcpy(dst, &v, 8);
     } else {
-      const float v = static_cast<float>(values[static_cast<Eigen::Index>(i)]);
+      const float v = floatFieldValue(values[static_cast<Eigen::Index>(i)], name, i);
       std::memcpy(dst, &v, 4);
     }
   }

@@ -19,6 +19,25 @@ double meanEdgeLength(const MeshTopology& topology, const Eigen::Matrix3Xd& posi
   return count > 0 ? sum / static_cast<double>(count) : 0.0;
 }
 
+TriangleQuality triangleQuality(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+  constexpr double kDegreesPerRadian = 57.295779513082320876798;
+  const Eigen::Matrix3Xi& t = topology.triangles();
+  TriangleQuality quality;
+  for (Eigen::Index f = 0; f < t.cols(); ++f) {
+    const Eigen::Vector3d p[3] = {positions.col(t(0, f)), positions.col(t(1, f)),
+                                  positions.col(t(2, f))};
+    if (isDegenerateTriangle(p[0], p[1], p[2])) continue;
+    double smallest = 180.0;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
+      smallest = std::min(smallest, kDegreesPerRadian * std::atan2(u.cross(v).norm(), u.dot(v)));
+    }
+    quality.min_angle_degrees = std::min(quality.min_angle_degrees, smallest);
+    quality.slivers += smallest < kSliverAngleDegrees;
+  }
+  return quality;
+}
+
 BoundingBox boundingBox(const Eigen::Matrix3Xd& positions) {
   BoundingBox box;
   bool any = false;

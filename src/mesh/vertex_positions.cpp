@@ -2,7 +2,9 @@
 
 #include <pcl/PCLPointField.h>
 
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <sstream>
 #include <string>
 
@@ -49,12 +51,21 @@ const pcl::PCLPointField& namedField(const pcl::PCLPointCloud2& cloud, const std
 }
 
 template <typename T>
-void store(std::uint8_t* p, double value) {
-  const T typed = static_cast<T>(value);
-  std::memcpy(p, &typed, sizeof(T));
+void store(std::uint8_t* p, T value) {
+  std::memcpy(p, &value, sizeof(T));
 }
 
 }  // namespace
+
+float floatFieldValue(double value, const std::string& field, std::size_t vertex) {
+  if (std::isfinite(value) && std::abs(value) > std::numeric_limits<float>::max()) {
+    std::ostringstream text;
+    text << "vertex " << vertex << ": " << field << " = " << value
+         << " does not fit a float field (write double precision, or a smaller step)";
+    throw InvalidMeshException(text.str());
+  }
+  return static_cast<float>(value);
+}
 
 NonFiniteVertices findNonFiniteVertices(const Eigen::Matrix3Xd& positions) {
   NonFiniteVertices result;
@@ -123,7 +134,7 @@ void setVertexPositions(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& posi
       std::uint8_t* p = cloud.data.data() + i * cloud.point_step + field.offset;
       const double value = positions(axis, static_cast<Eigen::Index>(i));
       if (field.datatype == pcl::PCLPointField::FLOAT32) {
-        store<float>(p, value);
+        store<float>(p, floatFieldValue(value, names[axis], i));
       } else {
         store<double>(p, value);
       }

@@ -16,6 +16,7 @@ struct VertexSums {
   double angle_sum = 0.0;
   Eigen::Vector3d laplace = Eigen::Vector3d::Zero();      ///< (L x)_v, cotangent L
   Eigen::Vector3d area_normal = Eigen::Vector3d::Zero();  ///< orientation reference
+  double area = 0.0;                                      ///< sum of |area vectors|
 };
 
 VertexSums gather(const MeshTopology& topology, const Eigen::Matrix3Xd& positions, int v,
@@ -26,6 +27,7 @@ VertexSums gather(const MeshTopology& topology, const Eigen::Matrix3Xd& position
     s.angle_sum += c.angle();
     s.laplace += detail::cotangentLaplacianPart(c);
     s.area_normal += c.area_vector;
+    s.area += 0.5 * c.double_area;
   });
   return s;
 }
@@ -78,8 +80,8 @@ VertexCurvatures computeCurvatures(const MeshTopology& topology, const Eigen::Ma
   c.kappa1.resize(n);
   c.kappa2.resize(n);
   c.valid.assign(n, 0);
-  std::int64_t clamped = 0, invalid = 0;
-#pragma omp parallel for schedule(static) reduction(+ : clamped, invalid)
+  std::int64_t clamped = 0, invalid = 0, unoriented = 0;
+#pragma omp parallel for schedule(static) reduction(+ : clamped, invalid, unoriented)
   for (int v = 0; v < n; ++v) {
     const VertexSums s = gather(topology, positions, v, mass);
     c.vertex_area[v] = s.mass;
@@ -88,10 +90,17 @@ VertexCurvatures computeCurvatures(const MeshTopology& topology, const Eigen::Ma
       ++invalid;
       continue;
     }
+    c.gauss[v] = ((topology.isBoundary(v) ? kPi : 2.0 * kPi) - s.angle_sum) / s.mass;
+    if (detail::hasCancelled(s.area_normal, s.area)) {
+      // No orientation to sign H by: only K, which needs none, is given.
+      c.mean[v] = c.kappa1[v] = c.kappa2[v] = nan;
+      ++invalid;
+      ++unoriented;
+      continue;
+    }
     c.valid[v] = 1;
     const Eigen::Vector3d hn = -0.5 * s.laplace / s.mass;
     c.mean[v] = hn.dot(s.area_normal) < 0.0 ? -hn.norm() : hn.norm();
-    c.gauss[v] = ((topology.isBoundary(v) ? kPi : 2.0 * kPi) - s.angle_sum) / s.mass;
     const double discriminant = c.mean[v] * c.mean[v] - c.gauss[v];
     if (discriminant < 0.0) ++clamped;
     const double root = std::sqrt(std::max(discriminant, 0.0));
@@ -100,6 +109,7 @@ VertexCurvatures computeCurvatures(const MeshTopology& topology, const Eigen::Ma
   }
   c.clamped_vertices = clamped;
   c.invalid_vertices = invalid;
+  c.unoriented_vertices = unoriented;
   return c;
 }
 

@@ -41,6 +41,16 @@ struct CornerView {
   }
 };
 
+/**
+ * Whether a sum of vectors has cancelled: its length is at rounding level of the sum of the
+ * lengths of its terms (a face and its reversed duplicate; a fin folded onto itself). Its
+ * direction is then noise, and so is any sign taken from it.
+ */
+inline bool hasCancelled(const Eigen::Vector3d& sum, double sum_of_lengths) {
+  constexpr double kRelativeTolerance = 1e-8;
+  return !(sum.norm() > kRelativeTolerance * sum_of_lengths);
+}
+
 inline int cornerOf(const Eigen::Matrix3Xi& triangles, int t, int v) {
   return triangles(0, t) == v ? 0 : (triangles(1, t) == v ? 1 : 2);
 }

@@ -30,7 +30,8 @@ Eigen::Matrix3Xd smoothOrganizedPositions(const Eigen::Matrix3Xd& positions, int
   if (!(p.max_depth_jump > 0.0)) badArgument("max depth jump must be > 0");
   if (!origin.allFinite()) badArgument("the sensor origin is not finite");
 
-  // Ranges and unit rays; holes get range 0 in the flow (they are never coupled) and stay NaN.
+  // Ranges and unit rays; holes get range 0 in the flow (they are never coupled) and stay NaN. A
+  // point at the sensor origin has no ray to move along: it is not coupled and stays where it is.
   GridSmoothingReport r;
   Eigen::MatrixXd range = Eigen::MatrixXd::Zero(n, 1);
   Eigen::Matrix3Xd rays(3, n);
@@ -38,13 +39,17 @@ Eigen::Matrix3Xd smoothOrganizedPositions(const Eigen::Matrix3Xd& positions, int
   for (int i = 0; i < n; ++i) {
     const Eigen::Vector3d d = positions.col(i) - origin;
     const double length = d.norm();
-    if (!std::isfinite(length) || !(length > 0.0)) continue;
+    if (!std::isfinite(length)) continue;
+    if (!(length > 0.0)) {
+      ++r.points_at_origin;
+      continue;
+    }
     valid[i] = 1;
     range(i) = length;
     rays.col(i) = d / length;
     ++r.valid_pixels;
   }
-  r.holes = n - r.valid_pixels;
+  r.holes = n - r.valid_pixels - r.points_at_origin;
 
   // The 5-point graph Laplacian of the coupled pixels (every valid pixel keeps a diagonal entry).
   std::vector<Eigen::Triplet<double>> entries;
@@ -91,7 +96,9 @@ Eigen::Matrix3Xd smoothOrganizedPositions(const Eigen::Matrix3Xd& positions, int
   Eigen::Matrix3Xd result(3, n);
   for (int i = 0; i < n; ++i) {
     result.col(i) = valid[i] ? Eigen::Vector3d(origin + range(i) * rays.col(i))
-                             : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+                    : positions.col(i).allFinite()
+                        ? Eigen::Vector3d(positions.col(i))
+                        : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   }
   if (report) *report = r;
   return result;

@@ -39,6 +39,12 @@ void LaplacianFlow::setOperator(Eigen::SparseMatrix<double> laplacian, Eigen::Ve
   factor_current_ = false;
 }
 
+void LaplacianFlow::setMass(Eigen::VectorXd mass) {
+  if (mass.size() != num_vertices_) throw pcl::BadArgumentException("mass of the wrong size");
+  mass_ = std::move(mass);
+  factor_current_ = false;
+}
+
 void LaplacianFlow::chooseFreeVertices() {
   compact_.assign(num_vertices_, -1);
   free_vertices_.clear();
@@ -99,6 +105,7 @@ void LaplacianFlow::explicitStep(Eigen::MatrixXd& values, double tau) const {
 }
 
 void LaplacianFlow::implicitStep(Eigen::MatrixXd& values, double tau) {
+  if (numFree() == 0) return;  // every value constrained: nothing to solve for
   if (!factor_current_ || tau != factor_tau_) {
     fillSystem(tau);
     if (!pattern_analysed_) {

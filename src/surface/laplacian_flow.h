@@ -7,7 +7,8 @@
 //
 // Constrained vertices (fixed boundary, and vertices of zero mass: isolated, or only on degenerate
 // triangles) keep their values; the implicit system is solved for the free vertices only, with
-// the constrained values moved to the right-hand side. The system's pattern is analysed once; a
+// the constrained values moved to the right-hand side (with nothing free, a step changes nothing).
+// The system's pattern is analysed once; a
 // new operator (same mesh, new values) or a new tau only refactorises.
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -25,6 +26,9 @@ class LaplacianFlow {
 
   /** The summed (symmetric, negative semi-definite) Laplacian and the lumped masses. */
   void setOperator(Eigen::SparseMatrix<double> laplacian, Eigen::VectorXd mass);
+
+  /** New masses with the Laplacian kept (frozen stiffness); the free set stays as first chosen. */
+  void setMass(Eigen::VectorXd mass);
 
   void explicitStep(Eigen::MatrixXd& values, double tau) const;
 

@@ -11,10 +11,17 @@
 namespace pcl_ddg {
 namespace {
 
+// Per vertex, the weighted sum of the face normals and the sum of the weighted normals' lengths
+// (which tells a sum that cancelled from a short one).
+struct NormalSums {
+  Eigen::Matrix3Xd sums;
+  Eigen::VectorXd lengths;
+};
+
 // Uniform and area weightings: each triangle's normal once (parallel over triangles), then
-// gathered per vertex. Returns unnormalised directions.
-Eigen::Matrix3Xd faceNormalSums(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
-                                NormalWeighting weighting) {
+// gathered per vertex.
+NormalSums faceNormalSums(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+                          NormalWeighting weighting) {
   const Eigen::Matrix3Xi& triangles = topology.triangles();
   Eigen::Matrix3Xd face_normal(3, triangles.cols());
 #pragma omp parallel for schedule(static)
@@ -29,61 +36,77 @@ Eigen::Matrix3Xd faceNormalSums(const MeshTopology& topology, const Eigen::Matri
                                : Eigen::Vector3d(2.0 * c.area_vector / c.double_area);
     }
   }
-  Eigen::Matrix3Xd sums(3, topology.numVertices());
+  NormalSums result{Eigen::Matrix3Xd(3, topology.numVertices()),
+                    Eigen::VectorXd(topology.numVertices())};
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < topology.numVertices(); ++v) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (const int t : topology.incidentTriangles(v)) sum += face_normal.col(t);
-    sums.col(v) = sum;
+    double length = 0.0;
+    for (const int t : topology.incidentTriangles(v)) {
+      sum += face_normal.col(t);
+      length += face_normal.col(t).norm();
+    }
+    result.sums.col(v) = sum;
+    result.lengths[v] = length;
   }
-  return sums;
+  return result;
 }
 
 // Angle weighting: every corner has its own weight, so each vertex gathers its triangles whole
 // (a per-triangle array of angles measured slower: its fresh pages cost more than the flops).
-Eigen::Matrix3Xd angleWeightedSums(const MeshTopology& topology,
-                                   const Eigen::Matrix3Xd& positions) {
-  Eigen::Matrix3Xd sums(3, topology.numVertices());
+NormalSums angleWeightedSums(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+  NormalSums result{Eigen::Matrix3Xd(3, topology.numVertices()),
+                    Eigen::VectorXd(topology.numVertices())};
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < topology.numVertices(); ++v) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double length = 0.0;
     detail::forEachCornerOf(topology, positions, v, [&](const detail::CornerView& c, int) {
-      sum += c.angle() * 2.0 * c.area_vector / c.double_area;
+      const double angle = c.angle();
+      sum += angle * 2.0 * c.area_vector / c.double_area;
+      length += angle;
     });
-    sums.col(v) = sum;
+    result.sums.col(v) = sum;
+    result.lengths[v] = length;
   }
-  return sums;
+  return result;
 }
 
 // -M^-1 L x turned towards the area normal, or the area normal where it is shorter than epsilon
-// or on the boundary (counted in fallback).
-Eigen::Matrix3Xd meanCurvatureDirections(const MeshTopology& topology,
-                                         const Eigen::Matrix3Xd& positions, MassType mass_type,
-                                         double epsilon, std::int64_t& fallback) {
-  Eigen::Matrix3Xd directions(3, topology.numVertices());
+// or on the boundary (counted in fallback). Where the area normal has cancelled, the turn is
+// undecided: that vertex gets the (cancelled) area sum, which becomes NaN.
+NormalSums meanCurvatureDirections(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+                                   MassType mass_type, double epsilon, std::int64_t& fallback) {
+  NormalSums result{Eigen::Matrix3Xd(3, topology.numVertices()),
+                    Eigen::VectorXd(topology.numVertices())};
   std::int64_t fallback_count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : fallback_count)
   for (int v = 0; v < topology.numVertices(); ++v) {
     Eigen::Vector3d area_normal = Eigen::Vector3d::Zero(), laplace = Eigen::Vector3d::Zero();
-    double mass = 0.0;
+    double mass = 0.0, area = 0.0;
     detail::forEachCornerOf(topology, positions, v, [&](const detail::CornerView& c, int) {
       area_normal += c.area_vector;
+      area += 0.5 * c.double_area;
       laplace += detail::cotangentLaplacianPart(c);
       mass += detail::cornerMass(c, mass_type);
     });
     const Eigen::Vector3d towards_normal =
         mass > 0.0 ? Eigen::Vector3d(-laplace / mass) : Eigen::Vector3d::Zero();
     const double magnitude = towards_normal.norm();
-    if (!topology.isBoundary(v) && magnitude >= epsilon && magnitude > 0.0) {
-      directions.col(v) =
+    result.lengths[v] = area;
+    if (detail::hasCancelled(area_normal, area)) {
+      result.sums.col(v) = area_normal;
+    } else if (!topology.isBoundary(v) && magnitude >= epsilon && magnitude > 0.0) {
+      result.sums.col(v) =
           towards_normal.dot(area_normal) < 0.0 ? Eigen::Vector3d(-towards_normal) : towards_normal;
+      result.lengths[v] = 0.0;  // -M^-1 L x is not a sum of normals: no cancellation test
     } else {
-      directions.col(v) = area_normal;
-      if (area_normal.squaredNorm() > 0.0) ++fallback_count;
+      result.sums.col(v) = area_normal;
+      ++fallback_count;
     }
   }
   fallback = fallback_count;
-  return directions;
+  return result;
 }
 
 }  // namespace
@@ -102,34 +125,40 @@ MeshNormals computeMeshNormals(const MeshTopology& topology, const Eigen::Matrix
   }
 
   MeshNormals result;
+  NormalSums sums;
   switch (weighting) {
     case NormalWeighting::Uniform:
     case NormalWeighting::Area:
-      result.normals = faceNormalSums(topology, positions, weighting);
+      sums = faceNormalSums(topology, positions, weighting);
       break;
     case NormalWeighting::Angle:
-      result.normals = angleWeightedSums(topology, positions);
+      sums = angleWeightedSums(topology, positions);
       break;
     case NormalWeighting::MeanCurvature:
-      result.normals = meanCurvatureDirections(topology, positions, options.mass, epsilon,
-                                               result.fallback_vertices);
+      sums = meanCurvatureDirections(topology, positions, options.mass, epsilon,
+                                     result.fallback_vertices);
       break;
   }
   const int n = topology.numVertices();
+  result.normals.swap(sums.sums);
   result.valid.assign(n, 0);
-  std::int64_t invalid = 0;
-#pragma omp parallel for schedule(static) reduction(+ : invalid)
+  std::int64_t invalid = 0, cancelled = 0;
+#pragma omp parallel for schedule(static) reduction(+ : invalid, cancelled)
   for (int v = 0; v < n; ++v) {
     const double length = result.normals.col(v).norm();
-    if (length > 0.0 && std::isfinite(length)) {
+    const bool has_cancelled =
+        sums.lengths[v] > 0.0 && detail::hasCancelled(result.normals.col(v), sums.lengths[v]);
+    if (length > 0.0 && std::isfinite(length) && !has_cancelled) {
       result.normals.col(v) /= length;
       result.valid[v] = 1;
     } else {
       result.normals.col(v).setConstant(std::numeric_limits<double>::quiet_NaN());
       ++invalid;
+      cancelled += has_cancelled;
     }
   }
   result.invalid_vertices = invalid;
+  result.cancelled_vertices = cancelled;
   return result;
 }
 

@@ -113,6 +113,7 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   MeshSmoothingReport r;
   r.solver = flow.backend();
   r.area_before = surfaceArea(topology, positions);
+  r.quality_before = triangleQuality(topology, positions);
   if (isClosedAndOriented(topology)) r.volume_before = enclosedVolume(topology, positions);
 
   Eigen::Matrix3Xd current = positions;
@@ -121,6 +122,8 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   r.fixed_vertices = n - flow.numFree();
   for (int iteration = 1; iteration <= p.iterations; ++iteration) {
     if (iteration > 1 && p.weight_update == WeightUpdate::EveryIteration) setOperator(current);
+    if (iteration > 1 && p.weight_update == WeightUpdate::FrozenStiffness)
+      flow.setMass(lumpedMass(topology, current, p.mass));
     if (p.scheme == SmoothingScheme::Explicit) {
       flow.explicitStep(values, p.time_step);
     } else {
@@ -156,6 +159,7 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
     if (progress) progress(iteration, p.iterations);
   }
   r.area_after = surfaceArea(topology, current);
+  r.quality_after = triangleQuality(topology, current);
   if (isClosedAndOriented(topology)) r.volume_after = enclosedVolume(topology, current);
   if (report) *report = r;
   return current;

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cstdint>
 #include <limits>
 
 #include "pcl_ddg/mesh/mesh_topology.h"
@@ -29,6 +30,15 @@ inline bool isDegenerateTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d
 
 /** Mean length of the unique edges whose end points are finite (0 if there are none). */
 double meanEdgeLength(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+
+/** Angle quality of the non-degenerate triangles (degenerate ones are counted by MeshReport). */
+struct TriangleQuality {
+  double min_angle_degrees = 180.0;  ///< smallest corner angle
+  std::int64_t slivers = 0;          ///< triangles with a corner below kSliverAngleDegrees
+};
+constexpr double kSliverAngleDegrees = 1.0;
+
+TriangleQuality triangleQuality(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
 
 struct BoundingBox {
   Eigen::Vector3d min = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());

@@ -29,7 +29,8 @@ Eigen::Matrix3Xd vertexPositions(const pcl::PCLPointCloud2& cloud,
 
 /**
  * Writes positions into the cloud's existing x, y, z fields (float or double, kept as they are:
- * a float mesh stays float). Throws InvalidMeshException on a size mismatch or integer fields.
+ * a float mesh stays float). Throws InvalidMeshException on a size mismatch or integer fields,
+ * and when a finite value does not fit a float field (it would become infinite).
  */
 void setVertexPositions(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions);
 
@@ -38,6 +39,10 @@ Eigen::VectorXd vertexScalarField(const pcl::PCLPointCloud2& cloud, const std::s
 
 /** True if the cloud has a field of that name. */
 bool hasVertexField(const pcl::PCLPointCloud2& cloud, const std::string& name);
+
+/** value as a float for a float field; throws InvalidMeshException naming the field and the
+ *  vertex when a finite value lies beyond float's range (the cast would be undefined). */
+float floatFieldValue(double value, const std::string& field, std::size_t vertex);
 
 /** Throws InvalidMeshException naming the first non-finite vertex and the count, if any. */
 void requireFinite(const Eigen::Matrix3Xd& positions);

@@ -11,7 +11,9 @@
 //              vertex normal. On a boundary vertex Hn carries the boundary's curvature too and
 //              is not a surface curvature.
 //   Principal  kappa_{1,2} = H +- sqrt(max(H^2 - K, 0)); vertices where H^2 < K were clamped.
-// Vertices without area (isolated, or only on degenerate triangles) get NaN and valid = 0.
+// Vertices without area (isolated, or only on degenerate triangles) get NaN and valid = 0. Where
+// the incident face normals cancel (a face and its reversed duplicate) H has no sign: mean,
+// kappa1 and kappa2 are NaN, valid = 0 (counted in unoriented_vertices), K is still given.
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
@@ -36,8 +38,9 @@ struct VertexCurvatures {
   Eigen::VectorXd kappa2;
   Eigen::VectorXd vertex_area;  ///< the mass used
   std::vector<std::uint8_t> valid;
-  std::int64_t clamped_vertices = 0;  ///< H^2 < K: kappa1 = kappa2 = H there
-  std::int64_t invalid_vertices = 0;
+  std::int64_t clamped_vertices = 0;     ///< H^2 < K: kappa1 = kappa2 = H there
+  std::int64_t invalid_vertices = 0;     ///< valid == 0, all causes
+  std::int64_t unoriented_vertices = 0;  ///< of those, the ones whose face normals cancelled
 };
 
 /** All curvatures at once, sharing the triangle quantities (OpenMP over vertices). */

@@ -8,7 +8,9 @@
 //   explicit  r <- r + tau L r          (stable for tau < 1/4: L's eigenvalues lie in [-8, 0])
 //   implicit  (I - tau L) r' = r        (stable for any tau; one factorisation for all steps)
 // where (L r)_i = sum over coupled 4-neighbours j of (r_j - r_i). Pixels with a non-finite point
-// (or at the origin) are holes: missing data, never coupled, never filled; they stay NaN. Two
+// are holes: missing data, never coupled, never filled; they stay NaN. A point exactly at the
+// sensor origin has no ray: it is not coupled and kept as it is. With no valid pixel at all the
+// result equals the input. Two
 // neighbours are not coupled across a depth jump: |r_i - r_j| > max_depth_jump * min(r_i, r_j)
 // (relative, so the same threshold works at every distance), decided once on the input. The grid
 // border is insulated (no flux), so a constant range is kept exactly.
@@ -32,6 +34,7 @@ struct GridSmoothingParameters {
 struct GridSmoothingReport {
   std::int64_t valid_pixels = 0;
   std::int64_t holes = 0;
+  std::int64_t points_at_origin = 0;  ///< kept in place (no ray to move along)
   std::int64_t coupled_pairs = 0;
   std::int64_t cut_pairs = 0;  ///< neighbours both valid but across a depth jump
 };

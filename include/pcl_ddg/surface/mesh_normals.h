@@ -14,7 +14,9 @@
 //                 also holds the curvature of the boundary curve. Default epsilon: 0.02 / mean edge
 //                 length, i.e. radii of curvature above 100 mean edge lengths count as flat.
 // Degenerate triangles contribute nothing. Vertices with no non-degenerate triangle (isolated
-// ones included) get a NaN normal and valid = 0.
+// ones included) get a NaN normal and valid = 0; so do vertices whose weighted face normals
+// cancel (a face and its reversed duplicate), where any direction would be rounding noise
+// (counted in cancelled_vertices).
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>
@@ -36,8 +38,9 @@ struct MeshNormalOptions {
 struct MeshNormals {
   Eigen::Matrix3Xd normals;  ///< unit, or NaN where valid == 0
   std::vector<std::uint8_t> valid;
-  std::int64_t invalid_vertices = 0;
-  std::int64_t fallback_vertices = 0;  ///< MeanCurvature: flat vertices given the area normal
+  std::int64_t invalid_vertices = 0;    ///< NaN normals, all causes
+  std::int64_t cancelled_vertices = 0;  ///< of those, the ones whose face normals cancelled
+  std::int64_t fallback_vertices = 0;   ///< MeanCurvature: flat vertices given the area normal
 };
 
 MeshNormals computeMeshNormals(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,

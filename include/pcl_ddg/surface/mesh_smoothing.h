@@ -9,8 +9,12 @@
 //             solve per iteration, x, y, z as three right-hand sides. Stable for any tau, so one
 //             large step replaces thousands of small ones.
 // L is the summed uniform or cotangent Laplacian (laplacian.h), M the lumped mass of the chosen
-// type; both are rebuilt from the current positions every iteration (default) or frozen at the
-// input's. The system's pattern is analysed once per run and refactorised per iteration.
+// type. By default L is frozen at the input and M follows the current positions (Kazhdan et al.
+// 2012, "Can mean-curvature flow be modified to be non-singular?"; libigl's smoothing tutorial):
+// rebuilding cotangent weights every iteration is the singular mean-curvature flow, which pinches
+// triangles into slivers within a few large steps. Both can also be rebuilt every iteration or
+// both frozen at the input. The system's pattern is analysed once and refactorised per iteration.
+// The report gives the triangles' angle quality before and after (slivers: a corner under 1 deg).
 //
 // Boundary vertices move (Free, default) or keep their position (Fixed). Vertices without mass
 // (isolated, or only on degenerate triangles) never move. Laplacian flow shrinks a surface; the
@@ -27,6 +31,7 @@
 #include <Eigen/Core>
 #include <functional>
 
+#include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/operators/laplacian.h"
 #include "pcl_ddg/operators/mass_matrix.h"
@@ -35,7 +40,9 @@
 namespace pcl_ddg {
 
 enum class SmoothingScheme { Explicit, Implicit };
-enum class WeightUpdate { EveryIteration, Frozen };
+/** What of the operator follows the moving surface: nothing (Frozen), the mass only
+ *  (FrozenStiffness, the default), or the Laplacian and the mass (EveryIteration). */
+enum class WeightUpdate { FrozenStiffness, Frozen, EveryIteration };
 enum class BoundaryCondition { Free, Fixed };
 enum class ShrinkageCorrection { None, PreserveVolume, PreserveArea };
 
@@ -45,7 +52,7 @@ struct MeshSmoothingParameters {
   MassType mass = MassType::MixedVoronoi;
   double time_step = 0.0;  ///< tau, in length^2 (e.g. 0.1 * h^2 explicit, 10 * h^2 implicit)
   int iterations = 1;
-  WeightUpdate weight_update = WeightUpdate::EveryIteration;
+  WeightUpdate weight_update = WeightUpdate::FrozenStiffness;
   BoundaryCondition boundary = BoundaryCondition::Free;
   ShrinkageCorrection shrinkage = ShrinkageCorrection::None;
   CholeskyBackend solver = CholeskyBackend::Automatic;
@@ -57,6 +64,7 @@ struct MeshSmoothingReport {
   int fixed_vertices = 0;                               ///< fixed boundary + massless
   double volume_before = 0.0, volume_after = 0.0;       ///< closed meshes (else 0)
   double area_before = 0.0, area_after = 0.0;
+  TriangleQuality quality_before, quality_after;
 };
 
 /** Called after every iteration with (iterations done, total). */
