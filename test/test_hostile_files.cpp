@@ -291,6 +291,22 @@ TEST_F(HostileFiles, PcdReaderAgreesWithPclOnWellFormedFiles) {
   }
 }
 
+// What we write, PCL's reader reads back to the same values (and so do we).
+TEST_F(HostileFiles, PcdWriterOutputIsReadByPcl) {
+  for (const char* name : {"bun0.pcd", "office1.pcd", "terrain_CSite1_red2-utm.pcd"}) {
+    SCOPED_TRACE(name);
+    const pcl::PolygonMesh original = loadMesh(sharedData(std::string("clouds/") + name));
+    const std::string path = dir_ + "/out.pcd";
+    saveMesh(path, original);
+    pcl::PCLPointCloud2 by_pcl;
+    ASSERT_EQ(pcl::PCDReader().read(path, by_pcl), 0);
+    EXPECT_EQ(by_pcl.width, original.cloud.width);
+    EXPECT_EQ(by_pcl.height, original.cloud.height);
+    EXPECT_EQ(by_pcl.data, original.cloud.data);
+    EXPECT_EQ(loadMesh(path).cloud.data, original.cloud.data);
+  }
+}
+
 }  // namespace
 }  // namespace test
 }  // namespace pcl_ddg

@@ -1,11 +1,17 @@
 // Every loader on every file of the shared data, round trips, and broken files.
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/atomic_file.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
@@ -242,6 +248,48 @@ TEST_F(MeshIOFiles, FailedSaveLeavesNoFile) {
   EXPECT_TRUE(std::filesystem::is_empty(dir_));
   EXPECT_THROW(saveMesh(path("out.xyz"), mesh), FileFormatException);
   EXPECT_THROW(saveMesh(path("no/such/folder/out.ply"), mesh), FileFormatException);
+  EXPECT_TRUE(std::filesystem::is_empty(dir_));
+}
+
+TEST_F(MeshIOFiles, AnInterruptDuringAWriteLeavesNoTemporaryAndNoOutput) {
+  for (const int signal_number : {SIGINT, SIGTERM}) {
+    const pid_t child = fork();
+    if (child == 0) {
+      AtomicFile::removeUncommittedFilesOnInterrupt();
+      AtomicFile file(path("out.ply"));
+      writeBytes(file.temporaryPath(), "half of a file");
+      std::raise(signal_number);  // as a Ctrl-C in the middle of the write
+      _exit(0);
+    }
+    int status = 0;
+    waitpid(child, &status, 0);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == signal_number) << status;
+    EXPECT_TRUE(std::filesystem::is_empty(dir_));
+  }
+}
+
+TEST_F(MeshIOFiles, AFullDiskIsAnErrorAndLeavesNoFile) {
+  // A file-size limit makes writes fail as a full disk does (EFBIG instead of ENOSPC).
+  const pid_t child = fork();
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit{4096, 4096};
+    setrlimit(RLIMIT_FSIZE, &limit);
+    const pcl::PolygonMesh horse = loadMesh(sharedData("meshes/horse.ply"));
+    int failures = 0;
+    for (const char* name : {"out.ply", "out.pcd"}) {
+      try {
+        saveMesh(path(name), horse);
+      } catch (const FileFormatException&) {
+        ++failures;
+      }
+    }
+    _exit(failures);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2) << "both writers must report the failed write";
   EXPECT_TRUE(std::filesystem::is_empty(dir_));
 }
 

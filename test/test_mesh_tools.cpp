@@ -287,6 +287,15 @@ TEST_F(MeshTools, RenderMakesAPicture) {
                     sharedData("meshes/cow.off") + " " + path("cow.png") + " -field nothing")
                 .exit_code,
             1);
+  // A full disk (here a 1 KiB file-size limit, SIGXFSZ ignored) is an error, not an empty PNG.
+  const ToolRun full = runTool(std::string("trap '' XFSZ; ulimit -f 1; ") + PCL_DDG_RENDER_TOOL,
+                               sharedData("meshes/cow.off") + " " + path("full.png"));
+  EXPECT_EQ(full.exit_code, 1) << full.err;
+  EXPECT_NE(full.err.find("pcl_ddg_render: error: cannot write"), std::string::npos) << full.err;
+  EXPECT_FALSE(std::filesystem::exists(path("full.png")));
+  for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+    EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+  }
 }
 
 }  // namespace

@@ -29,6 +29,8 @@ pcl::PolygonMesh parseVTK(std::string_view data);
 pcl::PolygonMesh parsePCD(std::string_view data);
 
 void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding);
+/** A cloud as a binary_compressed PCD file (padding fields left out). */
+std::string encodePCD(const pcl::PCLPointCloud2& cloud);
 
 /** A corner index from a file; anything outside 0..INT_MAX becomes -1, which MeshTopology reports
  *  as out of range. */

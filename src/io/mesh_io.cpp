@@ -1,9 +1,9 @@
 #include "pcl_ddg/io/mesh_io.h"
 
-#include <pcl/io/pcd_io.h>
-
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 
 #include "byte_cursor.h"
@@ -15,15 +15,14 @@ namespace pcl_ddg {
 namespace {
 
 void savePCD(const std::string& path, const pcl::PolygonMesh& mesh) {
-  pcl::PCDWriter writer;
-  if (writer.writeBinary(path, mesh.cloud) < 0) throw FileFormatException("PCD writer failed");
+  writeBytes(path, detail::encodePCD(mesh.cloud));
 }
 
 void savePLY(const std::string& path, const pcl::PolygonMesh& mesh, PlyEncoding encoding) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   detail::writePLY(out, mesh, encoding);
-  out.flush();
-  if (!out) throw FileFormatException("write failed (disk full?)");
+  out.close();
+  if (!out) throw FileFormatException(std::string("write failed: ") + std::strerror(errno));
 }
 
 }  // namespace

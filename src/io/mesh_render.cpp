@@ -111,11 +111,18 @@ Image renderMesh(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xi& tria
 }
 
 void savePNG(const std::string& path, const Image& image) {
-  AtomicFile file(path);
-  if (!stbi_write_png(file.temporaryPath().c_str(), image.width, image.height, 3, image.rgb.data(),
-                      image.width * 3)) {
-    throw FileFormatException(path + ": PNG write failed");
+  // Encoded in memory and written by writeBytes: stb's own file writer ignores write errors.
+  std::string png;
+  const auto append = [](void* context, void* data, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data),
+                                               static_cast<std::size_t>(size));
+  };
+  if (!stbi_write_png_to_func(append, &png, image.width, image.height, 3, image.rgb.data(),
+                              image.width * 3)) {
+    throw FileFormatException(path + ": PNG encoding failed");
   }
+  AtomicFile file(path);
+  writeBytes(file.temporaryPath(), png);
   file.commit();
 }
 

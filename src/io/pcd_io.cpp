@@ -3,6 +3,9 @@
 // Every size is checked against the bytes the file really holds before anything is allocated.
 #include <pcl/io/lzf.h>
 
+#include <pcl/common/io.h>
+
+#include <algorithm>
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -261,6 +264,74 @@ pcl::PolygonMesh parsePCD(std::string_view data) {
       break;
   }
   return mesh;
+}
+
+namespace {
+
+char pcdType(std::uint8_t datatype) {
+  switch (datatype) {
+    case pcl::PCLPointField::INT8:
+    case pcl::PCLPointField::INT16:
+    case pcl::PCLPointField::INT32:
+    case pcl::PCLPointField::INT64:
+      return 'I';
+    case pcl::PCLPointField::FLOAT32:
+    case pcl::PCLPointField::FLOAT64:
+      return 'F';
+    default:
+      return 'U';
+  }
+}
+
+}  // namespace
+
+// binary_compressed, as PCL's tools write it: the fields one after the other (each as an array
+// over all points), LZF-compressed. Padding fields ("_") carry nothing and are left out.
+std::string encodePCD(const pcl::PCLPointCloud2& cloud) {
+  std::vector<const pcl::PCLPointField*> fields;
+  for (const auto& f : cloud.fields) {
+    if (f.name != "_" && pcl::getFieldSize(f.datatype) > 0) fields.push_back(&f);
+  }
+  if (fields.empty()) throw FileFormatException("the cloud has no fields to write");
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  std::string header = "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS";
+  for (const auto* f : fields) header += " " + f->name;
+  header += "\nSIZE";
+  for (const auto* f : fields) header += " " + std::to_string(pcl::getFieldSize(f->datatype));
+  header += "\nTYPE";
+  for (const auto* f : fields) header += std::string(" ") + pcdType(f->datatype);
+  header += "\nCOUNT";
+  for (const auto* f : fields) header += " " + std::to_string(std::max<std::uint32_t>(f->count, 1));
+  header += "\nWIDTH " + std::to_string(cloud.width) + "\nHEIGHT " + std::to_string(cloud.height) +
+            "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(n) + "\nDATA binary_compressed\n";
+
+  std::string planar;
+  for (const auto* f : fields) {
+    const std::size_t size = pcl::getFieldSize(f->datatype) * std::max<std::uint32_t>(f->count, 1);
+    for (std::size_t i = 0; i < n; ++i) {
+      planar.append(
+          reinterpret_cast<const char*>(cloud.data.data() + i * cloud.point_step + f->offset),
+          size);
+    }
+  }
+  if (planar.size() > std::numeric_limits<std::uint32_t>::max() / 2) {
+    throw FileFormatException("cloud too large for a compressed PCD file");
+  }
+  // LZF may expand incompressible data slightly; PCL allows 1.5x as well.
+  std::string packed(planar.size() + planar.size() / 2 + 64, '\0');
+  const unsigned int packed_size =
+      planar.empty() ? 0
+                     : pcl::lzfCompress(planar.data(), static_cast<unsigned int>(planar.size()),
+                                        packed.data(), static_cast<unsigned int>(packed.size()));
+  if (packed_size == 0 && !planar.empty()) throw FileFormatException("LZF compression failed");
+  const auto sizes = [](std::uint32_t compressed, std::uint32_t uncompressed) {
+    std::string bytes(8, '\0');
+    std::memcpy(bytes.data(), &compressed, 4);
+    std::memcpy(bytes.data() + 4, &uncompressed, 4);
+    return bytes;
+  };
+  return header + sizes(packed_size, static_cast<std::uint32_t>(planar.size())) +
+         packed.substr(0, packed_size);
 }
 
 }  // namespace detail

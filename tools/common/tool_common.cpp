@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/atomic_file.h"
 
 namespace pcl_ddg {
 namespace tools {
@@ -121,6 +122,7 @@ int ToolArguments::integer(const std::string& option, int fallback) const {
 
 int runTool(const char* name, const char* description, const char* syntax,
             const std::function<int()>& body) {
+  AtomicFile::removeUncommittedFilesOnInterrupt();  // Ctrl-C leaves no temporary behind
   try {
     return body();
   } catch (const HelpRequested&) {

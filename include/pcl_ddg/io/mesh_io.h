@@ -3,7 +3,8 @@
 //
 // Read: .ply (ascii/binary; face, tristrips or range_grid elements), .obj, .off (also binary OFF),
 // .stl (ascii/binary), .vtk (legacy POLYDATA), .pcd (organized or not; no faces).
-// Written: .ply (binary by default) and .pcd (binary; faces are not stored).
+// Written: .ply (binary by default) and .pcd (binary_compressed, as PCL's tools write it; faces
+// are not stored).
 // A cloud is a mesh without polygons. All vertex fields are kept as they are stored (a double
 // coordinate stays double). Malformed, truncated or unknown files raise FileFormatException with
 // the path and the reason; output goes through a temporary file renamed on success, so a failed

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# Runs every libFuzzer target of a sanitize build for a while, each seeded with the small files in
+# fuzz/seeds/<format> and the shared scans of that format (read in place, never copied here).
+#   fuzz/run_fuzzers.sh BUILD_DIR SECONDS_PER_TARGET [TARGET ...]
+# New corpus entries stay in BUILD_DIR/fuzz/corpus/<target>; a finding is written to
+# BUILD_DIR/fuzz/findings/ and makes this script fail. Inputs may cost at most 256 MiB in one
+# allocation (a small file that asks for more is a lying count the loader should have refused).
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
+build=$(cd "$1" && pwd)
+seconds=$2
+shift 2
+targets=("$@")
+((${#targets[@]})) || targets=(ply off obj stl vtk pcd mesh)
+shared=${PCL_DDG_SHARED_DATA:-$here/../../shared/data}
+
+status=0
+for target in "${targets[@]}"; do
+  corpus=$build/fuzz/corpus/$target
+  seeds=$build/fuzz/seeds/$target
+  findings=$build/fuzz/findings/$target
+  mkdir -p "$corpus" "$seeds" "$findings"
+  rm -f "$seeds"/*
+  if [ -d "$here/seeds/$target" ]; then cp "$here/seeds/$target"/* "$seeds"/; fi
+  if [ -d "$shared" ]; then
+    find "$shared" -type f -name "*.$target" -exec ln -sf {} "$seeds"/ \;
+  fi
+  dict=()
+  [ -f "$here/$target.dict" ] && dict=(-dict="$here/$target.dict")
+  echo "== fuzz_$target for ${seconds}s"
+  if ! "$build/fuzz/fuzz_$target" "$corpus" "$seeds" "${dict[@]}" -max_total_time="$seconds" \
+      -max_len=16384 -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=256 -print_final_stats=1 \
+      -artifact_prefix="$findings/" 2>"$build/fuzz/$target.log"; then
+    echo "fuzz_$target: FINDING (see $findings and $build/fuzz/$target.log)"
+    grep -E "ERROR|SUMMARY|runtime error" "$build/fuzz/$target.log" | head -5 || true
+    status=1
+  else
+    grep -E "stat::number_of_executed_units|cov:" "$build/fuzz/$target.log" | tail -2 || true
+  fi
+done
+exit $status
