@@ -239,13 +239,23 @@ TEST_F(MeshIOFiles, GarbageAndEmptyFilesFail) {
   EXPECT_THROW(loadMesh(path("bad_header.ply")), FileFormatException);
 }
 
-TEST_F(MeshIOFiles, FailedSaveLeavesNoFile) {
-  pcl::PolygonMesh mesh = makeMesh(Eigen::Matrix3Xd::Zero(3, 300), {});
+TEST_F(MeshIOFiles, FacesOfManyCornersAndLongFileNamesAreWritten) {
+  pcl::PolygonMesh mesh = makeMesh(Eigen::Matrix3Xd::Random(3, 300), {{0, 1, 2}});
   pcl::Vertices huge;
   for (int i = 0; i < 300; ++i) huge.vertices.push_back(i);
-  mesh.polygons.push_back(huge);  // more corners than PLY's uchar count can hold
-  EXPECT_THROW(saveMesh(path("out.ply"), mesh), FileFormatException);
-  EXPECT_TRUE(std::filesystem::is_empty(dir_));
+  mesh.polygons.push_back(huge);  // more corners than PLY's usual uchar count can hold
+  const std::string long_name = std::string(246, 'n') + ".ply";  // 250 bytes: legal
+  for (PlyEncoding encoding : {PlyEncoding::Binary, PlyEncoding::Ascii}) {
+    saveMesh(path(long_name), mesh, {encoding});
+    const pcl::PolygonMesh back = loadMesh(path(long_name));
+    ASSERT_EQ(back.polygons.size(), 2u);
+    EXPECT_EQ(back.polygons[1].vertices, huge.vertices);
+    EXPECT_EQ(back.polygons[0].vertices.size(), 3u);
+  }
+}
+
+TEST_F(MeshIOFiles, FailedSaveLeavesNoFile) {
+  const pcl::PolygonMesh mesh = makeMesh(Eigen::Matrix3Xd::Zero(3, 3), {{0, 1, 2}});
   EXPECT_THROW(saveMesh(path("out.xyz"), mesh), FileFormatException);
   EXPECT_THROW(saveMesh(path("no/such/folder/out.ply"), mesh), FileFormatException);
   EXPECT_TRUE(std::filesystem::is_empty(dir_));

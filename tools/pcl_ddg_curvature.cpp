@@ -114,6 +114,11 @@ int run(int argc, char** argv) {
     if (!(time > 0.0)) throw tools::UsageError("-smooth must be > 0");
     if (!in.topology) throw tools::UsageError("-smooth needs a mesh; this input is a point cloud");
     const double h = meanEdgeLength(*in.topology, in.positions);
+    if (!(h > 0.0)) {
+      throw std::runtime_error(
+          "-smooth: the mesh has no edge of positive length to measure the "
+          "time in");
+    }
     HeatFlowParameters heat;
     heat.diffusion_time = time * h * h;
     Eigen::MatrixXd curvatures(mean.size(), 4);

@@ -83,7 +83,8 @@ AtomicFile::AtomicFile(const std::string& path) : path_(path) {
   const std::size_t slash = path.find_last_of('/');
   const std::string folder = slash == std::string::npos ? "" : path.substr(0, slash + 1);
   const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
-  std::string pattern = folder + "." + name + ".tmp.XXXXXX";
+  // A file name may take 255 bytes: a long target name is shortened in its temporary's name.
+  std::string pattern = folder + "." + name.substr(0, 200) + ".tmp.XXXXXX";
   std::vector<char> buffer(pattern.begin(), pattern.end());
   buffer.push_back('\0');
   const int fd = mkstemp(buffer.data());

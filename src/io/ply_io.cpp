@@ -512,8 +512,16 @@ void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encod
       << "element vertex " << n << "\n";
   for (const auto& p : properties)
     out << "property " << plyTypeName(p.datatype) << " " << p.name << "\n";
+  // The usual uchar corner count, or int when a face has more than 255 corners.
+  std::size_t most_corners = 0;
+  for (const auto& polygon : mesh.polygons)
+    most_corners = std::max(most_corners, polygon.vertices.size());
+  if (most_corners > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
+    throw FileFormatException("a face has too many corners for PLY");
+  }
+  const bool wide_counts = most_corners > 255;
   out << "element face " << mesh.polygons.size() << "\n"
-      << "property list uchar int vertex_indices\nend_header\n";
+      << "property list " << (wide_counts ? "int" : "uchar") << " int vertex_indices\nend_header\n";
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
     for (std::size_t k = 0; k < properties.size(); ++k) {
@@ -528,18 +536,19 @@ void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encod
     if (!binary) out << '\n';
   }
   for (const auto& polygon : mesh.polygons) {
-    if (polygon.vertices.size() > 255) {
-      throw FileFormatException("a face with more than 255 corners cannot be written to PLY");
-    }
-    const auto corners = static_cast<std::uint8_t>(polygon.vertices.size());
+    const auto corners = static_cast<std::int32_t>(polygon.vertices.size());
     if (binary) {
-      out.put(static_cast<char>(corners));
+      if (wide_counts) {
+        out.write(reinterpret_cast<const char*>(&corners), 4);
+      } else {
+        out.put(static_cast<char>(corners));
+      }
       for (const pcl::index_t v : polygon.vertices) {
         const auto index = static_cast<std::int32_t>(v);
         out.write(reinterpret_cast<const char*>(&index), 4);
       }
     } else {
-      out << static_cast<int>(corners);
+      out << corners;
       for (const pcl::index_t v : polygon.vertices) out << ' ' << v;
       out << '\n';
     }

@@ -10,6 +10,8 @@ macro(step)
 endmacro()
 step(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${prefix}")
 step(${CMAKE_COMMAND} -S "${CONSUMER_SOURCE}" -B "${WORK_DIR}/build" -DCMAKE_PREFIX_PATH=${prefix}
-     -DCMAKE_BUILD_TYPE=Release)
+     -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=${CONSUMER_C_COMPILER}
+     -DCMAKE_CXX_COMPILER=${CONSUMER_CXX_COMPILER} "-DCMAKE_CXX_FLAGS=${CONSUMER_FLAGS}"
+     "-DCMAKE_EXE_LINKER_FLAGS=${CONSUMER_FLAGS}")
 step(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
 step("${WORK_DIR}/build/consumer")
