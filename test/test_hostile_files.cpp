@@ -266,7 +266,7 @@ TEST_F(HostileFiles, PcdReaderAgreesWithPclOnWellFormedFiles) {
     pcl::PCLPointCloud2 expected;
     ASSERT_EQ(pcl::PCDReader().read(sharedData(std::string("clouds/") + name), expected), 0);
     pcl::PCDWriter writer;
-    const std::string compressed = dir_ + "/compressed.pcd";
+    const std::string compressed = dir_ + "/compressed_" + name;
     ASSERT_EQ(writer.writeBinaryCompressed(compressed, expected), 0);
     for (const std::string& path : {sharedData(std::string("clouds/") + name), compressed}) {
       const pcl::PCLPointCloud2 ours = loadMesh(path).cloud;
