@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "analytic_surfaces.h"
+#include "mesh/disjoint_sets.h"  // internal: the union-find under the orientation check
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "test_data.h"
@@ -189,6 +190,49 @@ TEST(MeshTopology, NeighbourRowsAreSortedSymmetricAndMatchEdges) {
     }
   }
   EXPECT_EQ(t.numEdges(), 3 * t.numVertices());
+}
+
+// The orientation union-find must stay linear on chains (a long strip unites each triangle with
+// the previous one): counted in parent links followed, not by a clock. Without path compression
+// and union by size the strip below takes n^2 / 2 = 5e11 steps.
+TEST(MeshTopology, OrientationUnionFindIsLinearOnALongChain) {
+  const int n = 1000000;
+  for (const bool reversed : {false, true}) {
+    detail::ParityDisjointSets sets(n);
+    for (int i = 1; i < n; ++i) {
+      const int t = reversed ? n - 1 - i : i;
+      ASSERT_TRUE(sets.unite(reversed ? t + 1 : t - 1, t, static_cast<char>(i % 2)));
+    }
+    EXPECT_LE(sets.steps(), 4 * static_cast<std::int64_t>(n)) << "reversed " << reversed;
+    // Parities compose along the chain: element i relative to element 0.
+    const auto root = sets.find(reversed ? n - 1 : 0);
+    char expected = 0;
+    for (int i = 1; i < n; i += 99991) {
+      expected = 0;
+      for (int j = 1; j <= i; ++j) expected ^= static_cast<char>(j % 2);
+      const auto r = sets.find(reversed ? n - 1 - i : i);
+      EXPECT_EQ(r.root, root.root);
+      EXPECT_EQ(r.parity ^ root.parity, expected) << i;
+    }
+  }
+}
+
+TEST(MeshTopology, AMillionTriangleStripIsOneOrientedDisk) {
+  const int triangles = 1000000;
+  Eigen::Matrix3Xi faces(3, triangles);
+  for (int t = 0; t < triangles; ++t) {
+    if (t % 2 == 0) {
+      faces.col(t) << t, t + 1, t + 2;
+    } else {
+      faces.col(t) << t + 1, t, t + 2;
+    }
+  }
+  const MeshTopology strip(triangles + 2, faces);
+  EXPECT_TRUE(strip.counts().orientable);
+  EXPECT_TRUE(strip.counts().consistently_oriented);
+  EXPECT_EQ(strip.counts().boundary_loops, 1);
+  EXPECT_EQ(strip.counts().connected_components, 1);
+  EXPECT_EQ(strip.eulerCharacteristic(), 1);
 }
 
 }  // namespace

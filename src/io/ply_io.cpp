@@ -499,9 +499,52 @@ void printScalar(std::ostream& out, const std::uint8_t* p, std::uint8_t datatype
   }
 }
 
+// Bytes gathered in a reused buffer and written in large blocks: a stream write per value costs
+// more than the data, and one buffer of the whole body costs its page faults.
+class BlockWriter {
+ public:
+  explicit BlockWriter(std::ostream& out) : out_(out) { buffer_.reserve(kBlock); }
+  ~BlockWriter() { flush(); }
+  void append(const void* data, std::size_t size) {
+    if (buffer_.size() + size > kBlock) flush();
+    buffer_.append(static_cast<const char*>(data), size);
+  }
+  void flush() {
+    out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+    buffer_.clear();
+  }
+
+ private:
+  static constexpr std::size_t kBlock = 1 << 20;
+  std::ostream& out_;
+  std::string buffer_;
+};
+
+// Little-endian: the byte order of every platform PCL supports.
+void writeBinaryBody(std::ostream& out, const pcl::PolygonMesh& mesh,
+                     const std::vector<OutputProperty>& properties, bool wide_counts) {
+  const pcl::PCLPointCloud2& cloud = mesh.cloud;
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  BlockWriter writer(out);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
+    for (const auto& p : properties) writer.append(point + p.offset, pcl::getFieldSize(p.datatype));
+  }
+  for (const auto& polygon : mesh.polygons) {
+    const auto corners = static_cast<std::int32_t>(polygon.vertices.size());
+    if (wide_counts) {
+      writer.append(&corners, 4);
+    } else {
+      const auto narrow = static_cast<std::uint8_t>(corners);
+      writer.append(&narrow, 1);
+    }
+    static_assert(sizeof(pcl::index_t) == 4, "PLY indices are written as int32");
+    writer.append(polygon.vertices.data(), 4 * polygon.vertices.size());
+  }
+}
+
 }  // namespace
 
-// Binary output is little-endian: the byte order of every platform PCL supports.
 void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding) {
   const pcl::PCLPointCloud2& cloud = mesh.cloud;
   const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
@@ -522,36 +565,22 @@ void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encod
   const bool wide_counts = most_corners > 255;
   out << "element face " << mesh.polygons.size() << "\n"
       << "property list " << (wide_counts ? "int" : "uchar") << " int vertex_indices\nend_header\n";
+  if (binary) {
+    writeBinaryBody(out, mesh, properties, wide_counts);
+    return;
+  }
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
     for (std::size_t k = 0; k < properties.size(); ++k) {
-      const OutputProperty& p = properties[k];
-      if (binary) {
-        out.write(reinterpret_cast<const char*>(point + p.offset), pcl::getFieldSize(p.datatype));
-      } else {
-        if (k) out << ' ';
-        printScalar(out, point + p.offset, p.datatype);
-      }
+      if (k) out << ' ';
+      printScalar(out, point + properties[k].offset, properties[k].datatype);
     }
-    if (!binary) out << '\n';
+    out << '\n';
   }
   for (const auto& polygon : mesh.polygons) {
-    const auto corners = static_cast<std::int32_t>(polygon.vertices.size());
-    if (binary) {
-      if (wide_counts) {
-        out.write(reinterpret_cast<const char*>(&corners), 4);
-      } else {
-        out.put(static_cast<char>(corners));
-      }
-      for (const pcl::index_t v : polygon.vertices) {
-        const auto index = static_cast<std::int32_t>(v);
-        out.write(reinterpret_cast<const char*>(&index), 4);
-      }
-    } else {
-      out << corners;
-      for (const pcl::index_t v : polygon.vertices) out << ' ' << v;
-      out << '\n';
-    }
+    out << polygon.vertices.size();
+    for (const pcl::index_t v : polygon.vertices) out << ' ' << v;
+    out << '\n';
   }
 }
 

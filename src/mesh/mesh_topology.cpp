@@ -52,11 +52,13 @@ void MeshTopology::build(const std::vector<pcl::Vertices>& polygons, OutOfRangeF
   if (num_vertices_ <= 0) throw InvalidMeshException("mesh has no vertices");
   triangulate(polygons, policy);
   countDuplicatePolygons(polygons);
-  buildVertexTriangles();
-  buildVertexNeighbours();
-  buildEdges();
-  classifyEdgesAndVertices();
-  findBowTieVertices();
+  {
+    const Wedges wedges = buildVertexTriangles();
+    buildVertexNeighbours(wedges);
+    buildEdges(wedges);
+    classifyEdgesAndVertices();
+    findBowTieVertices(wedges);
+  }
   findComponents();
   checkOrientation();
   countBoundaryLoops();
@@ -112,44 +114,74 @@ void MeshTopology::triangulate(const std::vector<pcl::Vertices>& polygons,
 }
 
 void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons) {
-  // Sort each polygon's corner set into one flat buffer, then sort polygons by that key.
-  std::vector<std::size_t> offsets(polygons.size() + 1, 0);
-  for (std::size_t i = 0; i < polygons.size(); ++i) {
-    offsets[i + 1] = offsets[i] + polygons[i].vertices.size();
-  }
-  std::vector<pcl::index_t> keys(offsets.back());
-  for (std::size_t i = 0; i < polygons.size(); ++i) {
-    std::copy(polygons[i].vertices.begin(), polygons[i].vertices.end(), keys.begin() + offsets[i]);
-    std::sort(keys.begin() + offsets[i], keys.begin() + offsets[i + 1]);
-  }
-  auto key_less = [&](std::size_t a, std::size_t b) {
-    return std::lexicographical_compare(keys.begin() + offsets[a], keys.begin() + offsets[a + 1],
-                                        keys.begin() + offsets[b], keys.begin() + offsets[b + 1]);
+  // Two polygons are duplicates when they have the same corner set. Bucket the polygons by their
+  // smallest corner (a counting sort: linear), then compare sorted corner sets within a bucket,
+  // which holds a handful of polygons. Polygons out of range take no part (they are not faces of
+  // the mesh), nor do those with fewer than three corners.
+  const auto valid = [&](const pcl::Vertices& p) {
+    return p.vertices.size() >= 3 &&
+           std::all_of(p.vertices.begin(), p.vertices.end(),
+                       [&](pcl::index_t i) { return i >= 0 && i < num_vertices_; });
   };
-  std::vector<std::size_t> order(polygons.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), key_less);
-  for (std::size_t i = 1; i < order.size(); ++i) {
-    if (polygons[order[i]].vertices.size() >= 3 && !key_less(order[i - 1], order[i])) {
-      ++counts_.duplicate_polygons;
+  std::vector<int> bucket_start(num_vertices_ + 1, 0);
+  std::vector<int> smallest(polygons.size(), -1);
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    if (!valid(polygons[i])) continue;
+    smallest[i] = *std::min_element(polygons[i].vertices.begin(), polygons[i].vertices.end());
+    ++bucket_start[smallest[i] + 1];
+  }
+  std::partial_sum(bucket_start.begin(), bucket_start.end(), bucket_start.begin());
+  std::vector<int> bucketed(bucket_start.back());
+  std::vector<int> cursor(bucket_start.begin(), bucket_start.end() - 1);
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    if (smallest[i] >= 0) bucketed[cursor[smallest[i]]++] = static_cast<int>(i);
+  }
+
+  std::int64_t duplicates = 0;
+#pragma omp parallel reduction(+ : duplicates)
+  {
+    std::vector<std::vector<pcl::index_t>> keys;  // per thread, reused across buckets
+#pragma omp for schedule(dynamic, 4096)
+    for (int v = 0; v < num_vertices_; ++v) {
+      const int begin = bucket_start[v], end = bucket_start[v + 1];
+      if (end - begin < 2) continue;
+      keys.resize(static_cast<std::size_t>(end - begin));
+      for (int j = begin; j < end; ++j) {
+        auto& key = keys[static_cast<std::size_t>(j - begin)];
+        key.assign(polygons[bucketed[j]].vertices.begin(), polygons[bucketed[j]].vertices.end());
+        std::sort(key.begin(), key.end());
+      }
+      std::sort(keys.begin(), keys.end());
+      for (std::size_t j = 1; j < keys.size(); ++j) duplicates += keys[j] == keys[j - 1];
     }
   }
+  counts_.duplicate_polygons = duplicates;
 }
 
-void MeshTopology::buildVertexTriangles() {
+MeshTopology::Wedges MeshTopology::buildVertexTriangles() {
   vt_offsets_.assign(num_vertices_ + 1, 0);
   for (Eigen::Index t = 0; t < triangles_.cols(); ++t) {
     for (int k = 0; k < 3; ++k) ++vt_offsets_[triangles_(k, t) + 1];
   }
   std::partial_sum(vt_offsets_.begin(), vt_offsets_.end(), vt_offsets_.begin());
-  vt_triangles_.resize(vt_offsets_.back());
+  const std::size_t incidences = static_cast<std::size_t>(vt_offsets_.back());
+  vt_triangles_.resize(incidences);
+  Wedges wedges{std::vector<int>(incidences), std::vector<int>(incidences),
+                std::vector<std::uint8_t>(incidences)};
   std::vector<int> cursor(vt_offsets_.begin(), vt_offsets_.end() - 1);
   for (Eigen::Index t = 0; t < triangles_.cols(); ++t) {
-    for (int k = 0; k < 3; ++k) vt_triangles_[cursor[triangles_(k, t)]++] = static_cast<int>(t);
+    for (int k = 0; k < 3; ++k) {
+      const int at = cursor[triangles_(k, t)]++;
+      vt_triangles_[at] = static_cast<int>(t);
+      wedges.next[at] = triangles_((k + 1) % 3, t);
+      wedges.previous[at] = triangles_((k + 2) % 3, t);
+      wedges.corner[at] = static_cast<std::uint8_t>(k);
+    }
   }
+  return wedges;
 }
 
-void MeshTopology::buildVertexNeighbours() {
+void MeshTopology::buildVertexNeighbours(const Wedges& wedges) {
   // Each incident triangle offers two neighbours; gather them into a row of twice the triangle
   // count, sort and deduplicate it in place, then compact the rows.
   std::vector<int> scratch(2 * vt_triangles_.size());
@@ -159,11 +191,8 @@ void MeshTopology::buildVertexNeighbours() {
     int* out = scratch.data() + 2 * vt_offsets_[v];
     int n = 0;
     for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
-      const int t = vt_triangles_[i];
-      for (int k = 0; k < 3; ++k) {
-        const int w = triangles_(k, t);
-        if (w != v) out[n++] = w;
-      }
+      out[n++] = wedges.next[i];
+      out[n++] = wedges.previous[i];
     }
     std::sort(out, out + n);
     row_size[v] = static_cast<int>(std::unique(out, out + n) - out);
@@ -171,6 +200,7 @@ void MeshTopology::buildVertexNeighbours() {
   vv_offsets_.assign(num_vertices_ + 1, 0);
   for (int v = 0; v < num_vertices_; ++v) vv_offsets_[v + 1] = vv_offsets_[v] + row_size[v];
   vv_neighbours_.resize(vv_offsets_.back());
+#pragma omp parallel for schedule(static)
   for (int v = 0; v < num_vertices_; ++v) {
     const int* in = scratch.data() + 2 * vt_offsets_[v];
     std::copy(in, in + row_size[v], vv_neighbours_.begin() + vv_offsets_[v]);
@@ -184,33 +214,64 @@ int MeshTopology::findEdge(int a, int b) const {
   return vv_edges_[vv_offsets_[a] + static_cast<int>(it - row_a.begin())];
 }
 
-void MeshTopology::buildEdges() {
-  // Edge ids are assigned in order of (smaller vertex, larger vertex).
-  vv_edges_.assign(vv_neighbours_.size(), -1);
-  int num_edges = 0;
-  for (int v = 0; v < num_vertices_; ++v) {
-    for (int i = vv_offsets_[v]; i < vv_offsets_[v + 1]; ++i) {
-      if (vv_neighbours_[i] > v) vv_edges_[i] = num_edges++;
-    }
-  }
+void MeshTopology::buildEdges(const Wedges& wedges) {
+  // Edge ids in order of (smaller vertex, larger vertex), from a prefix sum over each row's count
+  // of larger neighbours (rows are sorted). Every edge and every triangle side is then written by
+  // its smaller end point alone, so the rows are processed in parallel without conflicts.
+  const auto firstLarger = [&](int v) {
+    const IndexSpan row = neighbours(v);
+    return static_cast<int>(std::upper_bound(row.begin(), row.end(), v) - row.begin());
+  };
+  std::vector<int> first_edge(num_vertices_ + 1, 0);
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < num_vertices_; ++v) first_edge[v + 1] = neighbours(v).size() - firstLarger(v);
+  std::partial_sum(first_edge.begin(), first_edge.end(), first_edge.begin());
+  const int num_edges = first_edge.back();
+
+  vv_edges_.resize(vv_neighbours_.size());
   edge_vertices_.resize(2, num_edges);
+#pragma omp parallel for schedule(static)
   for (int v = 0; v < num_vertices_; ++v) {
-    for (int i = vv_offsets_[v]; i < vv_offsets_[v + 1]; ++i) {
-      const int w = vv_neighbours_[i];
-      if (w > v) {
-        edge_vertices_.col(vv_edges_[i]) << v, w;
-      } else {
-        vv_edges_[i] = findEdge(w, v);
+    const int larger = firstLarger(v);
+    for (int i = 0; i < neighbours(v).size(); ++i) {
+      const int w = neighbours(v)[i];
+      int e;
+      if (i >= larger) {
+        e = first_edge[v] + i - larger;
+        edge_vertices_.col(e) << v, w;
+      } else {  // the edge belongs to w's row: v's place among w's larger neighbours
+        const IndexSpan row_w = neighbours(w);
+        const int at =
+            static_cast<int>(std::lower_bound(row_w.begin(), row_w.end(), v) - row_w.begin());
+        e = first_edge[w] + at - firstLarger(w);
       }
+      vv_edges_[vv_offsets_[v] + i] = e;
     }
   }
+
+  // Sides (v, next) and (v, previous) of each triangle at v, written when v is their smaller end:
+  // side (v, next) is opposite corner k + 2, side (v, previous) opposite corner k + 1.
   triangle_edges_.resize(3, triangles_.cols());
   edge_triangle_count_.assign(num_edges, 0);
-  for (Eigen::Index t = 0; t < triangles_.cols(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const int e = findEdge(triangles_((k + 1) % 3, t), triangles_((k + 2) % 3, t));
-      triangle_edges_(k, t) = e;
-      ++edge_triangle_count_[e];
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < num_vertices_; ++v) {
+    const IndexSpan row = neighbours(v);
+    const auto edgeTo = [&](int w) {
+      const int at = static_cast<int>(std::lower_bound(row.begin(), row.end(), w) - row.begin());
+      return vv_edges_[vv_offsets_[v] + at];
+    };
+    for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
+      const int t = vt_triangles_[i], k = wedges.corner[i];
+      if (wedges.next[i] > v) {
+        const int e = edgeTo(wedges.next[i]);
+        triangle_edges_((k + 2) % 3, t) = e;
+        ++edge_triangle_count_[e];
+      }
+      if (wedges.previous[i] > v) {
+        const int e = edgeTo(wedges.previous[i]);
+        triangle_edges_((k + 1) % 3, t) = e;
+        ++edge_triangle_count_[e];
+      }
     }
   }
 }
@@ -240,50 +301,55 @@ void MeshTopology::classifyEdgesAndVertices() {
   }
 }
 
-void MeshTopology::findBowTieVertices() {
+void MeshTopology::findBowTieVertices(const Wedges& wedges) {
   // The triangles around v form fans: two are in one fan when they share an edge at v.
   // More than one fan means the surface is pinched at v.
   int max_valence = 0;
   for (int v = 0; v < num_vertices_; ++v) {
     max_valence = std::max(max_valence, vt_offsets_[v + 1] - vt_offsets_[v]);
   }
-  std::vector<int> parent(max_valence);
-  std::vector<int> first_triangle_at_neighbour(max_valence * 2);
-  auto find = [&](int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  };
-  for (int v = 0; v < num_vertices_; ++v) {
-    const IndexSpan tris = incidentTriangles(v);
-    const IndexSpan ring = neighbours(v);
-    if (tris.size() < 2) continue;
-    std::iota(parent.begin(), parent.begin() + tris.size(), 0);
-    std::fill(first_triangle_at_neighbour.begin(),
-              first_triangle_at_neighbour.begin() + ring.size(), -1);
-    int fans = tris.size();
-    for (int i = 0; i < tris.size(); ++i) {
-      for (int k = 0; k < 3; ++k) {
-        const int w = triangles_(k, tris[i]);
-        if (w == v) continue;
-        const int slot =
-            static_cast<int>(std::lower_bound(ring.begin(), ring.end(), w) - ring.begin());
-        int& first = first_triangle_at_neighbour[slot];
-        if (first < 0) {
-          first = i;
-        } else {
-          const int a = find(first), b = find(i);
-          if (a != b) {
-            parent[a] = b;
-            --fans;
+  std::int64_t bow_ties = 0;
+#pragma omp parallel reduction(+ : bow_ties)
+  {
+    std::vector<int> parent(max_valence);
+    std::vector<int> first_triangle_at_neighbour(max_valence * 2);
+    auto find = [&](int x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+#pragma omp for schedule(static)
+    for (int v = 0; v < num_vertices_; ++v) {
+      const IndexSpan tris = incidentTriangles(v);
+      const IndexSpan ring = neighbours(v);
+      if (tris.size() < 2) continue;
+      std::iota(parent.begin(), parent.begin() + tris.size(), 0);
+      std::fill(first_triangle_at_neighbour.begin(),
+                first_triangle_at_neighbour.begin() + ring.size(), -1);
+      int fans = tris.size();
+      for (int i = 0; i < tris.size(); ++i) {
+        const int wedge = vt_offsets_[v] + i;
+        for (const int w : {wedges.next[wedge], wedges.previous[wedge]}) {
+          const int slot =
+              static_cast<int>(std::lower_bound(ring.begin(), ring.end(), w) - ring.begin());
+          int& first = first_triangle_at_neighbour[slot];
+          if (first < 0) {
+            first = i;
+          } else {
+            const int a = find(first), b = find(i);
+            if (a != b) {
+              parent[a] = b;
+              --fans;
+            }
           }
         }
       }
-    }
-    if (fans > 1) {
-      vertex_flags_[v] |= static_cast<std::uint8_t>(VertexFlag::NonManifoldVertex);
-      ++counts_.nonmanifold_vertices;
+      if (fans > 1) {
+        vertex_flags_[v] |= static_cast<std::uint8_t>(VertexFlag::NonManifoldVertex);
+        ++bow_ties;
+      }
     }
   }
+  counts_.nonmanifold_vertices = bow_ties;
 }
 
 void MeshTopology::findComponents() {
@@ -305,24 +371,13 @@ void MeshTopology::findComponents() {
 }
 
 void MeshTopology::checkOrientation() {
-  // Union-find over triangles that also tracks, for each triangle, whether it must be flipped
-  // relative to its root. A manifold edge traversed the same way by both of its triangles asks
-  // for a relative flip; a contradiction means the component is not orientable.
-  const int num_triangles = numTriangles();
-  std::vector<int> parent(num_triangles);
-  std::vector<char> flip_to_parent(num_triangles, 0);
-  std::iota(parent.begin(), parent.end(), 0);
-  auto find = [&](int t, char& flip) {
-    flip = 0;
-    while (parent[t] != t) {
-      flip ^= flip_to_parent[t];
-      t = parent[t];
-    }
-    return t;
-  };
+  // Union-find over triangles with a parity: flipped or not relative to the set's root. A
+  // manifold edge traversed the same way by both of its triangles asks for a relative flip; a
+  // contradiction means the component is not orientable.
+  detail::ParityDisjointSets sets(numTriangles());
   std::vector<int> first_triangle(numEdges(), -1);
   std::vector<char> first_forward(numEdges(), 0);
-  for (int t = 0; t < num_triangles; ++t) {
+  for (int t = 0; t < numTriangles(); ++t) {
     for (int k = 0; k < 3; ++k) {
       const int e = triangle_edges_(k, t);
       if (edge_triangle_count_[e] != 2) continue;
@@ -334,15 +389,7 @@ void MeshTopology::checkOrientation() {
       }
       const char relative_flip = forward == first_forward[e];
       if (relative_flip) counts_.consistently_oriented = false;
-      char flip_a, flip_b;
-      const int a = find(first_triangle[e], flip_a);
-      const int b = find(t, flip_b);
-      if (a == b) {
-        if ((flip_a ^ flip_b) != relative_flip) counts_.orientable = false;
-      } else {
-        parent[b] = a;
-        flip_to_parent[b] = flip_a ^ flip_b ^ relative_flip;
-      }
+      if (!sets.unite(first_triangle[e], t, relative_flip)) counts_.orientable = false;
     }
   }
 }

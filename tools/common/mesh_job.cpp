@@ -18,10 +18,12 @@ SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name) {
 }
 
 SurfaceMesh checkSurfaceMesh(pcl::PolygonMesh mesh, const char* tool_name) {
+  Timer timer("Building the mesh topology");
   MeshTopology topology(mesh);
   Eigen::Matrix3Xd positions = vertexPositions(mesh.cloud);
-
   const MeshReport report = makeMeshReport(topology, positions);
+  timer.done(static_cast<std::size_t>(positions.cols()));
+
   const std::pair<std::int64_t, const char*> defects[] = {
       {report.degenerate_faces, "degenerate faces (no weight)"},
       {report.duplicate_faces, "duplicate faces"},

@@ -125,11 +125,18 @@ class MeshTopology {
   void build(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
   void triangulate(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
   void countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons);
-  void buildVertexTriangles();
-  void buildVertexNeighbours();
-  void buildEdges();
+  /** Per incidence of a vertex in a triangle (parallel to vt_triangles_): the triangle's next and
+   *  previous corners after the vertex, and the vertex's corner index. Built once, so that every
+   *  later per-vertex pass reads its own contiguous row instead of triangles all over memory. */
+  struct Wedges {
+    std::vector<int> next, previous;
+    std::vector<std::uint8_t> corner;
+  };
+  Wedges buildVertexTriangles();
+  void buildVertexNeighbours(const Wedges& wedges);
+  void buildEdges(const Wedges& wedges);
   void classifyEdgesAndVertices();
-  void findBowTieVertices();
+  void findBowTieVertices(const Wedges& wedges);
   void findComponents();
   void checkOrientation();
   void countBoundaryLoops();
