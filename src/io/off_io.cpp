@@ -1,6 +1,7 @@
 // Object File Format (Geomview): "OFF" header, counts, vertices, faces. Colour and normal variants
 // (COFF, NOFF, CNOFF) carry extra values per line, which are ignored; "OFF BINARY" in either byte
 // order.
+#include <algorithm>
 #include <vector>
 
 #include "byte_cursor.h"
@@ -98,25 +99,44 @@ pcl::PolygonMesh parseOFF(std::string_view data) {
     cursor.fail("vertex or face count larger than the file can hold (truncated?)");
   }
 
-  std::vector<double> xyz(3 * static_cast<std::size_t>(num_vertices));
-  for (std::int64_t i = 0; i < num_vertices; ++i) {
-    ByteCursor values = cursor.within(contentLine(cursor, "vertices"));
-    for (int d = 0; d < 3; ++d) xyz[3 * i + d] = values.readDouble("vertex coordinate");
+  // The content lines first (cheap: a scan for newlines), then vertices and faces parsed in
+  // parallel from them; the first error by line order is the one reported.
+  std::vector<std::string_view> lines;
+  lines.reserve(static_cast<std::size_t>(num_vertices + num_faces));
+  while (static_cast<std::int64_t>(lines.size()) < num_vertices + num_faces) {
+    lines.push_back(contentLine(
+        cursor, lines.size() < static_cast<std::size_t>(num_vertices) ? "vertices" : "faces"));
   }
+  std::vector<double> xyz(3 * static_cast<std::size_t>(num_vertices));
   pcl::PolygonMesh mesh;
-  mesh.cloud = makeXYZCloud(xyz);
   mesh.polygons.resize(static_cast<std::size_t>(num_faces));
-  for (auto& polygon : mesh.polygons) {
-    ByteCursor values = cursor.within(contentLine(cursor, "faces"));
+  const auto parseLine = [&](std::int64_t i) {
+    ByteCursor values = cursor.within(lines[static_cast<std::size_t>(i)]);
+    if (i < num_vertices) {
+      for (int d = 0; d < 3; ++d) xyz[3 * i + d] = values.readDouble("vertex coordinate");
+      return;
+    }
+    auto& polygon = mesh.polygons[static_cast<std::size_t>(i - num_vertices)];
     const std::int64_t n = values.readInt("face size");
     if (n < 0 || n > static_cast<std::int64_t>(values.remaining())) {
       values.fail("face size " + std::to_string(n) + " does not fit its line");
     }
-    polygon.vertices.reserve(static_cast<std::size_t>(n));
-    for (std::int64_t k = 0; k < n; ++k) {
-      polygon.vertices.push_back(cornerIndex(values.readInt("face index")));
+    polygon.vertices.resize(static_cast<std::size_t>(n));
+    for (auto& corner : polygon.vertices) corner = cornerIndex(values.readInt("face index"));
+  };
+  const std::int64_t total = num_vertices + num_faces;
+  std::int64_t first_error = total;
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < total; ++i) {
+    try {
+      parseLine(i);
+    } catch (const FileFormatException&) {
+#pragma omp critical(off_parse_error)
+      first_error = std::min(first_error, i);
     }
   }
+  if (first_error < total) parseLine(first_error);  // rethrows the first error, in order
+  mesh.cloud = makeXYZCloud(xyz);
   return mesh;
 }
 

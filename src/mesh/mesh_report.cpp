@@ -9,9 +9,7 @@
 #include "pcl_ddg/mesh/vertex_positions.h"
 
 namespace pcl_ddg {
-namespace {
 
-// Faces whose triangles are all degenerate by the relative area guard.
 std::int64_t countZeroAreaFaces(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
   const Eigen::Matrix3Xi& tris = topology.triangles();
   const std::vector<int>& source = topology.triangleSource();
@@ -30,8 +28,6 @@ std::int64_t countZeroAreaFaces(const MeshTopology& topology, const Eigen::Matri
   }
   return count;
 }
-
-}  // namespace
 
 MeshReport makeMeshReport(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
   const TopologyCounts& c = topology.counts();

@@ -21,15 +21,18 @@ SurfaceMesh checkSurfaceMesh(pcl::PolygonMesh mesh, const char* tool_name) {
   Timer timer("Building the mesh topology");
   MeshTopology topology(mesh);
   Eigen::Matrix3Xd positions = vertexPositions(mesh.cloud);
-  const MeshReport report = makeMeshReport(topology, positions);
+  // Only the defects worth a warning (pcl_ddg_info makes the whole MeshReport).
+  const TopologyCounts& counts = topology.counts();
+  const std::int64_t degenerate =
+      counts.repeated_index_polygons + countZeroAreaFaces(topology, positions);
   timer.done(static_cast<std::size_t>(positions.cols()));
 
   const std::pair<std::int64_t, const char*> defects[] = {
-      {report.degenerate_faces, "degenerate faces (no weight)"},
-      {report.duplicate_faces, "duplicate faces"},
-      {report.nonmanifold_edges, "non-manifold edges"},
-      {report.nonmanifold_vertices, "non-manifold (bow-tie) vertices"},
-      {report.unreferenced_vertices, "unreferenced vertices (NaN results)"}};
+      {degenerate, "degenerate faces (no weight)"},
+      {counts.duplicate_polygons, "duplicate faces"},
+      {counts.nonmanifold_edges, "non-manifold edges"},
+      {counts.nonmanifold_vertices, "non-manifold (bow-tie) vertices"},
+      {counts.unreferenced_vertices, "unreferenced vertices (NaN results)"}};
   for (const auto& [count, what] : defects) {
     if (count > 0) warn(tool_name, std::to_string(count) + " " + what);
   }

@@ -41,6 +41,9 @@ struct MeshReport {
   std::string toText() const;
 };
 
+/** Faces all of whose triangles have zero area by the relative guard (mesh_geometry.h). */
+std::int64_t countZeroAreaFaces(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+
 /** Counts every defect of the mesh; positions may hold non-finite vertices (they are counted). */
 MeshReport makeMeshReport(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
 
