@@ -131,6 +131,17 @@ TEST_F(HostileFiles, PlyValuesOutsideTheirTypeAreRefusedWithTheLine) {
                 "out of range for a vertex index");
 }
 
+// Fuzzer finding (fuzz_ply, heap-buffer-overflow): a second vertex element appended its fields
+// to the first one's, and the range grid then wrote NaNs past each point.
+TEST_F(HostileFiles, PlyWithTwoVertexElementsIsRefused) {
+  expectRefused("twovertex.ply",
+                "ply\nformat ascii 1.0\nobj_info num_cols 2\nobj_info num_rows 1\n"
+                "element vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+                "element vertex 1\nproperty double w\nelement range_grid 2\n"
+                "property list uchar int vertex_indices\nend_header\n0 0 0\n5\n1 0\n0\n",
+                "second vertex element");
+}
+
 TEST_F(HostileFiles, PlyRangeGridSizesThatOverflow) {
   expectRefused("grid.ply",
                 "ply\nformat ascii 1.0\nobj_info num_cols 4611686018427387904\n"

@@ -372,6 +372,7 @@ pcl::PolygonMesh parsePLY(std::string_view data) {
                   " rows, more than the file holds (truncated?)");
     }
     if (element.name == "vertex") {
+      if (has_vertices) cursor.fail("PLY file has a second vertex element");
       readVertices(element, reader, cursor, mesh.cloud);
       has_vertices = true;
     } else if (element.name == "face") {
