@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "pcl_ddg/version.h"
 #include "test_data.h"
 #include "tool_runner.h"
 
@@ -100,6 +101,16 @@ TEST_F(ToolErrors, EveryToolGivesOneErrorLineForEveryBadFile) {
   }
   for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
     EXPECT_EQ(entry.path().filename().string().find(".tmp"), std::string::npos) << entry.path();
+  }
+}
+
+TEST_F(ToolErrors, EveryToolSaysItsVersion) {
+  for (const Tool& tool : kTools) {
+    for (const char* option : {"--version", "-version"}) {
+      const ToolRun run = runTool(tool.binary, option);
+      EXPECT_EQ(run.exit_code, 0) << tool.name;
+      EXPECT_EQ(run.out, std::string(tool.name) + " " + PCL_DDG_VERSION_STRING + "\n");
+    }
   }
 }
 

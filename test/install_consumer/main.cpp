@@ -1,6 +1,7 @@
 // A program outside the project that uses the installed package.
 #include <pcl_ddg/mesh/mesh_report.h>
 #include <pcl_ddg/mesh/mesh_topology.h>
+#include <pcl_ddg/version.h>
 
 #include <iostream>
 
@@ -11,6 +12,6 @@ int main() {
   points << 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1;
   const pcl_ddg::MeshTopology topology(4, triangles);
   const pcl_ddg::MeshReport report = pcl_ddg::makeMeshReport(topology, points);
-  std::cout << report.toJson() << "\n";
+  std::cout << "pcl_ddg " << PCL_DDG_VERSION_STRING << ": " << report.toJson() << "\n";
   return report.euler_characteristic == 2 ? 0 : 1;
 }

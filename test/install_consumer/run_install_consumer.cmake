@@ -1,5 +1,7 @@
-# Installs the build into a temporary prefix, then configures, builds and runs a consumer that
-# finds it with find_package(pcl_ddg REQUIRED).
+# The consumer matrix: find_package(pcl_ddg) from the build tree and from an install into a
+# temporary prefix, each by a consumer declared project(x CXX) and project(x C CXX); then the
+# installed pkg-config file, used by a plain compiler command line. Every consumer is built with the
+# build's compilers and sanitizer flags and run.
 file(REMOVE_RECURSE "${WORK_DIR}")
 set(prefix "${WORK_DIR}/prefix")
 macro(step)
@@ -9,9 +11,36 @@ macro(step)
   endif()
 endmacro()
 step(${CMAKE_COMMAND} --install "${BUILD_DIR}" --prefix "${prefix}")
-step(${CMAKE_COMMAND} -S "${CONSUMER_SOURCE}" -B "${WORK_DIR}/build" -DCMAKE_PREFIX_PATH=${prefix}
-     -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=${CONSUMER_C_COMPILER}
-     -DCMAKE_CXX_COMPILER=${CONSUMER_CXX_COMPILER} "-DCMAKE_CXX_FLAGS=${CONSUMER_FLAGS}"
-     "-DCMAKE_EXE_LINKER_FLAGS=${CONSUMER_FLAGS}")
-step(${CMAKE_COMMAND} --build "${WORK_DIR}/build")
-step("${WORK_DIR}/build/consumer")
+
+foreach(place build_tree install)
+  if(place STREQUAL "install")
+    set(search_path "${prefix}")
+  else()
+    set(search_path "${BUILD_DIR}")
+  endif()
+  foreach(languages "CXX" "C CXX")
+    string(REPLACE " " "_" tag "${place}_${languages}")
+    set(build "${WORK_DIR}/${tag}")
+    message(STATUS "consumer: ${place}, project(x ${languages})")
+    step(${CMAKE_COMMAND} -S "${CONSUMER_SOURCE}" -B "${build}" -DCMAKE_PREFIX_PATH=${search_path}
+         "-DCONSUMER_LANGUAGES=${languages}" -DCMAKE_BUILD_TYPE=Release
+         -DCMAKE_C_COMPILER=${CONSUMER_C_COMPILER} -DCMAKE_CXX_COMPILER=${CONSUMER_CXX_COMPILER}
+         "-DCMAKE_CXX_FLAGS=${CONSUMER_FLAGS}" "-DCMAKE_EXE_LINKER_FLAGS=${CONSUMER_FLAGS}")
+    step(${CMAKE_COMMAND} --build "${build}")
+    step("${build}/consumer")
+  endforeach()
+endforeach()
+
+# pkg-config from the install (relocatable: the prefix comes from where pcl_ddg.pc lies).
+find_program(PKG_CONFIG pkg-config REQUIRED)
+set(ENV{PKG_CONFIG_PATH} "${prefix}/lib/pkgconfig:$ENV{PKG_CONFIG_PATH}")
+execute_process(COMMAND ${PKG_CONFIG} --cflags --libs pcl_ddg OUTPUT_VARIABLE flags
+                RESULT_VARIABLE result OUTPUT_STRIP_TRAILING_WHITESPACE)
+if(NOT result EQUAL 0)
+  message(FATAL_ERROR "pkg-config --cflags --libs pcl_ddg failed")
+endif()
+separate_arguments(flags UNIX_COMMAND "${flags}")
+separate_arguments(sanitize UNIX_COMMAND "${CONSUMER_FLAGS}")
+step(${CONSUMER_CXX_COMPILER} -std=c++17 ${sanitize} "${CONSUMER_SOURCE}/main.cpp" ${flags}
+     -o "${WORK_DIR}/pkg_config_consumer")
+step("${WORK_DIR}/pkg_config_consumer")

@@ -12,6 +12,7 @@
 
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
+#include "pcl_ddg/version.h"
 
 namespace pcl_ddg {
 namespace tools {
@@ -61,6 +62,8 @@ ToolArguments::ToolArguments(int argc, char** argv, const std::set<std::string>&
     const std::string name = arg.substr(arg.find_first_not_of('-'));
     if (name == "h" || name == "help") {
       throw HelpRequested();
+    } else if (name == "version") {
+      throw VersionRequested();
     } else if (value_options.count(name)) {
       if (i + 1 >= argc) throw UsageError("option -" + name + " needs a value");
       values_[name] = argv[++i];
@@ -127,6 +130,9 @@ int runTool(const char* name, const char* description, const char* syntax,
     return body();
   } catch (const HelpRequested&) {
     std::cout << description << "\nSyntax is: " << name << " " << syntax << "\n";
+    return 0;
+  } catch (const VersionRequested&) {
+    std::cout << name << " " << PCL_DDG_VERSION_STRING << "\n";
     return 0;
   } catch (const UsageError& e) {
     printError(name, e.what());

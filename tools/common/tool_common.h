@@ -23,6 +23,9 @@ class UsageError : public std::runtime_error {
 /** -h or -help was given: print the description and syntax, exit 0. */
 class HelpRequested : public std::exception {};
 
+/** -version or --version was given: print the tool's name and pcl_ddg's version, exit 0. */
+class VersionRequested : public std::exception {};
+
 class ToolArguments {
  public:
   /** Options taking a value and switches are given without the dash: {"k", "method"}. */
