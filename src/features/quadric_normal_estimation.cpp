@@ -1,15 +1,12 @@
 #include "pcl_ddg/features/quadric_normal_estimation.h"
 
-#include <pcl/point_types.h>
+#include "pcl_ddg/point_types.h"
 
 #include "pcl_ddg/features/impl/quadric_normal_estimation.hpp"
 
-#define PCL_DDG_INSTANTIATE_FOR_OUTPUTS(T)                             \
-  PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, pcl::Normal)          \
-      PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, pcl::PointNormal) \
-          PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, pcl::PointXYZRGBNormal)
-
-PCL_DDG_INSTANTIATE_FOR_OUTPUTS(pcl::PointXYZ)
-PCL_DDG_INSTANTIATE_FOR_OUTPUTS(pcl::PointXYZRGB)
-PCL_DDG_INSTANTIATE_FOR_OUTPUTS(pcl::PointNormal)
-PCL_DDG_INSTANTIATE_FOR_OUTPUTS(pcl::PointXYZRGBNormal)
+// Every input type x every output type of pcl_ddg/point_types.h.
+#define PCL_DDG_INSTANTIATE_PAIR(r, types)                                 \
+  PCL_DDG_INSTANTIATE_QuadricNormalEstimation(BOOST_PP_SEQ_ELEM(0, types), \
+                                              BOOST_PP_SEQ_ELEM(1, types))
+BOOST_PP_SEQ_FOR_EACH_PRODUCT(PCL_DDG_INSTANTIATE_PAIR,
+                              (PCL_DDG_XYZ_POINT_TYPES)(PCL_DDG_NORMAL_POINT_TYPES))

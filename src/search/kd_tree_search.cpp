@@ -1,10 +1,9 @@
 #include "pcl_ddg/search/kd_tree_search.h"
 
-#include <pcl/point_types.h>
+#include "pcl_ddg/point_types.h"
 
 #include "pcl_ddg/search/impl/kd_tree_search.hpp"
 
-PCL_DDG_INSTANTIATE_KdTreeSearch(pcl::PointXYZ) PCL_DDG_INSTANTIATE_KdTreeSearch(pcl::PointXYZRGB)
-    PCL_DDG_INSTANTIATE_KdTreeSearch(pcl::PointXYZI)
-        PCL_DDG_INSTANTIATE_KdTreeSearch(pcl::PointNormal)
-            PCL_DDG_INSTANTIATE_KdTreeSearch(pcl::PointXYZRGBNormal)
+// Every input type of pcl_ddg/point_types.h.
+#define PCL_DDG_INSTANTIATE(r, data, T) PCL_DDG_INSTANTIATE_KdTreeSearch(T)
+BOOST_PP_SEQ_FOR_EACH(PCL_DDG_INSTANTIATE, _, PCL_DDG_XYZ_POINT_TYPES)

@@ -1,11 +1,9 @@
 #include "pcl_ddg/search/mesh_ring_search.h"
 
-#include <pcl/point_types.h>
+#include "pcl_ddg/point_types.h"
 
 #include "pcl_ddg/search/impl/mesh_ring_search.hpp"
 
-PCL_DDG_INSTANTIATE_MeshRingSearch(pcl::PointXYZ)
-    PCL_DDG_INSTANTIATE_MeshRingSearch(pcl::PointXYZRGB)
-        PCL_DDG_INSTANTIATE_MeshRingSearch(pcl::PointXYZI)
-            PCL_DDG_INSTANTIATE_MeshRingSearch(pcl::PointNormal)
-                PCL_DDG_INSTANTIATE_MeshRingSearch(pcl::PointXYZRGBNormal)
+// Every input type of pcl_ddg/point_types.h.
+#define PCL_DDG_INSTANTIATE(r, data, T) PCL_DDG_INSTANTIATE_MeshRingSearch(T)
+BOOST_PP_SEQ_FOR_EACH(PCL_DDG_INSTANTIATE, _, PCL_DDG_XYZ_POINT_TYPES)
