@@ -289,8 +289,9 @@ TEST_F(MeshTools, RenderMakesAPicture) {
             1);
   // A full disk (here a 16 KiB file-size limit, SIGXFSZ ignored; the OpenMP runtime needs a few
   // KiB for itself) is an error, not an empty PNG.
-  const ToolRun full = runTool(std::string("trap '' XFSZ; ulimit -f 16; ") + PCL_DDG_RENDER_TOOL,
-                               sharedData("meshes/cow.off") + " " + path("full.png") + " -size 1024");
+  const ToolRun full =
+      runTool(std::string("trap '' XFSZ; ulimit -f 16; ") + PCL_DDG_RENDER_TOOL,
+              sharedData("meshes/cow.off") + " " + path("full.png") + " -size 1024");
   EXPECT_EQ(full.exit_code, 1) << full.err;
   EXPECT_NE(full.err.find("pcl_ddg_render: error: cannot write"), std::string::npos) << full.err;
   EXPECT_FALSE(std::filesystem::exists(path("full.png")));

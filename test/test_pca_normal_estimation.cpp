@@ -12,6 +12,7 @@
 #include "analytic_surfaces.h"
 #include "estimator_support.h"
 #include "pcl_ddg/features/pca_normal_estimation.h"
+#include "pcl_ddg/search/kd_tree_search.h"
 #include "pcl_ddg/search/mesh_ring_search.h"
 #include "test_data.h"
 
@@ -265,6 +266,28 @@ TEST(PCANormals, KLargerThanAComponentUsesWhatThereIsAndFailsBelowThreePoints) {
   EXPECT_EQ(estimator.getFailedPoints(), 1) << "only the isolated vertex";
   for (int v = n; v < n + 3; ++v) EXPECT_NEAR(std::abs(normals[v].normal_z), 1.0, 1e-6);
   EXPECT_TRUE(std::isnan(normals[n + 3].normal_x));
+}
+
+TEST(PCANormals, RadiusWithMaxNeighboursIsTheNearestWithinTheRadius) {
+  // Open3D's hybrid search: with a radius covering the whole cloud, at most max_nn neighbours
+  // are the max_nn nearest, so the result is the k = max_nn result, bit for bit; with a radius
+  // smaller than the k-th distance, fewer neighbours are used.
+  SurfaceSample torus = makeTorus({32, 0.2, 5});
+  const Cloud::Ptr cloud = toCloud(torus.points);
+  const auto radiusEstimate = [&](double radius, unsigned int max_nn) {
+    PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+    estimator.setInputCloud(cloud);
+    estimator.setSearchMethod(std::make_shared<KdTreeSearch<pcl::PointXYZ>>());
+    estimator.setRadiusSearch(radius);
+    estimator.setRadiusSearchMaxNeighbours(max_nn);
+    Normals normals;
+    estimator.compute(normals);
+    return normalsOf(normals);
+  };
+  const Eigen::Matrix3Xd by_k =
+      normalsOf(ourNormals(cloud, std::make_shared<KdTreeSearch<pcl::PointXYZ>>(), 16));
+  EXPECT_EQ(radiusEstimate(100.0, 16), by_k);
+  EXPECT_NE(radiusEstimate(100.0, 0), by_k);  // uncapped: every point of the cloud
 }
 
 TEST(PCANormals, EmptyInputFailsThroughPCLsContract) {

@@ -104,6 +104,52 @@ TEST_F(ToolErrors, EveryToolGivesOneErrorLineForEveryBadFile) {
   }
 }
 
+TEST_F(ToolErrors, BadOptionsFailBeforeAnyFileIsRead) {
+  // The input does not exist: a usage error (exit 2) rather than "no such file" (exit 1) proves
+  // that the option was checked before the input was opened.
+  struct Case {
+    const char* binary;
+    const char* input;
+    const char* options;
+  };
+  const Case cases[] = {
+      {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method pca -k abc"},
+      {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method pca -k 2"},
+      {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method pca -k 16 -radius 0.1"},
+      {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method pca -max_nn 8"},
+      {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method pca -radius 2.5x"},
+      {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method pca -radius 1 -max_nn 0"},
+      {PCL_DDG_NORMALS_TOOL, "missing.ply", "-neighbours tree"},
+      {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method mean_curvature -epsilon -1"},
+      {PCL_DDG_CURVATURE_TOOL, "missing.ply", "-smooth -1"},
+      {PCL_DDG_CURVATURE_TOOL, "missing.ply", "-smooth abc"},
+      {PCL_DDG_CURVATURE_TOOL, "missing.ply", "-method quadric -k abc"},
+      {PCL_DDG_CURVATURE_TOOL, "missing.ply", "-area heron"},
+      {PCL_DDG_COMPARE_TOOL, "missing.ply", "-k 16 -radius 1"},
+      {PCL_DDG_SMOOTH_TOOL, "missing.ply", "-lambda_dt abc"},
+      {PCL_DDG_SMOOTH_TOOL, "missing.ply", "-freeze_weights -rebuild_weights"},
+      {PCL_DDG_SMOOTH_ORGANIZED_TOOL, "missing.pcd", "-method explicit -lambda_dt 1"},
+      {PCL_DDG_SMOOTH_ORGANIZED_TOOL, "missing.pcd", "-iterations 0"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::string(c.binary) + " " + c.options);
+    const ToolRun run = runTool(c.binary, path(c.input) + " " + path("out.ply") + " " + c.options);
+    EXPECT_EQ(run.exit_code, 2) << run.err;
+    EXPECT_NE(run.err.find(": error: "), std::string::npos) << run.err;
+    EXPECT_EQ(run.err.find("No such file"), std::string::npos) << run.err;
+  }
+}
+
+TEST_F(ToolErrors, KLargerThanTheCloudIsRefused) {
+  writeText(path("three.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+  const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL,
+                              path("three.obj") + " " + path("out.ply") + " -method pca -k 5");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("-k 5 is more than the 3 points of the input"), std::string::npos)
+      << run.err;
+  EXPECT_FALSE(std::filesystem::exists(path("out.ply")));
+}
+
 TEST_F(ToolErrors, EveryToolSaysItsVersion) {
   for (const Tool& tool : kTools) {
     for (const char* option : {"--version", "-version"}) {

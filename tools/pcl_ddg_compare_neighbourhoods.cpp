@@ -19,11 +19,12 @@ constexpr const char* kDescription =
     "angle_difference (degrees) and overlap (Jaccard, 0..1), coloured by the angle difference.";
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk} output.{ply,pcd} [-method pca|quadric] [-k N (default 16)]\n"
-    "         [-radius r or 2.5h (instead of -k)] [-precision float|double]";
+    "         [-radius r or 2.5h (instead of -k)] [-max_nn N (with -radius; default 64)]\n"
+    "         [-precision float|double]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
-  const tools::ToolArguments args(argc, argv, {"method", "k", "radius", "precision"}, {});
+  const tools::ToolArguments args(argc, argv, {"method", "k", "radius", "max_nn", "precision"}, {});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
   const std::string method = args.choice("method", {"pca", "quadric"}, "pca");
@@ -32,6 +33,7 @@ int run(int argc, char** argv) {
   if (fileExtension(output) != "ply" && fileExtension(output) != "pcd") {
     throw tools::UsageError("the output must be .ply or .pcd");
   }
+  tools::checkLocalFitArguments(args);
   tools::SurfaceInput in = tools::loadSurfaceInput(args.positional()[0], kName);
   if (!in.topology)
     throw std::runtime_error(args.positional()[0] +

@@ -25,17 +25,17 @@ constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk,pcd} output.{ply,pcd} [-method cotan|quadric (default: cotan on "
     "meshes)]\n"
     "         [-area mixed|voronoi|barycentric (cotan)]\n"
-    "         [-neighbours bfs|knn] [-k N (default 20)] [-radius r or 2.5h] (quadric)\n"
+    "         [-neighbours bfs|knn] [-k N (default 20)] [-radius r or 2.5h] [-max_nn N] (quadric)\n"
     "         [-smooth t (heat flow time in h^2, meshes)]\n"
     "         [-color mean|gauss|k1|k2] [-percentile p (colour scale clamp, default 2)]\n"
     "         [-precision float|double]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
-  const tools::ToolArguments args(
-      argc, argv,
-      {"method", "area", "neighbours", "k", "radius", "smooth", "color", "percentile", "precision"},
-      {});
+  const tools::ToolArguments args(argc, argv,
+                                  {"method", "area", "neighbours", "k", "radius", "max_nn",
+                                   "smooth", "color", "percentile", "precision"},
+                                  {});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
   const std::string color = args.choice("color", {"none", "mean", "gauss", "k1", "k2"}, "none");
@@ -55,6 +55,9 @@ int run(int argc, char** argv) {
     throw tools::UsageError("-neighbours, -k and -radius apply to -method quadric");
   }
   const MassType mass = tools::massTypeArgument(args, "area");  // validated before loading
+  tools::checkLocalFitArguments(args);
+  const double smooth_time = args.number("smooth", 1.0);
+  if (!(smooth_time > 0.0)) throw tools::UsageError("-smooth must be > 0");
 
   tools::SurfaceInput in = tools::loadSurfaceInput(args.positional()[0], kName);
   const std::string method = !requested.empty() ? requested : (in.topology ? "cotan" : "quadric");
@@ -110,8 +113,6 @@ int run(int argc, char** argv) {
     tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
   }
   if (args.has("smooth")) {
-    const double time = args.number("smooth", 0.0);
-    if (!(time > 0.0)) throw tools::UsageError("-smooth must be > 0");
     if (!in.topology) throw tools::UsageError("-smooth needs a mesh; this input is a point cloud");
     const double h = meanEdgeLength(*in.topology, in.positions);
     if (!(h > 0.0)) {
@@ -120,7 +121,7 @@ int run(int argc, char** argv) {
           "time in");
     }
     HeatFlowParameters heat;
-    heat.diffusion_time = time * h * h;
+    heat.diffusion_time = smooth_time * h * h;
     Eigen::MatrixXd curvatures(mean.size(), 4);
     curvatures << mean, gauss, kappa1, kappa2;
     tools::Timer timer("Smoothing curvatures");

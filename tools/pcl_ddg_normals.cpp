@@ -23,6 +23,7 @@ constexpr const char* kSyntax =
     "         [-neighbours bfs|knn (pca, quadric; bfs needs a mesh)] [-k N (default 16, quadric "
     "20)]\n"
     "         [-radius r (a length, or a multiple of the mean spacing like 2.5h; instead of -k)]\n"
+    "         [-max_nn N (with -radius: at most the N nearest; default 64)]\n"
     "         [-precision float|double]";
 
 pcl_ddg::NormalWeighting weightingOf(const std::string& method) {
@@ -36,7 +37,7 @@ pcl_ddg::NormalWeighting weightingOf(const std::string& method) {
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(
-      argc, argv, {"method", "epsilon", "neighbours", "k", "radius", "precision"}, {});
+      argc, argv, {"method", "epsilon", "neighbours", "k", "radius", "max_nn", "precision"}, {});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
   const FieldPrecision precision = tools::precisionArgument(args);
@@ -55,6 +56,9 @@ int run(int argc, char** argv) {
   if (args.has("epsilon") && requested != "mean_curvature") {
     throw tools::UsageError("-epsilon applies to -method mean_curvature only");
   }
+  if (args.has("epsilon") && !(args.number("epsilon", 0.0) >= 0.0))
+    throw tools::UsageError("-epsilon must be >= 0");
+  tools::checkLocalFitArguments(args);
 
   tools::SurfaceInput in = tools::loadSurfaceInput(args.positional()[0], kName);
   const std::string method =

@@ -22,6 +22,7 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
   }
   if (options.radius > 0.0) {
     estimator.setRadiusSearch(options.radius);
+    estimator.setRadiusSearchMaxNeighbours(options.max_neighbours);
   } else {
     estimator.setKSearch(options.k);
   }

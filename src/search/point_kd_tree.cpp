@@ -103,9 +103,24 @@ int PointKdTree::withinRadius(const float* query, double radius, pcl::Indices& i
   indices.clear();
   squared_distances.clear();
   if (!index_ || !(radius >= 0.0)) return 0;
-  WithinRadius result(static_cast<float>(radius * radius), indices, squared_distances);
+  const float squared_radius = static_cast<float>(radius * radius);
+  if (max_nn > 0) {
+    // Hybrid search (Open3D's): the max_nn nearest, cut at the radius. Its cost is that of a
+    // k-nearest query, however many points the ball holds (dense or duplicated scans).
+    nearestK(query, static_cast<int>(max_nn), indices, squared_distances);
+    std::size_t keep = 0;
+    for (std::size_t i = 0; i < indices.size(); ++i) {
+      if (squared_distances[i] > squared_radius) continue;
+      indices[keep] = indices[i];
+      squared_distances[keep++] = squared_distances[i];
+    }
+    indices.resize(keep);
+    squared_distances.resize(keep);
+    return static_cast<int>(keep);
+  }
+  WithinRadius result(squared_radius, indices, squared_distances);
   index_->tree.findNeighbors(result, query, flann::SearchParams(-1, 0.0f));
-  if (sorted || (max_nn > 0 && indices.size() > max_nn)) {
+  if (sorted) {
     // Sort (distance, index) pairs through a permutation.
     std::vector<std::size_t> order(indices.size());
     std::iota(order.begin(), order.end(), 0);
@@ -113,11 +128,9 @@ int PointKdTree::withinRadius(const float* query, double radius, pcl::Indices& i
       return squared_distances[a] < squared_distances[b] ||
              (squared_distances[a] == squared_distances[b] && indices[a] < indices[b]);
     });
-    const std::size_t keep =
-        max_nn > 0 ? std::min<std::size_t>(max_nn, order.size()) : order.size();
-    pcl::Indices sorted_indices(keep);
-    std::vector<float> sorted_distances(keep);
-    for (std::size_t i = 0; i < keep; ++i) {
+    pcl::Indices sorted_indices(order.size());
+    std::vector<float> sorted_distances(order.size());
+    for (std::size_t i = 0; i < order.size(); ++i) {
       sorted_indices[i] = indices[order[i]];
       sorted_distances[i] = squared_distances[order[i]];
     }

@@ -82,8 +82,48 @@ SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name) {
   return input;
 }
 
+namespace {
+
+constexpr int kDefaultMaxNeighbours = 64;
+
+// -radius as written: a length, or a multiple of the input's spacing like "2.5h".
+struct RadiusArgument {
+  double value = 0.0;
+  bool in_spacings = false;
+};
+
+RadiusArgument radiusArgument(const ToolArguments& args) {
+  RadiusArgument radius;
+  if (!args.has("radius")) return radius;
+  std::string text = *args.value("radius");
+  if (!text.empty() && text.back() == 'h') {
+    text.pop_back();
+    radius.in_spacings = true;
+  }
+  char* end = nullptr;
+  radius.value = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !(radius.value > 0.0) || !std::isfinite(radius.value)) {
+    throw UsageError("-radius must be a positive length or a multiple of the spacing like 2.5h");
+  }
+  return radius;
+}
+
+}  // namespace
+
+void checkLocalFitArguments(const ToolArguments& args) {
+  if (args.has("k") && args.has("radius"))
+    throw UsageError("-k and -radius exclude each other (use -radius r -max_nn N for both)");
+  if (args.has("max_nn") && !args.has("radius")) throw UsageError("-max_nn needs -radius");
+  if (args.integer("k", 16) < 3) throw UsageError("-k must be at least 3");
+  if (args.integer("max_nn", kDefaultMaxNeighbours) < 3)
+    throw UsageError("-max_nn must be at least 3");
+  radiusArgument(args);
+  args.choice("neighbours", {"bfs", "knn"}, "knn");
+}
+
 LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput& input,
                                   LocalFitMethod method) {
+  checkLocalFitArguments(args);
   LocalFitOptions options;
   options.method = method;
   const std::string neighbours =
@@ -94,20 +134,16 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
   options.neighbourhood =
       neighbours == "bfs" ? NeighbourhoodKind::MeshRings : NeighbourhoodKind::KdTree;
   options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20 : 16);
-  if (options.k < 3) throw UsageError("-k must be at least 3");
-  if (args.has("radius")) {
-    std::string text = *args.value("radius");
-    double unit = 1.0;
-    if (!text.empty() && text.back() == 'h') {
-      text.pop_back();
-      unit = input.spacing;
-    }
-    char* end = nullptr;
-    const double value = std::strtod(text.c_str(), &end);
-    if (text.empty() || *end != '\0' || !(value > 0.0) || !std::isfinite(value)) {
-      throw UsageError("-radius must be a positive length or a multiple of the spacing like 2.5h");
-    }
-    options.radius = value * unit;
+  const auto points = static_cast<int>(input.positions.cols());
+  if (!args.has("radius") && options.k > points) {
+    throw std::runtime_error("-k " + std::to_string(options.k) + " is more than the " +
+                             std::to_string(points) + " points of the input");
+  }
+  const RadiusArgument radius = radiusArgument(args);
+  if (radius.value > 0.0) {
+    options.radius = radius.value * (radius.in_spacings ? input.spacing : 1.0);
+    options.max_neighbours =
+        static_cast<unsigned int>(args.integer("max_nn", kDefaultMaxNeighbours));
   }
   return options;
 }

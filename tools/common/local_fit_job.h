@@ -33,8 +33,13 @@ struct SurfaceInput {
  *  non-finite points for clouds. */
 SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name);
 
-/** -neighbours bfs|knn (bfs is the default on meshes and impossible on clouds), -k N, and
- *  -radius r, where r is a length or a multiple of the input's spacing written like 2.5h. */
+/** The syntax of -neighbours, -k, -radius and -max_nn, checked before any file is read
+ *  (UsageError): -k and -radius exclude each other, -max_nn needs -radius. */
+void checkLocalFitArguments(const ToolArguments& args);
+
+/** -neighbours bfs|knn (bfs is the default on meshes and impossible on clouds), -k N (at most the
+ *  input's point count), and -radius r, where r is a length or a multiple of the input's spacing
+ *  written like 2.5h, with at most -max_nn N neighbours (default 64, Open3D's hybrid search). */
 LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput& input,
                                   LocalFitMethod method);
 

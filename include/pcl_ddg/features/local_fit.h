@@ -22,9 +22,10 @@ enum class NeighbourhoodKind {
 struct LocalFitOptions {
   LocalFitMethod method = LocalFitMethod::PCA;
   NeighbourhoodKind neighbourhood = NeighbourhoodKind::KdTree;
-  int k = 16;                ///< neighbours, when radius is 0
-  double radius = 0.0;       ///< > 0: a radius search instead of k nearest
-  unsigned int threads = 0;  ///< 0: all cores
+  int k = 16;                       ///< neighbours, when radius is 0
+  double radius = 0.0;              ///< > 0: a radius search instead of k nearest
+  unsigned int max_neighbours = 0;  ///< with radius: keep at most this many, the nearest (0: all)
+  unsigned int threads = 0;         ///< 0: all cores
 };
 
 struct LocalFitResult {

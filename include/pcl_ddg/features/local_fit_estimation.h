@@ -46,6 +46,14 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   /** The orientation used by the last compute(). */
   NormalOrientation getOrientation() const { return used_orientation_; }
 
+  /** With setRadiusSearch: at most this many neighbours, the nearest (Open3D's hybrid search);
+   *  0 (the default, PCL's semantics) takes every point in the radius, which on dense or
+   *  duplicated scans can be thousands per query. */
+  void setRadiusSearchMaxNeighbours(unsigned int max_neighbours) {
+    max_neighbours_ = max_neighbours;
+  }
+  unsigned int getRadiusSearchMaxNeighbours() const { return max_neighbours_; }
+
   /** Threads for compute(); 0 = as many as the machine has. */
   void setNumberOfThreads(unsigned int threads) { threads_ = threads; }
 
@@ -70,6 +78,7 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   /** Sets every field of a point that cannot be estimated to NaN. */
   virtual void setInvalid(PointOutT& point) const = 0;
 
+  unsigned int max_neighbours_ = 0;
   std::int64_t fallback_points_ = 0;  ///< counted by fitEachNeighbourhood (FitOutcome::FellBack)
 
  private:

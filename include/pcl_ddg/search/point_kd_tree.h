@@ -31,7 +31,8 @@ class PointKdTree {
                std::vector<float>& squared_distances) const;
 
   /** All points within radius (squared distances below radius^2), sorted by distance if sorted;
-   *  max_nn > 0 keeps that many (the nearest ones when sorted). */
+   *  max_nn > 0 gives the max_nn nearest within the radius, sorted (a k-nearest query cut at the
+   *  radius, so its cost does not grow with the points in the ball). */
   int withinRadius(const float* query, double radius, pcl::Indices& indices,
                    std::vector<float>& squared_distances, unsigned int max_nn, bool sorted) const;
 

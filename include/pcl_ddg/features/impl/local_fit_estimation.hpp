@@ -72,8 +72,15 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(indices.size()); ++i) {
       const PointInT& query = (*this->input_)[indices[i]];
       FitOutcome outcome = FitOutcome::Failed;
-      if (pcl::isXYZFinite(query) && this->searchForNeighbors(indices[i], this->search_parameter_,
-                                                              neighbours, squared_distances) > 0) {
+      const bool capped_radius = this->search_radius_ > 0.0 && max_neighbours_ > 0;
+      const int found =
+          !pcl::isXYZFinite(query) ? 0
+          : capped_radius
+              ? this->tree_->radiusSearch(*this->input_, indices[i], this->search_radius_,
+                                          neighbours, squared_distances, max_neighbours_)
+              : this->searchForNeighbors(indices[i], this->search_parameter_, neighbours,
+                                         squared_distances);
+      if (found > 0) {
         const Eigen::Vector3d origin = query.getVector3fMap().template cast<double>();
         if (local.cols() < static_cast<Eigen::Index>(neighbours.size()))
           local.resize(3, neighbours.size());
