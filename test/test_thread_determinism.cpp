@@ -56,12 +56,18 @@ void expectSameWithAnyThreadCount(const char* what, const std::function<Bytes()>
   omp_set_num_threads(saved);
 }
 
-TEST(ThreadDeterminism, MeshOperatorsNormalsCurvaturesAndSmoothing) {
+// An irregular surface far from the origin: rounding differs from point to point.
+SurfaceSample jitteredTorusFarAway() {
   Sampling sampling;
   sampling.resolution = 48;
   sampling.jitter = 0.2;
   SurfaceSample torus = makeTorus(sampling);
   torus.rotateAndShiftFar();
+  return torus;
+}
+
+TEST(ThreadDeterminism, MeshOperatorsNormalsCurvaturesAndSmoothing) {
+  const SurfaceSample torus = jitteredTorusFarAway();
   const MeshTopology topology = topologyOf(torus);
   const Eigen::Matrix3Xd& x = torus.points;
 
@@ -96,11 +102,7 @@ TEST(ThreadDeterminism, MeshOperatorsNormalsCurvaturesAndSmoothing) {
 }
 
 TEST(ThreadDeterminism, FittedNormalsAndCurvaturesWithBothNeighbourhoods) {
-  Sampling sampling;
-  sampling.resolution = 48;
-  sampling.jitter = 0.2;
-  SurfaceSample torus = makeTorus(sampling);
-  torus.rotateAndShiftFar();
+  const SurfaceSample torus = jitteredTorusFarAway();
   const auto cloud = toCloud(torus.points);
   const auto topology = topologyPtrOf(torus);
   for (const LocalFitMethod method : {LocalFitMethod::PCA, LocalFitMethod::Quadric}) {
