@@ -304,6 +304,34 @@ TEST_F(HostileFiles, PcdReaderAgreesWithPclOnWellFormedFiles) {
   }
 }
 
+TEST_F(HostileFiles, PcdViewpointIsKeptFromInputToOutput) {
+  SensorPose pose;
+  const pcl::PolygonMesh office = loadMesh(sharedData("clouds/office1.pcd"), &pose);
+  EXPECT_EQ(pose.origin, Eigen::Vector3d::Zero());
+  EXPECT_EQ(pose.orientation.coeffs(),
+            Eigen::Vector4d(1, 0, 0, 0));  // x y z w: "0 1 0 0" in w x y z
+  pose.origin = Eigen::Vector3d(512600.25, 5403580.5, 1000.125);
+  MeshWriteOptions options;
+  options.sensor_pose = pose;
+  const std::string path = dir_ + "/office.pcd";
+  saveMesh(path, office, options);
+  SensorPose back;
+  loadMesh(path, &back);
+  EXPECT_EQ(back.origin, pose.origin);
+  EXPECT_EQ(back.orientation.coeffs(), pose.orientation.coeffs());
+  pcl::PCLPointCloud2 by_pcl;
+  Eigen::Vector4f origin;
+  Eigen::Quaternionf orientation;
+  int version = 0;
+  ASSERT_EQ(pcl::PCDReader().read(path, by_pcl, origin, orientation, version), 0);
+  EXPECT_EQ(origin.head<3>(), pose.origin.cast<float>());
+  EXPECT_EQ(orientation.coeffs(), pose.orientation.coeffs().cast<float>());
+  expectRefused("viewpoint.pcd",
+                replaced(kPcdHeader, "VIEWPOINT 0 0 0 1 0 0 0", "VIEWPOINT 0 0 0 0 0 0 0") +
+                    "DATA ascii\n0 0 0\n1 1 1\n",
+                "VIEWPOINT needs");
+}
+
 // What we write, PCL's reader reads back to the same values (and so do we).
 TEST_F(HostileFiles, PcdWriterOutputIsReadByPcl) {
   for (const char* name : {"bun0.pcd", "office1.pcd", "terrain_CSite1_red2-utm.pcd"}) {

@@ -278,6 +278,39 @@ TEST_F(MeshTools, CompareNeighbourhoodsShowsAThinTwoSheetSurface) {
   EXPECT_FALSE(std::filesystem::exists(path("c.ply")));
 }
 
+TEST_F(MeshTools, CloudNormalsFaceTheViewpointGivenOrInTheFile) {
+  // Aerial LiDAR in UTM coordinates, its VIEWPOINT at the origin (far below and to the side):
+  // towards it, a large share of the ground's normals point down; towards a point above the
+  // scan, all but the steepest point up. The viewpoint given is written to the output.
+  const std::string terrain = sharedData("clouds/terrain_CSite1_red2-utm.pcd");
+  const auto upShare = [&](const std::string& out) {
+    const Eigen::Matrix3Xd n = [&] {
+      const pcl::PolygonMesh m = loadMesh(out);
+      Eigen::Matrix3Xd values(3, m.cloud.width * m.cloud.height);
+      values.row(0) = vertexScalarField(m.cloud, "normal_x").transpose();
+      values.row(1) = vertexScalarField(m.cloud, "normal_y").transpose();
+      values.row(2) = vertexScalarField(m.cloud, "normal_z").transpose();
+      return values;
+    }();
+    return (n.row(2).array() > 0.0).cast<double>().mean();
+  };
+  ASSERT_EQ(runTool(PCL_DDG_NORMALS_TOOL, terrain + " " + path("origin.pcd")).exit_code, 0);
+  const ToolRun above = runTool(
+      PCL_DDG_NORMALS_TOOL, terrain + " " + path("above.pcd") + " -viewpoint 512600,5403580,10000");
+  ASSERT_EQ(above.exit_code, 0) << above.err;
+  const double towards_origin = upShare(path("origin.pcd")),
+               towards_above = upShare(path("above.pcd"));
+  std::printf(
+      "terrain normals pointing up: %.1f%% towards the file's VIEWPOINT, %.2f%% towards a "
+      "point above\n",
+      100 * towards_origin, 100 * towards_above);
+  EXPECT_GT(towards_above, 0.99);
+  EXPECT_LT(towards_origin, 0.9);
+  SensorPose pose;
+  loadMesh(path("above.pcd"), &pose);
+  EXPECT_EQ(pose.origin, Eigen::Vector3d::Zero()) << "the input's VIEWPOINT is kept in the output";
+}
+
 TEST_F(MeshTools, RenderMakesAPicture) {
   const ToolRun run = runTool(PCL_DDG_RENDER_TOOL,
                               sharedData("meshes/cow.off") + " " + path("cow.png") + " -size 64");

@@ -24,7 +24,8 @@ constexpr const char* kSyntax =
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
-  const tools::ToolArguments args(argc, argv, {"method", "k", "radius", "max_nn", "precision"}, {});
+  const tools::ToolArguments args(
+      argc, argv, {"method", "k", "radius", "max_nn", "viewpoint", "precision"}, {});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
   const std::string method = args.choice("method", {"pca", "quadric"}, "pca");
@@ -64,7 +65,7 @@ int run(int argc, char** argv) {
   // Coloured from the smallest difference to 30 degrees (larger ones saturate).
   Eigen::VectorXd clamped = c.angle_difference.cwiseMin(30.0);
   setVertexColors(in.mesh.cloud, colorize(clamped, ColorMap::Sequential, {0.0, 100.0}));
-  tools::saveResult(output, in.mesh);
+  tools::saveResult(output, in.mesh, in.sensor_pose);
   return 0;
 }
 

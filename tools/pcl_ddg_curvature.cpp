@@ -25,7 +25,8 @@ constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk,pcd} output.{ply,pcd} [-method cotan|quadric (default: cotan on "
     "meshes)]\n"
     "         [-area mixed|voronoi|barycentric (cotan)]\n"
-    "         [-neighbours bfs|knn] [-k N (default 20)] [-radius r or 2.5h] [-max_nn N] (quadric)\n"
+    "         [-neighbours bfs|knn] [-k N (default 20)] [-radius r or 2.5h] [-max_nn N]\n"
+    "         [-viewpoint x,y,z] (quadric)\n"
     "         [-smooth t (heat flow time in h^2, meshes)]\n"
     "         [-color mean|gauss|k1|k2] [-percentile p (colour scale clamp, default 2)]\n"
     "         [-precision float|double]";
@@ -143,7 +144,7 @@ int run(int argc, char** argv) {
     setVertexColors(in.mesh.cloud,
                     colorize(values, ColorMap::Diverging, {percentile, 100.0 - percentile}));
   }
-  tools::saveResult(output, in.mesh);
+  tools::saveResult(output, in.mesh, in.sensor_pose);
   return 0;
 }
 

@@ -24,6 +24,7 @@ constexpr const char* kSyntax =
     "20)]\n"
     "         [-radius r (a length, or a multiple of the mean spacing like 2.5h; instead of -k)]\n"
     "         [-max_nn N (with -radius: at most the N nearest; default 64)]\n"
+    "         [-viewpoint x,y,z (clouds: orient normals towards it; default the PCD's VIEWPOINT)]\n"
     "         [-precision float|double]";
 
 pcl_ddg::NormalWeighting weightingOf(const std::string& method) {
@@ -37,7 +38,8 @@ pcl_ddg::NormalWeighting weightingOf(const std::string& method) {
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(
-      argc, argv, {"method", "epsilon", "neighbours", "k", "radius", "max_nn", "precision"}, {});
+      argc, argv,
+      {"method", "epsilon", "neighbours", "k", "radius", "max_nn", "viewpoint", "precision"}, {});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
   const FieldPrecision precision = tools::precisionArgument(args);
@@ -109,7 +111,7 @@ int run(int argc, char** argv) {
     tools::warnAboutLocalFit(kName, result);
     tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
   }
-  tools::saveResult(output, in.mesh);
+  tools::saveResult(output, in.mesh, in.sensor_pose);
   return 0;
 }
 

@@ -1,6 +1,6 @@
 // pcl_ddg_smooth_organized: heat-equation smoothing of an organized cloud (a depth image) on its
 // pixel grid, moving every point along its viewing ray; holes and depth jumps are respected.
-#include <pcl/io/pcd_io.h>
+#include <pcl/exceptions.h>
 
 #include <cmath>
 #include <iostream>
@@ -56,26 +56,21 @@ int run(int argc, char** argv) {
   }
 
   tools::Timer load_timer("Loading " + input);
-  pcl::PolygonMesh cloud = loadMesh(input);  // checks the file before PCL parses it
+  SensorPose sensor;
+  pcl::PolygonMesh cloud = loadMesh(input, &sensor);
   const std::size_t points = static_cast<std::size_t>(cloud.cloud.width) * cloud.cloud.height;
   load_timer.done(points);
   if (cloud.cloud.height < 2) {
     throw std::runtime_error(input + " is not organized (height " +
                              std::to_string(cloud.cloud.height) + ")");
   }
-  pcl::PCLPointCloud2 header;
-  Eigen::Vector4f origin;
-  Eigen::Quaternionf orientation;
-  int version = 0, type = 0;
-  unsigned int offset = 0;
-  pcl::PCDReader().readHeader(input, header, origin, orientation, version, type, offset);
 
   const Eigen::Matrix3Xd positions = vertexPositions(cloud.cloud, NonFinitePolicy::Keep);
   tools::Timer timer("Smoothing");
   GridSmoothingReport report;
-  const Eigen::Matrix3Xd smoothed = smoothOrganizedPositions(
-      positions, static_cast<int>(cloud.cloud.width), static_cast<int>(cloud.cloud.height),
-      origin.head<3>().cast<double>(), p, &report);
+  const Eigen::Matrix3Xd smoothed =
+      smoothOrganizedPositions(positions, static_cast<int>(cloud.cloud.width),
+                               static_cast<int>(cloud.cloud.height), sensor.origin, p, &report);
   timer.done(points);
   std::cerr << kName << ": " << report.valid_pixels << " pixels, " << report.holes << " holes, "
             << report.cut_pairs << " neighbour pairs cut at depth jumps\n";
@@ -86,7 +81,7 @@ int run(int argc, char** argv) {
                            " points at the sensor origin kept in place (no ray to move along)");
   }
   setVertexPositions(cloud.cloud, smoothed);
-  tools::saveResult(args.positional()[1], cloud);
+  tools::saveResult(args.positional()[1], cloud, sensor);
   return 0;
 }
 

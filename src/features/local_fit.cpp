@@ -26,7 +26,12 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
   } else {
     estimator.setKSearch(options.k);
   }
-  if (topology) estimator.setOrientationMesh(topology);
+  if (topology) {
+    estimator.setOrientationMesh(topology);
+  } else if (options.viewpoint) {
+    const Eigen::Vector3f v = options.viewpoint->cast<float>();
+    estimator.setViewPoint(v.x(), v.y(), v.z());
+  }
   estimator.setNumberOfThreads(options.threads);
 }
 

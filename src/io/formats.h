@@ -25,12 +25,13 @@ pcl::PolygonMesh parseSTL(std::string_view data);
 /** Legacy VTK POLYDATA, ascii or binary, classic or 5.x (OFFSETS/CONNECTIVITY) cell layout;
  *  POLYGONS and TRIANGLE_STRIPS become faces, other cells and attributes are ignored. */
 pcl::PolygonMesh parseVTK(std::string_view data);
-/** PCD, ascii, binary or binary_compressed (padding fields "_" kept as in PCL's reader). */
-pcl::PolygonMesh parsePCD(std::string_view data);
+/** PCD, ascii, binary or binary_compressed (padding fields "_" kept as in PCL's reader); the
+ *  VIEWPOINT into sensor_pose when given. */
+pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose = nullptr);
 
 void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding);
 /** A cloud as a binary_compressed PCD file (padding fields left out). */
-std::string encodePCD(const pcl::PCLPointCloud2& cloud);
+std::string encodePCD(const pcl::PCLPointCloud2& cloud, const SensorPose& sensor_pose);
 
 /** A corner index from a file; anything outside 0..INT_MAX becomes -1, which MeshTopology reports
  *  as out of range. */

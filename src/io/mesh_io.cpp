@@ -14,8 +14,8 @@
 namespace pcl_ddg {
 namespace {
 
-void savePCD(const std::string& path, const pcl::PolygonMesh& mesh) {
-  writeBytes(path, detail::encodePCD(mesh.cloud));
+void savePCD(const std::string& path, const pcl::PolygonMesh& mesh, const SensorPose& pose) {
+  writeBytes(path, detail::encodePCD(mesh.cloud, pose));
 }
 
 void savePLY(const std::string& path, const pcl::PolygonMesh& mesh, PlyEncoding encoding) {
@@ -37,7 +37,7 @@ std::string fileExtension(const std::string& path) {
   return ext;
 }
 
-pcl::PolygonMesh loadMesh(const std::string& path) {
+pcl::PolygonMesh loadMesh(const std::string& path, SensorPose* sensor_pose) {
   const std::string ext = fileExtension(path);
   try {
     const std::string data = detail::readWholeFile(path);  // first: a missing file says so
@@ -48,13 +48,13 @@ pcl::PolygonMesh loadMesh(const std::string& path) {
     if (ext == "obj") parse = detail::parseOBJ;
     if (ext == "stl") parse = detail::parseSTL;
     if (ext == "vtk") parse = detail::parseVTK;
-    if (ext == "pcd") parse = detail::parsePCD;
-    if (parse == nullptr) {
+    if (parse == nullptr && ext != "pcd") {
       throw FileFormatException(
           (ext.empty() ? std::string("no file extension") : "unknown file type '." + ext + "'") +
           " (expected .ply, .obj, .off, .stl, .vtk or .pcd)");
     }
-    pcl::PolygonMesh mesh = parse(data);
+    if (sensor_pose) *sensor_pose = SensorPose();
+    pcl::PolygonMesh mesh = ext == "pcd" ? detail::parsePCD(data, sensor_pose) : parse(data);
     if (mesh.cloud.width * mesh.cloud.height == 0)
       throw FileFormatException("file has no vertices");
     return mesh;
@@ -74,7 +74,7 @@ void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh,
     if (ext == "ply") {
       savePLY(file.temporaryPath(), mesh, options.ply_encoding);
     } else {
-      savePCD(file.temporaryPath(), mesh);
+      savePCD(file.temporaryPath(), mesh, options.sensor_pose);
     }
     file.commit();
   } catch (const pcl::PCLException& e) {

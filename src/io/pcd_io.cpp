@@ -6,8 +6,12 @@
 #include <pcl/common/io.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <iomanip>
 #include <limits>
+#include <locale>
+#include <sstream>
 #include <vector>
 
 #include "byte_cursor.h"
@@ -28,6 +32,7 @@ struct PcdHeader {
   std::int64_t height = 1;
   std::int64_t points = -1;
   std::int64_t point_size = 0;  ///< bytes of one point, all fields (padding "_" included)
+  SensorPose sensor_pose;
   PcdData data = PcdData::Ascii;
 };
 
@@ -68,7 +73,18 @@ PcdHeader parseHeader(ByteCursor& cursor) {
     if (cursor.atEnd()) cursor.fail("not a PCD file (no DATA line)");
     ByteCursor line = cursor.within(cursor.line());
     const std::string_view key = line.token();
-    if (key.empty() || key.front() == '#' || key == "VERSION" || key == "VIEWPOINT") continue;
+    if (key.empty() || key.front() == '#' || key == "VERSION") continue;
+    if (key == "VIEWPOINT") {
+      double v[7];
+      for (double& value : v) value = line.readDouble("VIEWPOINT");
+      const Eigen::Quaterniond q(v[3], v[4], v[5], v[6]);
+      if (!Eigen::Vector3d(v[0], v[1], v[2]).allFinite() || !(q.norm() > 0.0) ||
+          !std::isfinite(q.norm())) {
+        line.fail("PCD VIEWPOINT needs a finite position and a non-zero quaternion");
+      }
+      header.sensor_pose = {Eigen::Vector3d(v[0], v[1], v[2]), q.normalized()};
+      continue;
+    }
     if (key == "FIELDS" || key == "COLUMNS") {
       for (std::string_view t = line.token(); !t.empty(); t = line.token()) names.emplace_back(t);
     } else if (key == "SIZE") {
@@ -222,9 +238,10 @@ void readCompressed(ByteCursor& cursor, const PcdHeader& header, pcl::PCLPointCl
 
 }  // namespace
 
-pcl::PolygonMesh parsePCD(std::string_view data) {
+pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose) {
   ByteCursor cursor(data);
   const PcdHeader header = parseHeader(cursor);
+  if (sensor_pose) *sensor_pose = header.sensor_pose;
   const std::int64_t point_size = header.point_size;
   const std::int64_t remaining = static_cast<std::int64_t>(cursor.remaining());
   // What the body must hold at least: all of it (binary), a digit and a separator per point
@@ -287,7 +304,7 @@ char pcdType(std::uint8_t datatype) {
 
 // binary_compressed, as PCL's tools write it: the fields one after the other (each as an array
 // over all points), LZF-compressed. Padding fields ("_") carry nothing and are left out.
-std::string encodePCD(const pcl::PCLPointCloud2& cloud) {
+std::string encodePCD(const pcl::PCLPointCloud2& cloud, const SensorPose& sensor_pose) {
   std::vector<const pcl::PCLPointField*> fields;
   for (const auto& f : cloud.fields) {
     if (f.name != "_" && pcl::getFieldSize(f.datatype) > 0) fields.push_back(&f);
@@ -302,8 +319,15 @@ std::string encodePCD(const pcl::PCLPointCloud2& cloud) {
   for (const auto* f : fields) header += std::string(" ") + pcdType(f->datatype);
   header += "\nCOUNT";
   for (const auto* f : fields) header += " " + std::to_string(std::max<std::uint32_t>(f->count, 1));
+  std::ostringstream viewpoint;
+  viewpoint.imbue(std::locale::classic());
+  viewpoint << std::setprecision(17) << sensor_pose.origin.x() << ' ' << sensor_pose.origin.y()
+            << ' ' << sensor_pose.origin.z() << ' ' << sensor_pose.orientation.w() << ' '
+            << sensor_pose.orientation.x() << ' ' << sensor_pose.orientation.y() << ' '
+            << sensor_pose.orientation.z();
   header += "\nWIDTH " + std::to_string(cloud.width) + "\nHEIGHT " + std::to_string(cloud.height) +
-            "\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS " + std::to_string(n) + "\nDATA binary_compressed\n";
+            "\nVIEWPOINT " + viewpoint.str() + "\nPOINTS " + std::to_string(n) +
+            "\nDATA binary_compressed\n";
 
   std::string planar;
   for (const auto* f : fields) {

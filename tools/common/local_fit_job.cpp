@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 
 #include "common/mesh_job.h"
 #include "pcl_ddg/io/mesh_io.h"
@@ -58,7 +59,7 @@ SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name) {
   SurfaceInput input;
   {
     Timer timer("Loading " + path);
-    input.mesh = loadMesh(path);
+    input.mesh = loadMesh(path, &input.sensor_pose);
     timer.done(static_cast<std::size_t>(input.mesh.cloud.width) * input.mesh.cloud.height);
   }
   if (!input.mesh.polygons.empty()) {
@@ -108,6 +109,23 @@ RadiusArgument radiusArgument(const ToolArguments& args) {
   return radius;
 }
 
+// -viewpoint x,y,z.
+std::optional<Eigen::Vector3d> viewpointArgument(const ToolArguments& args) {
+  if (!args.has("viewpoint")) return std::nullopt;
+  const std::string text = *args.value("viewpoint");
+  Eigen::Vector3d v;
+  char* at = const_cast<char*>(text.c_str());
+  for (int d = 0; d < 3; ++d) {
+    char* end = nullptr;
+    v[d] = std::strtod(at, &end);
+    const char expected = d < 2 ? ',' : '\0';
+    if (end == at || *end != expected || !std::isfinite(v[d]))
+      throw UsageError("-viewpoint needs x,y,z, not '" + text + "'");
+    at = end + (d < 2 ? 1 : 0);
+  }
+  return v;
+}
+
 }  // namespace
 
 void checkLocalFitArguments(const ToolArguments& args) {
@@ -118,6 +136,7 @@ void checkLocalFitArguments(const ToolArguments& args) {
   if (args.integer("max_nn", kDefaultMaxNeighbours) < 3)
     throw UsageError("-max_nn must be at least 3");
   radiusArgument(args);
+  viewpointArgument(args);
   args.choice("neighbours", {"bfs", "knn"}, "knn");
 }
 
@@ -139,6 +158,8 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
     throw std::runtime_error("-k " + std::to_string(options.k) + " is more than the " +
                              std::to_string(points) + " points of the input");
   }
+  options.viewpoint = viewpointArgument(args);
+  if (!options.viewpoint) options.viewpoint = input.sensor_pose.origin;
   const RadiusArgument radius = radiusArgument(args);
   if (radius.value > 0.0) {
     options.radius = radius.value * (radius.in_spacings ? input.spacing : 1.0);

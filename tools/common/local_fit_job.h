@@ -13,6 +13,7 @@
 
 #include "common/tool_common.h"
 #include "pcl_ddg/features/local_fit.h"
+#include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 
@@ -27,19 +28,21 @@ struct SurfaceInput {
   pcl::PointCloud<pcl::PointXYZ>::Ptr points;  ///< the same, as PCL points
   /** Mean edge length of a mesh, or mean nearest-neighbour distance of a cloud. */
   double spacing = 0.0;
+  SensorPose sensor_pose;  ///< a PCD's VIEWPOINT (kept for the output)
 };
 
 /** Loads a mesh or a cloud, with the warnings of loadSurfaceMesh for meshes and a count of
  *  non-finite points for clouds. */
 SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name);
 
-/** The syntax of -neighbours, -k, -radius and -max_nn, checked before any file is read
- *  (UsageError): -k and -radius exclude each other, -max_nn needs -radius. */
+/** The syntax of -neighbours, -k, -radius, -max_nn and -viewpoint, checked before any file is
+ *  read (UsageError): -k and -radius exclude each other, -max_nn needs -radius. */
 void checkLocalFitArguments(const ToolArguments& args);
 
 /** -neighbours bfs|knn (bfs is the default on meshes and impossible on clouds), -k N (at most the
  *  input's point count), and -radius r, where r is a length or a multiple of the input's spacing
- *  written like 2.5h, with at most -max_nn N neighbours (default 64, Open3D's hybrid search). */
+ *  written like 2.5h, with at most -max_nn N neighbours (default 64, Open3D's hybrid search);
+ *  -viewpoint x,y,z orients cloud normals (default: the file's VIEWPOINT). */
 LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput& input,
                                   LocalFitMethod method);
 

@@ -58,9 +58,12 @@ FieldPrecision precisionArgument(const ToolArguments& args) {
                                                                             : FieldPrecision::Float;
 }
 
-void saveResult(const std::string& path, const pcl::PolygonMesh& mesh) {
+void saveResult(const std::string& path, const pcl::PolygonMesh& mesh,
+                const SensorPose& sensor_pose) {
   Timer timer("Saving " + path);
-  saveMesh(path, mesh);
+  MeshWriteOptions options;
+  options.sensor_pose = sensor_pose;
+  saveMesh(path, mesh, options);
   timer.done(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height);
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common/tool_common.h"
+#include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/operators/mass_matrix.h"
@@ -37,8 +38,10 @@ CholeskyBackend solverArgument(const ToolArguments& args);
 /** -precision float|double. */
 FieldPrecision precisionArgument(const ToolArguments& args);
 
-/** Saves through saveMesh (format by extension, atomic), with a timing line. */
-void saveResult(const std::string& path, const pcl::PolygonMesh& mesh);
+/** Saves through saveMesh (format by extension, atomic), with a timing line; a PCD output
+ *  carries the sensor pose as its VIEWPOINT. */
+void saveResult(const std::string& path, const pcl::PolygonMesh& mesh,
+                const SensorPose& sensor_pose = {});
 
 }  // namespace tools
 }  // namespace pcl_ddg

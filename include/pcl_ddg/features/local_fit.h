@@ -5,8 +5,10 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "pcl_ddg/mesh/mesh_topology.h"
 
@@ -26,6 +28,9 @@ struct LocalFitOptions {
   double radius = 0.0;              ///< > 0: a radius search instead of k nearest
   unsigned int max_neighbours = 0;  ///< with radius: keep at most this many, the nearest (0: all)
   unsigned int threads = 0;         ///< 0: all cores
+  /** Clouds: normals are turned towards this point (a PCD's VIEWPOINT); unset: the origin, as
+   *  PCL does. Meshes are oriented like their faces. */
+  std::optional<Eigen::Vector3d> viewpoint;
 };
 
 struct LocalFitResult {

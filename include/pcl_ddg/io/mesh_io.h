@@ -11,17 +11,27 @@
 // save leaves no file behind.
 #include <pcl/PolygonMesh.h>
 
+#include <Eigen/Geometry>
 #include <string>
 
 namespace pcl_ddg {
 
 enum class PlyEncoding { Binary, Ascii };
 
-struct MeshWriteOptions {
-  PlyEncoding ply_encoding = PlyEncoding::Binary;
+/** Where the sensor was: a PCD file's VIEWPOINT (translation, then orientation as w x y z). The
+ *  origin and no rotation when a file has none. PCL's tools orient normals towards it. */
+struct SensorPose {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 };
 
-pcl::PolygonMesh loadMesh(const std::string& path);
+struct MeshWriteOptions {
+  PlyEncoding ply_encoding = PlyEncoding::Binary;
+  SensorPose sensor_pose;  ///< written as a PCD's VIEWPOINT
+};
+
+/** Loads any supported file; `sensor_pose`, if given, receives the file's VIEWPOINT (PCD). */
+pcl::PolygonMesh loadMesh(const std::string& path, SensorPose* sensor_pose = nullptr);
 
 void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh,
               const MeshWriteOptions& options = {});
