@@ -182,7 +182,14 @@ TEST_F(HostileFiles, PcdHeadersThatLie) {
                 "unsupported PCD field type F of size 3");
   expectRefused("truncated.pcd", kPcdHeader + "DATA binary\n" + std::string(23, '\0'),
                 "shorter than POINTS");
-  expectRefused("ascii_short.pcd", kPcdHeader + "DATA ascii\n1 2 3\n", "fewer rows than POINTS");
+  expectRefused("ascii_short.pcd", kPcdHeader + "DATA ascii\n1 2 3" + std::string(20, ' ') + "\n",
+                "fewer rows than POINTS");
+  // A megabyte per point claimed by COUNT, in a file of a few bytes.
+  expectRefused("ascii_count.pcd",
+                replaced(replaced(kPcdHeader, "COUNT 1 1 1", "COUNT 1 1 1048576"), "SIZE 4 4 4",
+                         "SIZE 4 4 8") +
+                    "DATA ascii\n1 2 3\n1 2 3\n",
+                "shorter than POINTS");
   expectRefused("ascii_range.pcd",
                 replaced(kPcdHeader, "TYPE F F F", "TYPE F F U") + "DATA ascii\n1 2 3\n1 2 -3\n",
                 "out of range");

@@ -244,12 +244,15 @@ pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose) {
   if (sensor_pose) *sensor_pose = header.sensor_pose;
   const std::int64_t point_size = header.point_size;
   const std::int64_t remaining = static_cast<std::int64_t>(cursor.remaining());
-  // What the body must hold at least: all of it (binary), a digit and a separator per point
+  // What the body must hold at least: all of it (binary), a digit and a separator per value
   // (ascii), or what LZF (at most ~90x expansion) can give. Checked before allocating anything,
   // so that a small file never costs more than a small multiple of its size.
   const std::int64_t bytes = cursor.product(point_size, header.points, "POINTS x point size");
+  std::int64_t values_per_point = 0;
+  for (const std::int64_t count : header.counts) values_per_point += count;
   if ((header.data == PcdData::Binary && bytes > remaining) ||
-      (header.data == PcdData::Ascii && header.points > remaining / 2) ||
+      (header.data == PcdData::Ascii &&
+       cursor.product(values_per_point, header.points, "POINTS x values") > remaining / 2) ||
       (header.data == PcdData::BinaryCompressed && bytes / 128 > remaining)) {
     cursor.fail("PCD data shorter than POINTS x point size (truncated?)");
   }
