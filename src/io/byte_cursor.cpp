@@ -1,5 +1,6 @@
 #include "byte_cursor.h"
 
+#include <pcl/PCLPointField.h>
 #include <sys/stat.h>
 
 #include <algorithm>
@@ -121,6 +122,32 @@ void ByteCursor::failOutOfRange(double v, const char* what) const {
   std::ostringstream text;
   text << "value " << v << " is out of range for " << what;
   fail(text.str());
+}
+
+void ByteCursor::storeAs(std::uint8_t pcl_datatype, double v, std::uint8_t* dst,
+                         const char* what) const {
+  switch (pcl_datatype) {
+    case pcl::PCLPointField::INT8:
+      return store<std::int8_t>(v, dst, what);
+    case pcl::PCLPointField::UINT8:
+      return store<std::uint8_t>(v, dst, what);
+    case pcl::PCLPointField::INT16:
+      return store<std::int16_t>(v, dst, what);
+    case pcl::PCLPointField::UINT16:
+      return store<std::uint16_t>(v, dst, what);
+    case pcl::PCLPointField::INT32:
+      return store<std::int32_t>(v, dst, what);
+    case pcl::PCLPointField::UINT32:
+      return store<std::uint32_t>(v, dst, what);
+    case pcl::PCLPointField::INT64:
+      return store<std::int64_t>(v, dst, what);
+    case pcl::PCLPointField::UINT64:
+      return store<std::uint64_t>(v, dst, what);
+    case pcl::PCLPointField::FLOAT32:
+      return store<float>(v, dst, what);
+    default:
+      return store<double>(v, dst, what);
+  }
 }
 
 std::int64_t ByteCursor::product(std::int64_t a, std::int64_t b, const char* what) const {

@@ -73,6 +73,8 @@ class ByteCursor {
     const T value = convert<T>(v, what);
     std::memcpy(dst, &value, sizeof(T));
   }
+  /** Stores v in a field of the given pcl::PCLPointField datatype (convert's checks). */
+  void storeAs(std::uint8_t pcl_datatype, double v, std::uint8_t* dst, const char* what) const;
   /** a * b for non-negative counts, refused when it overflows. */
   std::int64_t product(std::int64_t a, std::int64_t b, const char* what) const;
 

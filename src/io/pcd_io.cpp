@@ -155,35 +155,6 @@ PcdHeader parseHeader(ByteCursor& cursor) {
   return header;
 }
 
-// Stores an ascii value in its field's type; a value the type cannot hold is refused.
-void storeText(const ByteCursor& line, std::string_view token, std::uint8_t datatype,
-               std::uint8_t* dst) {
-  const char* what = "the PCD field type";
-  const double v = line.parseDouble(token, "PCD value");
-  switch (datatype) {
-    case pcl::PCLPointField::INT8:
-      return line.store<std::int8_t>(v, dst, what);
-    case pcl::PCLPointField::UINT8:
-      return line.store<std::uint8_t>(v, dst, what);
-    case pcl::PCLPointField::INT16:
-      return line.store<std::int16_t>(v, dst, what);
-    case pcl::PCLPointField::UINT16:
-      return line.store<std::uint16_t>(v, dst, what);
-    case pcl::PCLPointField::INT32:
-      return line.store<std::int32_t>(v, dst, what);
-    case pcl::PCLPointField::UINT32:
-      return line.store<std::uint32_t>(v, dst, what);
-    case pcl::PCLPointField::INT64:
-      return line.store<std::int64_t>(v, dst, what);
-    case pcl::PCLPointField::UINT64:
-      return line.store<std::uint64_t>(v, dst, what);
-    case pcl::PCLPointField::FLOAT32:
-      return line.store<float>(v, dst, what);
-    default:
-      return line.store<double>(v, dst, what);
-  }
-}
-
 void readAscii(ByteCursor& cursor, const PcdHeader& header, pcl::PCLPointCloud2& cloud) {
   std::int64_t point = 0;
   while (point < header.points) {
@@ -194,8 +165,8 @@ void readAscii(ByteCursor& cursor, const PcdHeader& header, pcl::PCLPointCloud2&
     for (std::size_t f = 0; f < header.fields.size(); ++f) {
       const pcl::PCLPointField& field = header.fields[f];
       for (std::uint32_t c = 0; c < field.count; ++c) {
-        storeText(line, line.requireToken("PCD value"), field.datatype,
-                  dst + field.offset + c * header.sizes[f]);
+        line.storeAs(field.datatype, line.readDouble("PCD value"),
+                     dst + field.offset + c * header.sizes[f], "the PCD field type");
       }
     }
     if (!line.token().empty()) line.fail("PCD row has more values than FIELDS x COUNT");

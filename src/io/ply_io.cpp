@@ -225,25 +225,7 @@ class PlyValueReader {
       return;
     }
     const double v = cursor_.readDouble(what);
-    const char* range = "the PLY property type";
-    switch (type) {
-      case PlyType::Int8:
-        return cursor_.store<std::int8_t>(v, dst, range);
-      case PlyType::UInt8:
-        return cursor_.store<std::uint8_t>(v, dst, range);
-      case PlyType::Int16:
-        return cursor_.store<std::int16_t>(v, dst, range);
-      case PlyType::UInt16:
-        return cursor_.store<std::uint16_t>(v, dst, range);
-      case PlyType::Int32:
-        return cursor_.store<std::int32_t>(v, dst, range);
-      case PlyType::UInt32:
-        return cursor_.store<std::uint32_t>(v, dst, range);
-      case PlyType::Float32:
-        return cursor_.store<float>(v, dst, range);
-      case PlyType::Float64:
-        return cursor_.store<double>(v, dst, range);
-    }
+    cursor_.storeAs(pclDatatype(type), v, dst, "the PLY property type");
   }
 
   void skip(const PlyProperty& property, const char* what) {
