@@ -2,6 +2,7 @@
 // every option, and bad input (one error line, non-zero exit, no output file).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include <cstdio>
@@ -276,6 +277,34 @@ TEST_F(MeshTools, CompareNeighbourhoodsShowsAThinTwoSheetSurface) {
       runTool(PCL_DDG_COMPARE_TOOL, sharedData("clouds/bun0.pcd") + " " + path("c.ply"));
   EXPECT_EQ(cloud.exit_code, 1);
   EXPECT_FALSE(std::filesystem::exists(path("c.ply")));
+}
+
+TEST_F(MeshTools, NormalsReplaceTheInputsOwnAndAreNeverWrittenTwice) {
+  // bun0.pcd carries PCL's normal_x/y/z + curvature, horse.ply its nx/ny/nz: whatever the output
+  // format, the input's triple is replaced in its own naming, and no second triple appears.
+  const auto names = [](const std::string& file) {
+    std::vector<std::string> n;
+    for (const auto& f : loadMesh(file).cloud.fields) n.push_back(f.name);
+    return n;
+  };
+  const auto count = [](const std::vector<std::string>& n, const std::string& name) {
+    return std::count(n.begin(), n.end(), name);
+  };
+  const std::string bunny = sharedData("clouds/bun0.pcd"), horse = sharedData("meshes/horse.ply");
+  ASSERT_EQ(runTool(PCL_DDG_NORMALS_TOOL, bunny + " " + path("bunny.ply")).exit_code, 0);
+  ASSERT_EQ(runTool(PCL_DDG_NORMALS_TOOL, horse + " " + path("horse.pcd")).exit_code, 0);
+  ASSERT_EQ(
+      runTool(PCL_DDG_NORMALS_TOOL, horse + " " + path("horse_pca.pcd") + " -method pca").exit_code,
+      0);
+  const auto b = names(path("bunny.ply"));
+  EXPECT_EQ(count(b, "normal_x") + count(b, "nx"), 1);
+  EXPECT_EQ(count(b, "normal_x"), 1) << "bun0's own naming";
+  EXPECT_EQ(count(b, "curvature"), 1);
+  for (const char* out : {"horse.pcd", "horse_pca.pcd"}) {
+    const auto h = names(path(out));
+    EXPECT_EQ(count(h, "nx"), 1) << out;
+    EXPECT_EQ(count(h, "normal_x"), 0) << out;
+  }
 }
 
 TEST_F(MeshTools, CloudNormalsFaceTheViewpointGivenOrInTheFile) {

@@ -89,11 +89,7 @@ int run(int argc, char** argv) {
       tools::warn(kName, std::to_string(normals.fallback_vertices) +
                              " flat or boundary vertices took the area-weighted normal");
     }
-    const bool pcd = fileExtension(output) == "pcd";
-    const char* names[2][3] = {{"nx", "ny", "nz"}, {"normal_x", "normal_y", "normal_z"}};
-    for (int d = 0; d < 3; ++d) {
-      setVertexField(in.mesh.cloud, names[pcd][d], normals.normals.row(d).transpose(), precision);
-    }
+    tools::setNormalTriple(in.mesh.cloud, output, normals.normals, precision);
   } else {
     const LocalFitOptions options = tools::localFitArguments(
         args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);

@@ -126,6 +126,13 @@ std::optional<Eigen::Vector3d> viewpointArgument(const ToolArguments& args) {
   return v;
 }
 
+Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals) {
+  Eigen::Matrix3Xd n(3, normals.size());
+  for (std::size_t i = 0; i < normals.size(); ++i)
+    n.col(i) = normals[i].getNormalVector3fMap().cast<double>();
+  return n;
+}
+
 }  // namespace
 
 void checkLocalFitArguments(const ToolArguments& args) {
@@ -171,14 +178,8 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
 
 void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
                      const pcl::PointCloud<pcl::Normal>& normals, FieldPrecision precision) {
-  const bool pcd = fileExtension(output_path) == "pcd";
-  const char* ply_names[] = {"nx", "ny", "nz"};
-  const char* pcd_names[] = {"normal_x", "normal_y", "normal_z"};
+  setNormalTriple(cloud, output_path, normalsOf(normals), precision);
   Eigen::VectorXd values(normals.size());
-  for (int d = 0; d < 3; ++d) {
-    for (std::size_t i = 0; i < normals.size(); ++i) values[i] = normals[i].normal[d];
-    setVertexField(cloud, pcd ? pcd_names[d] : ply_names[d], values, precision);
-  }
   for (std::size_t i = 0; i < normals.size(); ++i) values[i] = normals[i].curvature;
   setVertexField(cloud, "curvature", values, precision);
 }

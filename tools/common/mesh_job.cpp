@@ -58,6 +58,20 @@ FieldPrecision precisionArgument(const ToolArguments& args) {
                                                                             : FieldPrecision::Float;
 }
 
+void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
+                     const Eigen::Matrix3Xd& normals, FieldPrecision precision) {
+  const char* ply_names[] = {"nx", "ny", "nz"};
+  const char* pcd_names[] = {"normal_x", "normal_y", "normal_z"};
+  const bool pcd_naming = hasVertexField(cloud, "normal_x") ? true
+                          : hasVertexField(cloud, "nx")     ? false
+                                                            : fileExtension(output_path) == "pcd";
+  for (int d = 0; d < 3; ++d) {
+    removeVertexField(cloud, pcd_naming ? ply_names[d] : pcd_names[d]);
+    setVertexField(cloud, pcd_naming ? pcd_names[d] : ply_names[d], normals.row(d).transpose(),
+                   precision);
+  }
+}
+
 void saveResult(const std::string& path, const pcl::PolygonMesh& mesh,
                 const SensorPose& sensor_pose) {
   Timer timer("Saving " + path);

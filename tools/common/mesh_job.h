@@ -38,6 +38,15 @@ CholeskyBackend solverArgument(const ToolArguments& args);
 /** -precision float|double. */
 FieldPrecision precisionArgument(const ToolArguments& args);
 
+/**
+ * Writes normals (3 x N) as one field triple: under the input's own names when it has normals
+ * (nx ny nz, or normal_x normal_y normal_z), else under the output format's (PLY nx ny nz, PCD
+ * normal_x normal_y normal_z, as PCL writes them). The other naming is removed, so no output ever
+ * holds two normal triples.
+ */
+void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
+                     const Eigen::Matrix3Xd& normals, FieldPrecision precision);
+
 /** Saves through saveMesh (format by extension, atomic), with a timing line; a PCD output
  *  carries the sensor pose as its VIEWPOINT. */
 void saveResult(const std::string& path, const pcl::PolygonMesh& mesh,
