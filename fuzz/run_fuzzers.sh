@@ -12,7 +12,11 @@ seconds=$2
 shift 2
 targets=("$@")
 ((${#targets[@]})) || targets=(ply off obj stl vtk pcd mesh)
-shared=${PCL_DDG_SHARED_DATA:-$here/../../shared/data}
+# The shared scans, where the tests look for them too (test/CMakeLists.txt).
+shared=${PCL_DDG_SHARED_DATA:-}
+for candidate in "$here/../../shared/data" /work/shared/data; do
+  [ -z "$shared" ] && [ -f "$candidate/CATALOG.md" ] && shared=$candidate
+done
 
 status=0
 for target in "${targets[@]}"; do
@@ -22,7 +26,7 @@ for target in "${targets[@]}"; do
   mkdir -p "$corpus" "$seeds" "$findings"
   rm -f "$seeds"/*
   if [ -d "$here/seeds/$target" ]; then cp "$here/seeds/$target"/* "$seeds"/; fi
-  if [ -d "$shared" ]; then
+  if [ -n "$shared" ]; then
     find "$shared" -type f -name "*.$target" -exec ln -sf {} "$seeds"/ \;
   fi
   dict=()
