@@ -10,6 +10,12 @@
 #include <filesystem>
 #include <fstream>
 
+#include <pcl/conversions.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cmath>
+
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
 #include "pcl_ddg/io/mesh_io.h"
@@ -110,14 +116,91 @@ TEST_F(MeshIOFiles, PlyRoundTripKeepsDoublesFieldsAndFaces) {
   setVertexColors(mesh.cloud, rgb);
   for (PlyEncoding encoding : {PlyEncoding::Binary, PlyEncoding::Ascii}) {
     saveMesh(path("out.ply"), mesh, {encoding});
-    const pcl::PolygonMesh back = loadMesh(path("out.ply"));
-    EXPECT_EQ(vertexPositions(back.cloud), p);  // bit-exact, both encodings
+    const MeshFile file = readMeshFile(path("out.ply"));
+    EXPECT_EQ(file.positions, p);  // bit-exact, both encodings
+    EXPECT_EQ(file.coordinate_precision, FieldPrecision::Double);
+    const pcl::PolygonMesh& back = file.mesh;
+    EXPECT_EQ(vertexPositions(back.cloud), p.cast<float>().cast<double>());  // PCL gets floats
     ASSERT_EQ(back.polygons.size(), 1u);
     EXPECT_EQ(back.polygons[0].vertices.size(), 4u);
     std::vector<std::string> names;
     for (const auto& f : back.cloud.fields) names.push_back(f.name);
     EXPECT_EQ(names,
               (std::vector<std::string>{"x", "y", "z", "mean_curvature", "red", "green", "blue"}));
+  }
+}
+
+// What PCL code does with a loaded mesh: pcl::fromPCLPointCloud2 into its own point type. It
+// matches fields by name and type, so anything but FLOAT32 x, y, z would give zeros.
+void expectPCLReadsTheCoordinates(const std::string& path) {
+  SCOPED_TRACE(path);
+  const MeshFile file = readMeshFile(path);
+  pcl::PointCloud<pcl::PointXYZ> points;
+  pcl::fromPCLPointCloud2(file.mesh.cloud, points);
+  ASSERT_EQ(static_cast<Eigen::Index>(points.size()), file.positions.cols());
+  std::int64_t finite = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3f expected = file.positions.col(static_cast<Eigen::Index>(i)).cast<float>();
+    if (!expected.allFinite()) {
+      EXPECT_FALSE(std::isfinite(points[i].x)) << "vertex " << i;
+      continue;
+    }
+    ++finite;
+    ASSERT_EQ(points[i].getVector3fMap(), expected) << "vertex " << i;
+  }
+  EXPECT_GT(finite, 0);
+}
+
+TEST(MeshIO, PCLReadsFloatCoordinatesFromEveryLoadedSharedFile) {
+  for (const CatalogEntry& e : kCatalog) expectPCLReadsTheCoordinates(sharedData(e.file));
+  expectPCLReadsTheCoordinates(sharedData("range/bun000.ply"));
+}
+
+TEST_F(MeshIOFiles, PCLReadsFloatCoordinatesFromEveryFormatAndPrecision) {
+  const std::string triangle = "0.1 0.2 0.3\n100000.123456789 1 0\n0 1e-30 1\n";
+  writeText(path("t.off"), "OFF\n3 1 0\n" + triangle + "3 0 1 2\n");
+  writeText(path("t.obj"), "v 0.1 0.2 0.3\nv 100000.123456789 1 0\nv 0 1e-30 1\nf 1 2 3\n");
+  writeText(path("t.vtk"),
+            "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 double\n" + triangle +
+                "POLYGONS 1 4\n3 0 1 2\n");
+  writeText(path("t.stl"),
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0.1 0.2 0.3\n"
+            "vertex 100000.123456789 1 0\nvertex 0 1e-30 1\nendloop\nendfacet\nendsolid t\n");
+  const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\n";
+  writeText(path("double.ply"), header +
+                                    "property double x\nproperty double y\nproperty double z\n"
+                                    "element face 1\nproperty list uchar int vertex_indices\n"
+                                    "end_header\n" +
+                                    triangle + "3 0 1 2\n");
+  writeText(path("int.ply"), header +
+                                 "property int x\nproperty short y\nproperty uchar z\n"
+                                 "end_header\n1 2 3\n4 5 6\n7 8 9\n");
+  writeText(path("double.pcd"),
+            "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\n"
+            "HEIGHT 1\nPOINTS 3\nDATA ascii\n" +
+                triangle);
+  for (const char* name :
+       {"t.off", "t.obj", "t.vtk", "t.stl", "double.ply", "int.ply", "double.pcd"})
+    expectPCLReadsTheCoordinates(path(name));
+  // The exact coordinates stay beside the mesh, and a declared double is remembered.
+  const MeshFile off = readMeshFile(path("t.off"));
+  EXPECT_EQ(off.positions(0, 1), 100000.123456789);
+  EXPECT_EQ(off.coordinate_precision, FieldPrecision::Float);  // untyped text
+  for (const char* name : {"t.vtk", "double.ply", "double.pcd"}) {
+    EXPECT_EQ(readMeshFile(path(name)).positions(0, 1), 100000.123456789) << name;
+    EXPECT_EQ(readMeshFile(path(name)).coordinate_precision, FieldPrecision::Double) << name;
+  }
+}
+
+TEST_F(MeshIOFiles, CoordinatesBeyondFloatAreRefused) {
+  writeText(path("huge.off"), "OFF\n3 1 0\n0 0 0\n1e300 0 0\n0 1 0\n3 0 1 2\n");
+  try {
+    loadMesh(path("huge.off"));
+    ADD_FAILURE() << "loaded";
+  } catch (const FileFormatException& e) {
+    EXPECT_NE(std::string(e.what()).find("vertex 1: coordinate 1e+300 is beyond float"),
+              std::string::npos)
+        << e.what();
   }
 }
 

@@ -35,9 +35,10 @@ TEST_F(SmoothingTools, SmoothSharedMeshesBothSchemesKeepTheMeshAndPreserveVolume
   for (const char* file : {"cow.off", "bunny.off", "bun_zipper_res4.ply", "horse.ply"}) {
     SCOPED_TRACE(file);
     const std::string input = sharedData(std::string("meshes/") + file);
-    const pcl::PolygonMesh original = loadMesh(input);
+    const MeshFile original_file = readMeshFile(input);
+    const pcl::PolygonMesh& original = original_file.mesh;
     const MeshTopology topology(original);
-    const Eigen::Matrix3Xd before = vertexPositions(original.cloud);
+    const Eigen::Matrix3Xd& before = original_file.positions;
     for (const char* options :
          {"", "-method explicit -iterations 20", "-lambda_dt 5 -weights uniform"}) {
       SCOPED_TRACE(options);
@@ -57,7 +58,9 @@ TEST_F(SmoothingTools, SmoothSharedMeshesBothSchemesKeepTheMeshAndPreserveVolume
                                                            " -lambda_dt 3 -iterations 2 -preserve "
                                                            "volume -precision double");
       ASSERT_EQ(run.exit_code, 0) << run.err;
-      const Eigen::Matrix3Xd after = vertexPositions(loadMesh(path("vol.ply")).cloud);
+      const MeshFile smoothed = readMeshFile(path("vol.ply"));
+      EXPECT_EQ(smoothed.coordinate_precision, FieldPrecision::Double);
+      const Eigen::Matrix3Xd& after = smoothed.positions;
       EXPECT_NEAR(enclosedVolume(topology, after) / enclosedVolume(topology, before), 1.0, 1e-9);
     }
   }

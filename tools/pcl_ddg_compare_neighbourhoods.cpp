@@ -65,7 +65,8 @@ int run(int argc, char** argv) {
   // Coloured from the smallest difference to 30 degrees (larger ones saturate).
   Eigen::VectorXd clamped = c.angle_difference.cwiseMin(30.0);
   setVertexColors(in.mesh.cloud, colorize(clamped, ColorMap::Sequential, {0.0, 100.0}));
-  tools::saveResult(output, in.mesh, in.sensor_pose);
+  tools::saveResult(kName, output, in.mesh, in.positions,
+                    tools::coordinatePrecision(in.coordinate_precision, precision), in.sensor_pose);
   return 0;
 }
 

@@ -144,7 +144,8 @@ int run(int argc, char** argv) {
     setVertexColors(in.mesh.cloud,
                     colorize(values, ColorMap::Diverging, {percentile, 100.0 - percentile}));
   }
-  tools::saveResult(output, in.mesh, in.sensor_pose);
+  tools::saveResult(kName, output, in.mesh, in.positions,
+                    tools::coordinatePrecision(in.coordinate_precision, precision), in.sensor_pose);
   return 0;
 }
 

@@ -22,8 +22,9 @@ int run(int argc, char** argv) {
   const std::string& path = args.positional()[0];
 
   tools::Timer load_timer("Loading " + path);
-  const pcl::PolygonMesh mesh = loadMesh(path);
-  load_timer.done(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height);
+  const MeshFile file = readMeshFile(path);
+  const pcl::PolygonMesh& mesh = file.mesh;
+  load_timer.done(static_cast<std::size_t>(file.positions.cols()));
 
   const bool json = args.has("json");
   if (mesh.polygons.empty()) {
@@ -33,7 +34,7 @@ int run(int argc, char** argv) {
   }
   const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);
   const MeshReport report =
-      makeMeshReport(topology, vertexPositions(mesh.cloud, NonFinitePolicy::Keep));
+      makeMeshReport(topology, file.positions);
   std::cout << (json ? report.toJson() + "\n" : report.toText());
   return 0;
 }

@@ -107,7 +107,8 @@ int run(int argc, char** argv) {
     tools::warnAboutLocalFit(kName, result);
     tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
   }
-  tools::saveResult(output, in.mesh, in.sensor_pose);
+  tools::saveResult(kName, output, in.mesh, in.positions,
+                    tools::coordinatePrecision(in.coordinate_precision, precision), in.sensor_pose);
   return 0;
 }
 

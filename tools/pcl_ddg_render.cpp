@@ -39,13 +39,14 @@ int run(int argc, char** argv) {
                            : ColorMap::Sequential;
 
   tools::Timer load_timer("Loading " + input);
-  const pcl::PolygonMesh mesh = loadMesh(input);
-  load_timer.done(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height);
+  const MeshFile file = readMeshFile(input);
+  const pcl::PolygonMesh& mesh = file.mesh;
+  load_timer.done(static_cast<std::size_t>(file.positions.cols()));
   if (mesh.polygons.empty()) throw std::runtime_error(input + " has no faces to render");
 
   tools::Timer render_timer("Rendering " + output);
   const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);
-  const Eigen::Matrix3Xd positions = vertexPositions(mesh.cloud, NonFinitePolicy::Keep);
+  const Eigen::Matrix3Xd& positions = file.positions;
   Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colors(3, positions.cols());
   if (const auto field = args.value("field")) {
     colors = colorize(vertexScalarField(mesh.cloud, *field), map);

@@ -65,7 +65,7 @@ int run(int argc, char** argv) {
   const double lambda_dt = args.number("lambda_dt", 1.0);
   if (!(lambda_dt > 0.0) || !std::isfinite(lambda_dt))
     throw tools::UsageError("-lambda_dt must be > 0");
-  const bool double_output = tools::precisionArgument(args) == FieldPrecision::Double;
+  const FieldPrecision precision = tools::precisionArgument(args);
 
   tools::SurfaceMesh in = tools::loadSurfaceMesh(args.positional()[0], kName);
   const double h = meanEdgeLength(in.topology, in.positions);
@@ -139,14 +139,8 @@ int run(int argc, char** argv) {
                            "% (-fix_boundary keeps the boundary in place)");
   }
 
-  if (double_output) {
-    const char* names[] = {"x", "y", "z"};
-    for (int d = 0; d < 3; ++d)
-      setVertexField(in.mesh.cloud, names[d], smoothed.row(d).transpose(), FieldPrecision::Double);
-  } else {
-    setVertexPositions(in.mesh.cloud, smoothed);
-  }
-  tools::saveResult(args.positional()[1], in.mesh);
+  tools::saveResult(kName, args.positional()[1], in.mesh, smoothed,
+                    tools::coordinatePrecision(in.coordinate_precision, precision));
   return 0;
 }
 

@@ -56,8 +56,9 @@ int run(int argc, char** argv) {
   }
 
   tools::Timer load_timer("Loading " + input);
-  SensorPose sensor;
-  pcl::PolygonMesh cloud = loadMesh(input, &sensor);
+  MeshFile file = readMeshFile(input);
+  pcl::PolygonMesh& cloud = file.mesh;
+  const SensorPose& sensor = file.sensor_pose;
   const std::size_t points = static_cast<std::size_t>(cloud.cloud.width) * cloud.cloud.height;
   load_timer.done(points);
   if (cloud.cloud.height < 2) {
@@ -65,7 +66,7 @@ int run(int argc, char** argv) {
                              std::to_string(cloud.cloud.height) + ")");
   }
 
-  const Eigen::Matrix3Xd positions = vertexPositions(cloud.cloud, NonFinitePolicy::Keep);
+  const Eigen::Matrix3Xd& positions = file.positions;
   tools::Timer timer("Smoothing");
   GridSmoothingReport report;
   const Eigen::Matrix3Xd smoothed =
@@ -80,8 +81,9 @@ int run(int argc, char** argv) {
     tools::warn(kName, std::to_string(report.points_at_origin) +
                            " points at the sensor origin kept in place (no ray to move along)");
   }
-  setVertexPositions(cloud.cloud, smoothed);
-  tools::saveResult(args.positional()[1], cloud, sensor);
+  tools::saveResult(kName, args.positional()[1], cloud, smoothed,
+                    tools::coordinatePrecision(file.coordinate_precision, FieldPrecision::Float),
+                    sensor);
   return 0;
 }
 

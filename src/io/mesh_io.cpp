@@ -3,13 +3,17 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
+#include <sstream>
 
 #include "byte_cursor.h"
 #include "formats.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
 
 namespace pcl_ddg {
 namespace {
@@ -25,6 +29,20 @@ void savePLY(const std::string& path, const pcl::PolygonMesh& mesh, PlyEncoding 
   if (!out) throw FileFormatException(std::string("write failed: ") + std::strerror(errno));
 }
 
+void requireFloatRange(const Eigen::Matrix3Xd& positions) {
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+    for (int d = 0; d < 3; ++d) {
+      const double v = positions(d, i);
+      if (std::isfinite(v) && std::abs(v) > std::numeric_limits<float>::max()) {
+        std::ostringstream text;
+        text << "vertex " << i << ": coordinate " << v
+             << " is beyond float's range (PCL's point types are float)";
+        throw FileFormatException(text.str());
+      }
+    }
+  }
+}
+
 }  // namespace
 
 std::string fileExtension(const std::string& path) {
@@ -37,7 +55,7 @@ std::string fileExtension(const std::string& path) {
   return ext;
 }
 
-pcl::PolygonMesh loadMesh(const std::string& path, SensorPose* sensor_pose) {
+MeshFile readMeshFile(const std::string& path) {
   const std::string ext = fileExtension(path);
   try {
     const std::string data = detail::readWholeFile(path);  // first: a missing file says so
@@ -53,14 +71,30 @@ pcl::PolygonMesh loadMesh(const std::string& path, SensorPose* sensor_pose) {
           (ext.empty() ? std::string("no file extension") : "unknown file type '." + ext + "'") +
           " (expected .ply, .obj, .off, .stl, .vtk or .pcd)");
     }
-    if (sensor_pose) *sensor_pose = SensorPose();
-    pcl::PolygonMesh mesh = ext == "pcd" ? detail::parsePCD(data, sensor_pose) : parse(data);
-    if (mesh.cloud.width * mesh.cloud.height == 0)
-      throw FileFormatException("file has no vertices");
-    return mesh;
+    MeshFile file;
+    file.mesh = ext == "pcd" ? detail::parsePCD(data, &file.sensor_pose) : parse(data);
+    pcl::PCLPointCloud2& cloud = file.mesh.cloud;
+    if (cloud.width * cloud.height == 0) throw FileFormatException("file has no vertices");
+    file.positions = vertexPositions(cloud, NonFinitePolicy::Keep);
+    requireFloatRange(file.positions);
+    // Text OFF/OBJ/STL declare no type: their doubles are exact values of the text, not a choice.
+    const bool typed = ext == "ply" || ext == "pcd" || ext == "vtk";
+    const bool stored_double = std::any_of(cloud.fields.begin(), cloud.fields.end(), [](auto& f) {
+      return (f.name == "x" || f.name == "y" || f.name == "z") &&
+             f.datatype == pcl::PCLPointField::FLOAT64;
+    });
+    if (typed && stored_double) file.coordinate_precision = FieldPrecision::Double;
+    setVertexCoordinates(cloud, file.positions, FieldPrecision::Float);
+    return file;
   } catch (const pcl::PCLException& e) {
     throw FileFormatException(path + ": " + errorDescription(e));
   }
+}
+
+pcl::PolygonMesh loadMesh(const std::string& path, SensorPose* sensor_pose) {
+  MeshFile file = readMeshFile(path);
+  if (sensor_pose) *sensor_pose = file.sensor_pose;
+  return std::move(file.mesh);
 }
 
 void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh,

@@ -90,6 +90,45 @@ void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
   }
 }
 
+void setVertexCoordinates(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions,
+                          FieldPrecision precision) {
+  const std::uint8_t datatype = precision == FieldPrecision::Double ? pcl::PCLPointField::FLOAT64
+                                                                    : pcl::PCLPointField::FLOAT32;
+  if (static_cast<std::size_t>(positions.cols()) != pointCount(cloud))
+    throw pcl::BadArgumentException("positions do not match the vertex count");
+  const auto has_type = [&](const char* name) {
+    return std::any_of(cloud.fields.begin(), cloud.fields.end(), [&](const pcl::PCLPointField& f) {
+      return f.name == name && f.datatype == datatype && f.count == 1;
+    });
+  };
+  if (!(has_type("x") && has_type("y") && has_type("z"))) {
+    for (const char* axis : {"x", "y", "z"}) removeVertexField(cloud, axis);
+    // The coordinates go first, where PCL's point types keep them.
+    const std::uint32_t size = pcl::getFieldSize(datatype);
+    const std::size_t n = pointCount(cloud);
+    const std::uint32_t old_step = cloud.point_step;
+    const std::uint32_t new_step = old_step + 3 * size;
+    std::vector<std::uint8_t> data(n * new_step, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      std::memcpy(data.data() + i * new_step + 3 * size, cloud.data.data() + i * old_step,
+                  old_step);
+    }
+    for (auto& f : cloud.fields) f.offset += 3 * size;
+    for (std::uint32_t d = 0; d < 3; ++d) {
+      pcl::PCLPointField field;
+      field.name = std::string(1, static_cast<char>('x' + d));
+      field.offset = d * size;
+      field.datatype = datatype;
+      field.count = 1;
+      cloud.fields.insert(cloud.fields.begin() + d, field);
+    }
+    cloud.data.swap(data);
+    cloud.point_step = new_step;
+    cloud.row_step = new_step * cloud.width;
+  }
+  setVertexPositions(cloud, positions);
+}
+
 void setVertexColors(pcl::PCLPointCloud2& cloud,
                      const Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic>& rgb) {
   const std::size_t n = pointCount(cloud);

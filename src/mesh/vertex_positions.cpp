@@ -47,7 +47,10 @@ const pcl::PCLPointField& namedField(const pcl::PCLPointCloud2& cloud, const std
   for (const auto& f : cloud.fields) {
     if (f.name == name) return f;
   }
-  throw InvalidMeshException("vertex data has no '" + name + "' field");
+  std::string existing;
+  for (const auto& f : cloud.fields) existing += (existing.empty() ? "" : " ") + f.name;
+  throw InvalidMeshException("vertex data has no '" + name + "' field (it has: " +
+                             (existing.empty() ? std::string("no fields") : existing) + ")");
 }
 
 template <typename T>

@@ -57,13 +57,16 @@ double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) {
 
 SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name) {
   SurfaceInput input;
+  MeshFile file;
   {
     Timer timer("Loading " + path);
-    input.mesh = loadMesh(path, &input.sensor_pose);
-    timer.done(static_cast<std::size_t>(input.mesh.cloud.width) * input.mesh.cloud.height);
+    file = readMeshFile(path);
+    timer.done(static_cast<std::size_t>(file.positions.cols()));
   }
-  if (!input.mesh.polygons.empty()) {
-    SurfaceMesh mesh = checkSurfaceMesh(std::move(input.mesh), tool_name);
+  input.sensor_pose = file.sensor_pose;
+  input.coordinate_precision = file.coordinate_precision;
+  if (!file.mesh.polygons.empty()) {
+    SurfaceMesh mesh = checkSurfaceMesh(std::move(file), tool_name);
     input.points = toXYZ(mesh.positions);
     input.spacing = meanEdgeLength(mesh.topology, mesh.positions);
     input.topology = std::make_shared<const MeshTopology>(std::move(mesh.topology));
@@ -71,9 +74,9 @@ SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name) {
     input.mesh = std::move(mesh.mesh);
     return input;
   }
-  input.positions = vertexPositions(input.mesh.cloud, NonFinitePolicy::Keep);
+  input.mesh = std::move(file.mesh);
+  input.positions = std::move(file.positions);
   const Eigen::Matrix3Xd& positions = input.positions;
-  if (positions.cols() == 0) throw std::runtime_error(path + " has no points");
   const NonFiniteVertices bad = findNonFiniteVertices(positions);
   if (bad.count == positions.cols()) throw std::runtime_error(path + " has no finite point");
   if (bad.count > 0)

@@ -22,13 +22,14 @@ namespace tools {
 
 /** A mesh (topology set, coordinates finite) or a point cloud (no topology, NaN points kept). */
 struct SurfaceInput {
-  pcl::PolygonMesh mesh;
+  pcl::PolygonMesh mesh;  ///< x, y, z as float (PCL's point types); positions holds them exactly
   std::shared_ptr<const MeshTopology> topology;
   Eigen::Matrix3Xd positions;                  ///< double, as read
   pcl::PointCloud<pcl::PointXYZ>::Ptr points;  ///< the same, as PCL points
   /** Mean edge length of a mesh, or mean nearest-neighbour distance of a cloud. */
   double spacing = 0.0;
   SensorPose sensor_pose;  ///< a PCD's VIEWPOINT (kept for the output)
+  FieldPrecision coordinate_precision = FieldPrecision::Float;  ///< as the file declares them
 };
 
 /** Loads a mesh or a cloud, with the warnings of loadSurfaceMesh for meshes and a count of

@@ -11,16 +11,17 @@ namespace tools {
 
 SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name) {
   Timer timer("Loading " + path);
-  pcl::PolygonMesh mesh = loadMesh(path);
-  if (mesh.polygons.empty()) throw std::runtime_error(path + " has no faces (a point cloud?)");
-  timer.done(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height);
-  return checkSurfaceMesh(std::move(mesh), tool_name);
+  MeshFile file = readMeshFile(path);
+  if (file.mesh.polygons.empty()) throw std::runtime_error(path + " has no faces (a point cloud?)");
+  timer.done(static_cast<std::size_t>(file.positions.cols()));
+  return checkSurfaceMesh(std::move(file), tool_name);
 }
 
-SurfaceMesh checkSurfaceMesh(pcl::PolygonMesh mesh, const char* tool_name) {
+SurfaceMesh checkSurfaceMesh(MeshFile file, const char* tool_name) {
   Timer timer("Building the mesh topology");
-  MeshTopology topology(mesh);
-  Eigen::Matrix3Xd positions = vertexPositions(mesh.cloud);
+  requireFinite(file.positions);
+  MeshTopology topology(file.mesh);
+  Eigen::Matrix3Xd& positions = file.positions;
   // Only the defects worth a warning (pcl_ddg_info makes the whole MeshReport).
   const TopologyCounts& counts = topology.counts();
   const std::int64_t degenerate =
@@ -36,7 +37,8 @@ SurfaceMesh checkSurfaceMesh(pcl::PolygonMesh mesh, const char* tool_name) {
   for (const auto& [count, what] : defects) {
     if (count > 0) warn(tool_name, std::to_string(count) + " " + what);
   }
-  return {std::move(mesh), std::move(topology), std::move(positions)};
+  return {std::move(file.mesh), std::move(topology), std::move(positions),
+          file.coordinate_precision};
 }
 
 MassType massTypeArgument(const ToolArguments& args, const std::string& option) {
@@ -72,8 +74,28 @@ void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
   }
 }
 
-void saveResult(const std::string& path, const pcl::PolygonMesh& mesh,
+FieldPrecision coordinatePrecision(FieldPrecision input, FieldPrecision requested) {
+  return input == FieldPrecision::Double || requested == FieldPrecision::Double
+             ? FieldPrecision::Double
+             : FieldPrecision::Float;
+}
+
+void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh& mesh,
+                const Eigen::Matrix3Xd& positions, FieldPrecision coordinates,
                 const SensorPose& sensor_pose) {
+  setVertexCoordinates(mesh.cloud, positions, coordinates);
+  if (fileExtension(path) == "pcd") {
+    std::string doubles;
+    for (const auto& f : mesh.cloud.fields) {
+      if (f.datatype == pcl::PCLPointField::FLOAT64)
+        doubles += (doubles.empty() ? "" : " ") + f.name;
+    }
+    if (!doubles.empty()) {
+      warn(tool_name, path + " gets double fields (" + doubles +
+                          "), which pcl::io::loadPCDFile cannot read into PCL's float "
+                          "point types (pcl::PointXYZ, pcl::Normal, ...)");
+    }
+  }
   Timer timer("Saving " + path);
   MeshWriteOptions options;
   options.sensor_pose = sensor_pose;

@@ -17,17 +17,18 @@ namespace pcl_ddg {
 namespace tools {
 
 struct SurfaceMesh {
-  pcl::PolygonMesh mesh;
+  pcl::PolygonMesh mesh;  ///< x, y, z as float (PCL's point types); positions holds them exactly
   MeshTopology topology;
   Eigen::Matrix3Xd positions;
+  FieldPrecision coordinate_precision = FieldPrecision::Float;  ///< as the file declares them
 };
 
 /** Loads a mesh with faces; throws on out-of-range indices or non-finite coordinates, prints one
  *  warning line per kind of defect (degenerate, duplicate, non-manifold, unreferenced). */
 SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name);
 
-/** The checks and warnings of loadSurfaceMesh, for a mesh already loaded. */
-SurfaceMesh checkSurfaceMesh(pcl::PolygonMesh mesh, const char* tool_name);
+/** The checks and warnings of loadSurfaceMesh, for a file already loaded. */
+SurfaceMesh checkSurfaceMesh(MeshFile file, const char* tool_name);
 
 /** A vertex-area option (-area or -mass): mixed|voronoi|barycentric, default mixed. */
 MassType massTypeArgument(const ToolArguments& args, const std::string& option);
@@ -47,9 +48,17 @@ FieldPrecision precisionArgument(const ToolArguments& args);
 void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
                      const Eigen::Matrix3Xd& normals, FieldPrecision precision);
 
-/** Saves through saveMesh (format by extension, atomic), with a timing line; a PCD output
- *  carries the sensor pose as its VIEWPOINT. */
-void saveResult(const std::string& path, const pcl::PolygonMesh& mesh,
+/** The precision of an output's coordinates: double when the input declared them double or
+ *  -precision double asks for it, float otherwise. */
+FieldPrecision coordinatePrecision(FieldPrecision input, FieldPrecision requested);
+
+/**
+ * Writes positions into the mesh as x, y, z in the given precision and saves it through saveMesh
+ * (format by extension, atomic), with a timing line; a PCD output carries the sensor pose as its
+ * VIEWPOINT. Warns when a .pcd gets double fields, which PCL's float point types cannot read.
+ */
+void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh& mesh,
+                const Eigen::Matrix3Xd& positions, FieldPrecision coordinates,
                 const SensorPose& sensor_pose = {});
 
 }  // namespace tools

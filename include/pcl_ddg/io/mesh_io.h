@@ -5,14 +5,18 @@
 // .stl (ascii/binary), .vtk (legacy POLYDATA), .pcd (organized or not; no faces).
 // Written: .ply (binary by default) and .pcd (binary_compressed, as PCL's tools write it; faces
 // are not stored).
-// A cloud is a mesh without polygons. All vertex fields are kept as they are stored (a double
-// coordinate stays double). Malformed, truncated or unknown files raise FileFormatException with
-// the path and the reason; output goes through a temporary file renamed on success, so a failed
-// save leaves no file behind.
+// A cloud is a mesh without polygons. The mesh hands PCL what its point types read: x, y, z as
+// FLOAT32 (pcl::fromPCLPointCloud2 into pcl::PointXYZ works after any load); the coordinates as
+// the file holds them (double text, binary doubles) are kept exactly beside it (MeshFile).
+// Every other vertex field is kept as stored. Malformed, truncated or unknown files raise
+// FileFormatException with the path and the reason; output goes through a temporary file renamed on
+// success, so a failed save leaves no file behind.
 #include <pcl/PolygonMesh.h>
 
 #include <Eigen/Geometry>
 #include <string>
+
+#include "pcl_ddg/io/vertex_fields.h"
 
 namespace pcl_ddg {
 
@@ -30,7 +34,21 @@ struct MeshWriteOptions {
   SensorPose sensor_pose;  ///< written as a PCD's VIEWPOINT
 };
 
-/** Loads any supported file; `sensor_pose`, if given, receives the file's VIEWPOINT (PCD). */
+/** A loaded file: the mesh as PCL code reads it, and what float fields cannot hold. */
+struct MeshFile {
+  pcl::PolygonMesh mesh;       ///< x, y, z as FLOAT32; every other field as stored
+  Eigen::Matrix3Xd positions;  ///< the file's coordinates in double, exact (NaN kept)
+  /** Double when the file declares double coordinates (PLY `double x`, PCD `F 8`, VTK
+   *  `double`), so that a tool writes them back as such; Float for float and untyped text. */
+  FieldPrecision coordinate_precision = FieldPrecision::Float;
+  SensorPose sensor_pose;  ///< a PCD file's VIEWPOINT
+};
+
+/** Loads any supported file. Throws FileFormatException when a finite coordinate lies beyond
+ *  float's range (PCL's point types could not hold it). */
+MeshFile readMeshFile(const std::string& path);
+
+/** readMeshFile's mesh; `sensor_pose`, if given, receives the file's VIEWPOINT (PCD). */
 pcl::PolygonMesh loadMesh(const std::string& path, SensorPose* sensor_pose = nullptr);
 
 void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh,
