@@ -21,12 +21,12 @@ int main(int argc, char** argv) {
   const pcl_ddg::VertexCurvatures c = pcl_ddg::computeCurvatures(topology, positions);
 
   double total_gauss = 0.0;
-  for (Eigen::Index v = 0; v < c.gauss.size(); ++v) {
-    if (c.valid[v]) total_gauss += c.gauss[v] * c.vertex_area[v];
+  for (Eigen::Index v = 0; v < c.gauss_curvature.size(); ++v) {
+    if (c.valid[v]) total_gauss += c.gauss_curvature[v] * c.vertex_area[v];
   }
   const double two_pi_chi = 2.0 * 3.14159265358979323846 * topology.eulerCharacteristic();
-  std::cout << "vertex 0: H = " << c.mean[0] << ", K = " << c.gauss[0] << ", k1 = " << c.kappa1[0]
-            << ", k2 = " << c.kappa2[0] << "\n"
+  std::cout << "vertex 0: H = " << c.mean_curvature[0] << ", K = " << c.gauss_curvature[0]
+            << ", k1 = " << c.k1[0] << ", k2 = " << c.k2[0] << "\n"
             << "sum K dA = " << total_gauss
             << ", 2 pi chi = " << 2.0 * 3.14159265358979 * topology.eulerCharacteristic() << "\n";
   return 0;

@@ -87,7 +87,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     const pcl_ddg::VertexCurvatures c = pcl_ddg::computeCurvatures(topology, positions);
     for (int v = 0; v < num_vertices; ++v) {
-      if (c.valid[v] && !std::isfinite(c.mean[v] + c.gauss[v] + c.kappa1[v] + c.kappa2[v]))
+      if (c.valid[v] &&
+          !std::isfinite(c.mean_curvature[v] + c.gauss_curvature[v] + c.k1[v] + c.k2[v]))
         __builtin_trap();
     }
   } catch (const pcl_ddg::InvalidMeshException&) {

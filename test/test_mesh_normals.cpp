@@ -128,11 +128,11 @@ TEST(MeshNormals, FaceNormalsThatCancelGiveNaNAndACountForEveryWeightingAndForH)
     for (const int v : {0, 2, 3}) EXPECT_NEAR(n.normals.col(v).norm(), 1.0, 1e-12);
   }
   const VertexCurvatures c = computeCurvatures(topology, x);
-  EXPECT_TRUE(std::isnan(c.mean[1]) && std::isnan(c.kappa1[1]) && std::isnan(c.kappa2[1]));
-  EXPECT_TRUE(std::isfinite(c.gauss[1]));  // the angle defect needs no orientation
+  EXPECT_TRUE(std::isnan(c.mean_curvature[1]) && std::isnan(c.k1[1]) && std::isnan(c.k2[1]));
+  EXPECT_TRUE(std::isfinite(c.gauss_curvature[1]));  // the angle defect needs no orientation
   EXPECT_EQ(c.valid[1], 0);
   EXPECT_EQ(c.unoriented_vertices, 1);
-  for (const int v : {0, 2, 3}) EXPECT_TRUE(std::isfinite(c.mean[v]));
+  for (const int v : {0, 2, 3}) EXPECT_TRUE(std::isfinite(c.mean_curvature[v]));
 }
 
 TEST(MeshNormals, RealScansGiveUnitFiniteNormalsWhereValid) {

@@ -86,8 +86,8 @@ TEST(ThreadDeterminism, MeshOperatorsNormalsCurvaturesAndSmoothing) {
       "mass", [&] { return bytesOf(lumpedMass(topology, x, MassType::MixedVoronoi)); });
   expectSameWithAnyThreadCount("curvatures", [&] {
     const VertexCurvatures c = computeCurvatures(topology, x);
-    Eigen::MatrixXd all(c.mean.size(), 4);
-    all << c.mean, c.gauss, c.kappa1, c.kappa2;
+    Eigen::MatrixXd all(c.mean_curvature.size(), 4);
+    all << c.mean_curvature, c.gauss_curvature, c.k1, c.k2;
     return bytesOf(all);
   });
   for (const SmoothingScheme scheme : {SmoothingScheme::Explicit, SmoothingScheme::Implicit}) {

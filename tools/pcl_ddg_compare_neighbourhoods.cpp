@@ -16,19 +16,21 @@ constexpr const char* kDescription =
     "Runs a normal estimator on a mesh with mesh-ring (BFS) and with kd-tree neighbourhoods, "
     "prints\n"
     "how far the normals differ and how much the neighbour sets overlap, and writes per-vertex\n"
-    "angle_difference (degrees) and overlap (Jaccard, 0..1), coloured by the angle difference.";
+    "angle_difference (degrees) and overlap (Jaccard, 0..1), coloured by the angle difference\n"
+    "(by default unless the input has colours of its own; -color none keeps them as they are).";
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk} output.{ply,pcd} [-method pca|quadric] [-k N (default 16)]\n"
     "         [-radius r or 2.5h (instead of -k)] [-max_nn N (with -radius; default 64)]\n"
-    "         [-precision float|double]";
+    "         [-color angle_difference|overlap|none] [-precision float|double]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(
-      argc, argv, {"method", "k", "radius", "max_nn", "viewpoint", "precision"}, {});
+      argc, argv, {"method", "k", "radius", "max_nn", "viewpoint", "precision", "color"}, {});
   if (args.positional().size() != 2)
     throw tools::UsageError("expected an input and an output file");
   const std::string method = args.choice("method", {"pca", "quadric"}, "pca");
+  args.choice("color", {"angle_difference", "overlap", "none"}, "none");
   const FieldPrecision precision = tools::precisionArgument(args);
   const std::string output = args.positional()[1];
   if (fileExtension(output) != "ply" && fileExtension(output) != "pcd") {
@@ -62,9 +64,18 @@ int run(int argc, char** argv) {
 
   setVertexField(in.mesh.cloud, "angle_difference", c.angle_difference, precision);
   setVertexField(in.mesh.cloud, "overlap", c.overlap, precision);
-  // Coloured from the smallest difference to 30 degrees (larger ones saturate).
-  Eigen::VectorXd clamped = c.angle_difference.cwiseMin(30.0);
-  setVertexColors(in.mesh.cloud, colorize(clamped, ColorMap::Sequential, {0.0, 100.0}));
+  // An input's own colours are kept unless -color asks for a map.
+  const std::string color =
+      args.text("color", vertexColorLayout(in.mesh.cloud) ? "none" : "angle_difference");
+  if (color == "angle_difference") {
+    // From the smallest difference to 30 degrees (larger ones saturate).
+    const Eigen::VectorXd clamped = c.angle_difference.cwiseMin(30.0);
+    tools::setColorMapFields(kName, in.mesh.cloud, output, color, c.angle_difference,
+                             colorize(clamped, ColorMap::Sequential, {0.0, 100.0}));
+  } else if (color == "overlap") {
+    tools::setColorMapFields(kName, in.mesh.cloud, output, color, c.overlap,
+                             colorize(c.overlap, ColorMap::Sequential, {0.0, 100.0}));
+  }
   tools::saveResult(kName, output, in.mesh, in.positions,
                     tools::coordinatePrecision(in.coordinate_precision, precision), in.sensor_pose);
   return 0;

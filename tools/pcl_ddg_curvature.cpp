@@ -82,10 +82,10 @@ int run(int argc, char** argv) {
       tools::warn(kName, std::to_string(c.clamped_vertices) +
                              " vertices with H^2 < K (umbilic or noisy): k1 = k2 = H there");
     }
-    mean = c.mean;
-    gauss = c.gauss;
-    kappa1 = c.kappa1;
-    kappa2 = c.kappa2;
+    mean = c.mean_curvature;
+    gauss = c.gauss_curvature;
+    kappa1 = c.k1;
+    kappa2 = c.k2;
     setVertexField(in.mesh.cloud, "vertex_area", c.vertex_area, precision);
   } else {
     const LocalFitOptions options = tools::localFitArguments(args, in, LocalFitMethod::Quadric);
@@ -141,8 +141,9 @@ int run(int argc, char** argv) {
                                     : color == "gauss" ? gauss
                                     : color == "k1"    ? kappa1
                                                        : kappa2;
-    setVertexColors(in.mesh.cloud,
-                    colorize(values, ColorMap::Diverging, {percentile, 100.0 - percentile}));
+    tools::setColorMapFields(
+        kName, in.mesh.cloud, output, color == "mean" || color == "gauss" ? color + "_curvature" : color,
+        values, colorize(values, ColorMap::Diverging, {percentile, 100.0 - percentile}));
   }
   tools::saveResult(kName, output, in.mesh, in.positions,
                     tools::coordinatePrecision(in.coordinate_precision, precision), in.sensor_pose);

@@ -33,8 +33,7 @@ int run(int argc, char** argv) {
     return 0;
   }
   const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);
-  const MeshReport report =
-      makeMeshReport(topology, file.positions);
+  const MeshReport report = makeMeshReport(topology, file.positions);
   std::cout << (json ? report.toJson() + "\n" : report.toText());
   return 0;
 }

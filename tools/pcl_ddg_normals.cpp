@@ -3,6 +3,7 @@
 #include "common/local_fit_job.h"
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
+#include "pcl_ddg/features/ring_surface_variation.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/surface/mesh_normals.h"
 
@@ -14,7 +15,8 @@ constexpr const char* kDescription =
     "mean_curvature) or by fitting a plane (pca) or a quadric to each point's neighbours, found "
     "on\n"
     "the mesh (bfs rings) or in space (knn, kd-tree). Writes nx ny nz (.ply) or normal_x normal_y\n"
-    "normal_z curvature (.pcd).";
+    "normal_z curvature (.pcd; for mesh methods the curvature is PCL's surface variation over\n"
+    "the vertex's 1-ring).";
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk,pcd} output.{ply,pcd}\n"
     "         [-method uniform|area|angle|mean_curvature|pca|quadric (default: area on meshes, pca "
@@ -90,6 +92,11 @@ int run(int argc, char** argv) {
                              " flat or boundary vertices took the area-weighted normal");
     }
     tools::setNormalTriple(in.mesh.cloud, output, normals.normals, precision);
+    if (fileExtension(output) == "pcd") {
+      // What pcl::PointNormal expects beside the normal: PCL's surface variation, over the 1-ring.
+      setVertexField(in.mesh.cloud, "curvature", ringSurfaceVariation(*in.topology, positions),
+                     precision);
+    }
   } else {
     const LocalFitOptions options = tools::localFitArguments(
         args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);

@@ -18,13 +18,26 @@
 namespace pcl_ddg {
 namespace {
 
+// The mesh with its colours in the layout a format's viewers read; a copy only when they differ.
+const pcl::PolygonMesh& withColorLayout(const pcl::PolygonMesh& mesh, ColorLayout layout,
+                                        pcl::PolygonMesh& converted) {
+  const auto current = vertexColorLayout(mesh.cloud);
+  if (!current || *current == layout) return mesh;
+  converted = mesh;
+  setVertexColors(converted.cloud, vertexColors(mesh.cloud), layout);
+  return converted;
+}
+
 void savePCD(const std::string& path, const pcl::PolygonMesh& mesh, const SensorPose& pose) {
-  writeBytes(path, detail::encodePCD(mesh.cloud, pose));
+  pcl::PolygonMesh converted;
+  writeBytes(path, detail::encodePCD(withColorLayout(mesh, ColorLayout::PackedRGB, converted).cloud,
+                                     pose));
 }
 
 void savePLY(const std::string& path, const pcl::PolygonMesh& mesh, PlyEncoding encoding) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  detail::writePLY(out, mesh, encoding);
+  pcl::PolygonMesh converted;
+  detail::writePLY(out, withColorLayout(mesh, ColorLayout::Channels, converted), encoding);
   out.close();
   if (!out) throw FileFormatException(std::string("write failed: ") + std::strerror(errno));
 }

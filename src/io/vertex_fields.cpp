@@ -6,6 +6,7 @@
 #include <pcl/common/io.h>
 #include <pcl/exceptions.h>
 
+#include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 
 namespace pcl_ddg {
@@ -129,14 +130,23 @@ void setVertexCoordinates(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& po
   setVertexPositions(cloud, positions);
 }
 
-void setVertexColors(pcl::PCLPointCloud2& cloud,
-                     const Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic>& rgb) {
+void setVertexColors(pcl::PCLPointCloud2& cloud, const VertexColors& rgb, ColorLayout layout) {
   const std::size_t n = pointCount(cloud);
   if (static_cast<std::size_t>(rgb.cols()) != n) {
     throw pcl::BadArgumentException("colour count does not match the vertex count");
   }
   for (const char* name : {"rgb", "rgba", "red", "green", "blue", "alpha"}) {
     removeVertexField(cloud, name);
+  }
+  if (layout == ColorLayout::PackedRGB) {
+    const std::uint32_t offset = appendField(cloud, "rgb", pcl::PCLPointField::FLOAT32, 4);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto c = rgb.col(static_cast<Eigen::Index>(i));
+      const std::uint32_t packed =
+          0xff000000u | std::uint32_t{c[0]} << 16 | std::uint32_t{c[1]} << 8 | std::uint32_t{c[2]};
+      std::memcpy(cloud.data.data() + i * cloud.point_step + offset, &packed, 4);
+    }
+    return;
   }
   const char* names[3] = {"red", "green", "blue"};
   for (int c = 0; c < 3; ++c) {
@@ -145,6 +155,51 @@ void setVertexColors(pcl::PCLPointCloud2& cloud,
       cloud.data[i * cloud.point_step + offset] = rgb(c, static_cast<Eigen::Index>(i));
     }
   }
+}
+
+namespace {
+
+const pcl::PCLPointField* packedColorField(const pcl::PCLPointCloud2& cloud) {
+  for (const auto& f : cloud.fields) {
+    if ((f.name == "rgb" || f.name == "rgba") && pcl::getFieldSize(f.datatype) == 4 && f.count == 1)
+      return &f;
+  }
+  return nullptr;
+}
+
+}  // namespace
+
+std::optional<ColorLayout> vertexColorLayout(const pcl::PCLPointCloud2& cloud) {
+  if (hasVertexField(cloud, "red") && hasVertexField(cloud, "green") &&
+      hasVertexField(cloud, "blue"))
+    return ColorLayout::Channels;
+  if (packedColorField(cloud)) return ColorLayout::PackedRGB;
+  return std::nullopt;
+}
+
+VertexColors vertexColors(const pcl::PCLPointCloud2& cloud) {
+  const auto layout = vertexColorLayout(cloud);
+  if (!layout) throw InvalidMeshException("the vertices have no colours (red green blue or rgb)");
+  const std::size_t n = pointCount(cloud);
+  VertexColors rgb(3, static_cast<Eigen::Index>(n));
+  if (*layout == ColorLayout::Channels) {
+    const char* names[3] = {"red", "green", "blue"};
+    for (int c = 0; c < 3; ++c) {
+      // Channels stored wider than uchar (e.g. float 0..255) are clamped, not wrapped.
+      const Eigen::VectorXd values = vertexScalarField(cloud, names[c]);
+      rgb.row(c) =
+          values.array().cwiseMax(0.0).cwiseMin(255.0).round().cast<std::uint8_t>().transpose();
+    }
+    return rgb;
+  }
+  const std::uint32_t offset = packedColorField(cloud)->offset;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint32_t packed = 0;
+    std::memcpy(&packed, cloud.data.data() + i * cloud.point_step + offset, 4);
+    rgb.col(static_cast<Eigen::Index>(i)) << static_cast<std::uint8_t>(packed >> 16),
+        static_cast<std::uint8_t>(packed >> 8), static_cast<std::uint8_t>(packed);
+  }
+  return rgb;
 }
 
 }  // namespace pcl_ddg

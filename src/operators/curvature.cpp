@@ -75,10 +75,10 @@ VertexCurvatures computeCurvatures(const MeshTopology& topology, const Eigen::Ma
   const double nan = std::numeric_limits<double>::quiet_NaN();
   VertexCurvatures c;
   c.vertex_area.resize(n);
-  c.mean.resize(n);
-  c.gauss.resize(n);
-  c.kappa1.resize(n);
-  c.kappa2.resize(n);
+  c.mean_curvature.resize(n);
+  c.gauss_curvature.resize(n);
+  c.k1.resize(n);
+  c.k2.resize(n);
   c.valid.assign(n, 0);
   std::int64_t clamped = 0, invalid = 0, unoriented = 0;
 #pragma omp parallel for schedule(static) reduction(+ : clamped, invalid, unoriented)
@@ -86,26 +86,26 @@ VertexCurvatures computeCurvatures(const MeshTopology& topology, const Eigen::Ma
     const VertexSums s = gather(topology, positions, v, mass);
     c.vertex_area[v] = s.mass;
     if (!(s.mass > 0.0)) {
-      c.mean[v] = c.gauss[v] = c.kappa1[v] = c.kappa2[v] = nan;
+      c.mean_curvature[v] = c.gauss_curvature[v] = c.k1[v] = c.k2[v] = nan;
       ++invalid;
       continue;
     }
-    c.gauss[v] = ((topology.isBoundary(v) ? kPi : 2.0 * kPi) - s.angle_sum) / s.mass;
+    c.gauss_curvature[v] = ((topology.isBoundary(v) ? kPi : 2.0 * kPi) - s.angle_sum) / s.mass;
     if (detail::hasCancelled(s.area_normal, s.area)) {
       // No orientation to sign H by: only K, which needs none, is given.
-      c.mean[v] = c.kappa1[v] = c.kappa2[v] = nan;
+      c.mean_curvature[v] = c.k1[v] = c.k2[v] = nan;
       ++invalid;
       ++unoriented;
       continue;
     }
     c.valid[v] = 1;
     const Eigen::Vector3d hn = -0.5 * s.laplace / s.mass;
-    c.mean[v] = hn.dot(s.area_normal) < 0.0 ? -hn.norm() : hn.norm();
-    const double discriminant = c.mean[v] * c.mean[v] - c.gauss[v];
+    c.mean_curvature[v] = hn.dot(s.area_normal) < 0.0 ? -hn.norm() : hn.norm();
+    const double discriminant = c.mean_curvature[v] * c.mean_curvature[v] - c.gauss_curvature[v];
     if (discriminant < 0.0) ++clamped;
     const double root = std::sqrt(std::max(discriminant, 0.0));
-    c.kappa1[v] = c.mean[v] + root;
-    c.kappa2[v] = c.mean[v] - root;
+    c.k1[v] = c.mean_curvature[v] + root;
+    c.k2[v] = c.mean_curvature[v] - root;
   }
   c.clamped_vertices = clamped;
   c.invalid_vertices = invalid;

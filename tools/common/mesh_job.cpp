@@ -74,6 +74,17 @@ void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
   }
 }
 
+void setColorMapFields(const char* tool_name, pcl::PCLPointCloud2& cloud,
+                       const std::string& output_path, const std::string& field_name,
+                       const Eigen::VectorXd& values, const VertexColors& colors) {
+  if (vertexColorLayout(cloud)) {
+    warn(tool_name, "the input's own colours are replaced by the colour map of " + field_name);
+  }
+  setVertexColors(cloud, colors);
+  if (fileExtension(output_path) == "ply" && !hasVertexField(cloud, "quality"))
+    setVertexField(cloud, "quality", values);
+}
+
 FieldPrecision coordinatePrecision(FieldPrecision input, FieldPrecision requested) {
   return input == FieldPrecision::Double || requested == FieldPrecision::Double
              ? FieldPrecision::Double

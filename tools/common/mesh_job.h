@@ -48,6 +48,15 @@ FieldPrecision precisionArgument(const ToolArguments& args);
 void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
                      const Eigen::Matrix3Xd& normals, FieldPrecision precision);
 
+/**
+ * Colours the output by a colour map of `values` (the field `field_name`), replacing the input's
+ * own colours and saying so; a PLY output also gets the values as `quality` (what MeshLab's
+ * quality tools read), unless the input has a quality field of its own.
+ */
+void setColorMapFields(const char* tool_name, pcl::PCLPointCloud2& cloud,
+                       const std::string& output_path, const std::string& field_name,
+                       const Eigen::VectorXd& values, const VertexColors& colors);
+
 /** The precision of an output's coordinates: double when the input declared them double or
  *  -precision double asks for it, float otherwise. */
 FieldPrecision coordinatePrecision(FieldPrecision input, FieldPrecision requested);

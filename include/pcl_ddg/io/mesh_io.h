@@ -4,7 +4,8 @@
 // Read: .ply (ascii/binary; face, tristrips or range_grid elements), .obj, .off (also binary OFF),
 // .stl (ascii/binary), .vtk (legacy POLYDATA), .pcd (organized or not; no faces).
 // Written: .ply (binary by default) and .pcd (binary_compressed, as PCL's tools write it; faces
-// are not stored).
+// are not stored). Colours are written as each format's viewers read them (ColorLayout): PLY
+// red green blue, PCD a packed rgb.
 // A cloud is a mesh without polygons. The mesh hands PCL what its point types read: x, y, z as
 // FLOAT32 (pcl::fromPCLPointCloud2 into pcl::PointXYZ works after any load); the coordinates as
 // the file holds them (double text, binary doubles) are kept exactly beside it (MeshFile).

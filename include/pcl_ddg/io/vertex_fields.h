@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 namespace pcl_ddg {
@@ -25,9 +26,23 @@ void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
 void setVertexCoordinates(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions,
                           FieldPrecision precision);
 
-/** Sets uchar fields red, green, blue (replacing any colour fields, packed rgb/rgba included). */
-void setVertexColors(pcl::PCLPointCloud2& cloud,
-                     const Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic>& rgb);
+using VertexColors = Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic>;
+
+/** How a format keeps colours: PLY as uchar red, green, blue (MeshLab, CloudCompare); PCD as one
+ *  packed float `rgb` (0xAARRGGBB, PCL's PointXYZRGB, what pcl_viewer's colour handler reads). */
+enum class ColorLayout { Channels, PackedRGB };
+
+/** Sets the colours in the given layout, replacing any colour fields (red green blue alpha, packed
+ *  rgb or rgba). */
+void setVertexColors(pcl::PCLPointCloud2& cloud, const VertexColors& rgb,
+                     ColorLayout layout = ColorLayout::Channels);
+
+/** The layout of the cloud's colours: red, green, blue fields or a packed rgb/rgba; none if it
+ *  has neither. */
+std::optional<ColorLayout> vertexColorLayout(const pcl::PCLPointCloud2& cloud);
+
+/** The cloud's colours from either layout; throws InvalidMeshException if it has none. */
+VertexColors vertexColors(const pcl::PCLPointCloud2& cloud);
 
 /** Removes a field if present; returns whether it was there. */
 bool removeVertexField(pcl::PCLPointCloud2& cloud, const std::string& name);

@@ -32,13 +32,14 @@ Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology,
                                      MassType mass = MassType::MixedVoronoi);
 
 struct VertexCurvatures {
-  Eigen::VectorXd mean;    ///< H, signed
-  Eigen::VectorXd gauss;   ///< K density (angle defect / vertex area)
-  Eigen::VectorXd kappa1;  ///< kappa1 >= kappa2
-  Eigen::VectorXd kappa2;
+  // Named as the tools' output fields; k1, k2 are pcl::PrincipalCurvatures' pc1, pc2.
+  Eigen::VectorXd mean_curvature;   ///< H, signed
+  Eigen::VectorXd gauss_curvature;  ///< K density (angle defect / vertex area)
+  Eigen::VectorXd k1;               ///< k1 >= k2
+  Eigen::VectorXd k2;
   Eigen::VectorXd vertex_area;  ///< the mass used
   std::vector<std::uint8_t> valid;
-  std::int64_t clamped_vertices = 0;     ///< H^2 < K: kappa1 = kappa2 = H there
+  std::int64_t clamped_vertices = 0;     ///< H^2 < K: k1 = k2 = H there
   std::int64_t invalid_vertices = 0;     ///< valid == 0, all causes
   std::int64_t unoriented_vertices = 0;  ///< of those, the ones whose face normals cancelled
 };
