@@ -3,6 +3,7 @@
 // temporary left behind.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 #include <vector>
@@ -167,6 +168,97 @@ TEST_F(ToolErrors, AFileWithoutExtensionOrOfAnUnknownKindIsNamedAsSuch) {
   EXPECT_NE(none.err.find("no file extension"), std::string::npos) << none.err;
   const ToolRun unknown = runTool(PCL_DDG_INFO_TOOL, path("mesh.xyz"));
   EXPECT_NE(unknown.err.find("unknown file type '.xyz'"), std::string::npos) << unknown.err;
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+// PCL's batch mode: every file of a folder, one broken file not stopping the others, a summary,
+// exit 1 when something failed.
+TEST_F(ToolErrors, BatchModeGoesOnPastABrokenFileAndSaysSo) {
+  struct Batch {
+    const Tool& tool;
+    std::vector<std::string> good;  // shared files this tool can process
+    const char* output_extension;   // "" when the tool writes no file
+  };
+  const Batch batches[] = {
+      {kTools[0], {"meshes/cow.off", "clouds/milk.pcd"}, ""},
+      {kTools[1], {"meshes/cow.off", "clouds/milk.pcd"}, "ply"},
+      {kTools[2], {"meshes/cow.off", "meshes/bun_zipper_res4.ply"}, "ply"},
+      {kTools[3], {"meshes/cow.off", "meshes/bun_zipper_res4.ply"}, "ply"},
+      {kTools[4], {"meshes/cow.off", "meshes/bun_zipper_res4.ply"}, "png"},
+      {kTools[5], {"meshes/cow.off", "meshes/bun_zipper_res4.ply"}, "ply"},
+      // A PLY range grid is an organized cloud too.
+      {kTools[6], {"range/bun000.ply"}, "ply"},
+  };
+  for (const Batch& batch : batches) {
+    SCOPED_TRACE(batch.tool.name);
+    const std::string in = path(std::string(batch.tool.name) + "_in");
+    const std::string out = path(std::string(batch.tool.name) + "_out");
+    std::filesystem::create_directories(in);
+    for (const std::string& file : batch.good)
+      std::filesystem::copy_file(sharedData(file),
+                                 in + "/" + std::filesystem::path(file).filename().string());
+    writeText(in + "/broken.off", "OFF\n3 1 0\n0 0 0\n");
+    writeText(in + "/notes.txt", "not a mesh: skipped");
+    const std::string dirs =
+        " -input_dir " + in + (*batch.output_extension ? " -output_dir " + out : "");
+    const ToolRun run = runTool(batch.tool.binary, dirs);
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_NE(run.err.find(std::string(batch.tool.name) + ": error: " + in + "/broken.off: "),
+              std::string::npos)
+        << run.err;
+    const std::string summary = std::string(batch.tool.name) + ": " +
+                                std::to_string(batch.good.size() + 1) + " files, " +
+                                std::to_string(batch.good.size()) + " done, 1 failed: broken.off";
+    EXPECT_NE(run.err.find(summary), std::string::npos) << run.err;
+    if (*batch.output_extension) {
+      std::vector<std::string> written;
+      for (const auto& entry : std::filesystem::directory_iterator(out))
+        written.push_back(entry.path().filename().string());
+      std::sort(written.begin(), written.end());
+      std::vector<std::string> expected;
+      for (const std::string& file : batch.good) {
+        const std::filesystem::path name = std::filesystem::path(file).filename();
+        const std::string ext = name.extension().string().substr(1);
+        // Kept when the tool writes that format, else the tool's first output format.
+        const bool png = std::string(batch.output_extension) == "png";
+        expected.push_back(name.stem().string() + "." +
+                           (png                            ? "png"
+                            : ext == "ply" || ext == "pcd" ? ext
+                                                           : "ply"));
+      }
+      std::sort(expected.begin(), expected.end());
+      EXPECT_EQ(written, expected);
+    }
+    // All good: exit 0.
+    std::filesystem::remove(in + "/broken.off");
+    EXPECT_EQ(runTool(batch.tool.binary, dirs).exit_code, 0);
+  }
+}
+
+TEST_F(ToolErrors, BatchModeOptionsAreCheckedFirst) {
+  std::filesystem::create_directories(path("in"));
+  const std::string normals = PCL_DDG_NORMALS_TOOL;
+  for (const std::string& arguments :
+       {" -input_dir " + path("in"), " -output_dir " + path("out") + " in.ply out.ply",
+        " -input_dir " + path("in") + " -output_dir " + path("in"),
+        " -input_dir " + path("in") + " -output_dir " + path("out") + " extra.ply",
+        " -input_dir " + path("missing") + " -output_dir " + path("out")}) {
+    const ToolRun run = runTool(normals, arguments);
+    EXPECT_EQ(run.exit_code, 2) << arguments << "\n" << run.err;
+  }
+  EXPECT_EQ(runTool(PCL_DDG_INFO_TOOL, " -input_dir " + path("in") + " -output_dir " + path("o"))
+                .exit_code,
+            2);
+  // An empty folder is a failure, not a silent success.
+  EXPECT_EQ(runTool(normals, " -input_dir " + path("in") + " -output_dir " + path("out")).exit_code,
+            1);
 }
 
 }  // namespace

@@ -27,58 +27,55 @@ int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(
       argc, argv, {"method", "k", "radius", "max_nn", "viewpoint", "precision", "color"}, {});
-  if (args.positional().size() != 2)
-    throw tools::UsageError("expected an input and an output file");
   const std::string method = args.choice("method", {"pca", "quadric"}, "pca");
   args.choice("color", {"angle_difference", "overlap", "none"}, "none");
   const FieldPrecision precision = tools::precisionArgument(args);
-  const std::string output = args.positional()[1];
-  if (fileExtension(output) != "ply" && fileExtension(output) != "pcd") {
-    throw tools::UsageError("the output must be .ply or .pcd");
-  }
   tools::checkLocalFitArguments(args);
-  tools::SurfaceInput in = tools::loadSurfaceInput(args.positional()[0], kName);
-  if (!in.topology)
-    throw std::runtime_error(args.positional()[0] +
-                             " has no faces: there are no mesh rings to compare");
-  LocalFitOptions options = tools::localFitArguments(
-      args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
-  if (!args.has("k")) options.k = 16;
+  return tools::forEachInput(
+      args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+        tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
+        if (!in.topology)
+          throw std::runtime_error(input + " has no faces: there are no mesh rings to compare");
+        LocalFitOptions options = tools::localFitArguments(
+            args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
+        if (!args.has("k")) options.k = 16;
 
-  tools::Timer timer("Comparing " + method + " normals from mesh rings and from a kd-tree");
-  const NeighbourhoodComparison c = [&] {
-    const tools::QuietPCLWarnings quiet;
-    return compareNeighbourhoods(in.points, in.topology, options);
-  }();
-  timer.done(in.points->size());
-  tools::warnAboutLocalFit(kName, c.mesh_rings);
-  tools::warnAboutLocalFit(kName, c.kd_tree);
-  const NeighbourhoodComparison::Summary& s = c.summary;
-  std::printf(
-      "angle difference (degrees) over %lld vertices: mean %.3f, median %.3f, 95th percentile "
-      "%.3f, max %.3f\n",
-      static_cast<long long>(s.compared), s.mean, s.median, s.percentile95, s.max);
-  std::printf("vertices over 5 degrees: %.2f%%, over 30 degrees: %.2f%%\n", 100.0 * s.share_over_5,
-              100.0 * s.share_over_30);
-  std::printf("neighbourhood overlap (mean Jaccard): %.3f\n", s.mean_overlap);
+        tools::Timer timer("Comparing " + method + " normals from mesh rings and from a kd-tree");
+        const NeighbourhoodComparison c = [&] {
+          const tools::QuietPCLWarnings quiet;
+          return compareNeighbourhoods(in.points, in.topology, options);
+        }();
+        timer.done(in.points->size());
+        tools::warnAboutLocalFit(kName, c.mesh_rings);
+        tools::warnAboutLocalFit(kName, c.kd_tree);
+        const NeighbourhoodComparison::Summary& s = c.summary;
+        std::printf(
+            "angle difference (degrees) over %lld vertices: mean %.3f, median %.3f, 95th "
+            "percentile "
+            "%.3f, max %.3f\n",
+            static_cast<long long>(s.compared), s.mean, s.median, s.percentile95, s.max);
+        std::printf("vertices over 5 degrees: %.2f%%, over 30 degrees: %.2f%%\n",
+                    100.0 * s.share_over_5, 100.0 * s.share_over_30);
+        std::printf("neighbourhood overlap (mean Jaccard): %.3f\n", s.mean_overlap);
 
-  setVertexField(in.mesh.cloud, "angle_difference", c.angle_difference, precision);
-  setVertexField(in.mesh.cloud, "overlap", c.overlap, precision);
-  // An input's own colours are kept unless -color asks for a map.
-  const std::string color =
-      args.text("color", vertexColorLayout(in.mesh.cloud) ? "none" : "angle_difference");
-  if (color == "angle_difference") {
-    // From the smallest difference to 30 degrees (larger ones saturate).
-    const Eigen::VectorXd clamped = c.angle_difference.cwiseMin(30.0);
-    tools::setColorMapFields(kName, in.mesh.cloud, output, color, c.angle_difference,
-                             colorize(clamped, ColorMap::Sequential, {0.0, 100.0}));
-  } else if (color == "overlap") {
-    tools::setColorMapFields(kName, in.mesh.cloud, output, color, c.overlap,
-                             colorize(c.overlap, ColorMap::Sequential, {0.0, 100.0}));
-  }
-  tools::saveResult(kName, output, in.mesh, in.positions,
-                    tools::coordinatePrecision(in.coordinate_precision, precision), in.sensor_pose);
-  return 0;
+        setVertexField(in.mesh.cloud, "angle_difference", c.angle_difference, precision);
+        setVertexField(in.mesh.cloud, "overlap", c.overlap, precision);
+        // An input's own colours are kept unless -color asks for a map.
+        const std::string color =
+            args.text("color", vertexColorLayout(in.mesh.cloud) ? "none" : "angle_difference");
+        if (color == "angle_difference") {
+          // From the smallest difference to 30 degrees (larger ones saturate).
+          const Eigen::VectorXd clamped = c.angle_difference.cwiseMin(30.0);
+          tools::setColorMapFields(kName, in.mesh.cloud, output, color, c.angle_difference,
+                                   colorize(clamped, ColorMap::Sequential, {0.0, 100.0}));
+        } else if (color == "overlap") {
+          tools::setColorMapFields(kName, in.mesh.cloud, output, color, c.overlap,
+                                   colorize(c.overlap, ColorMap::Sequential, {0.0, 100.0}));
+        }
+        tools::saveResult(kName, output, in.mesh, in.positions,
+                          tools::coordinatePrecision(in.coordinate_precision, precision),
+                          in.sensor_pose);
+      });
 }
 
 }  // namespace

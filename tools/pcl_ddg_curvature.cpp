@@ -37,17 +37,11 @@ int run(int argc, char** argv) {
                                   {"method", "area", "neighbours", "k", "radius", "max_nn",
                                    "smooth", "color", "percentile", "precision"},
                                   {});
-  if (args.positional().size() != 2)
-    throw tools::UsageError("expected an input and an output file");
   const std::string color = args.choice("color", {"none", "mean", "gauss", "k1", "k2"}, "none");
   const double percentile = args.number("percentile", 2.0);
   if (percentile < 0.0 || percentile >= 50.0)
     throw tools::UsageError("-percentile must be in [0, 50)");
   const FieldPrecision precision = tools::precisionArgument(args);
-  const std::string output = args.positional()[1];
-  if (fileExtension(output) != "ply" && fileExtension(output) != "pcd") {
-    throw tools::UsageError("the output must be .ply or .pcd");
-  }
   const std::string requested =
       args.has("method") ? args.choice("method", {"cotan", "quadric"}, "cotan") : "";
   if (requested == "quadric" && args.has("area"))
@@ -60,94 +54,107 @@ int run(int argc, char** argv) {
   const double smooth_time = args.number("smooth", 1.0);
   if (!(smooth_time > 0.0)) throw tools::UsageError("-smooth must be > 0");
 
-  tools::SurfaceInput in = tools::loadSurfaceInput(args.positional()[0], kName);
-  const std::string method = !requested.empty() ? requested : (in.topology ? "cotan" : "quadric");
-  Eigen::VectorXd mean, gauss, kappa1, kappa2;
-  if (method == "cotan") {
-    if (!in.topology)
-      throw tools::UsageError("-method cotan needs a mesh; this input is a point cloud");
-    tools::Timer timer("Computing curvatures");
-    const VertexCurvatures c = computeCurvatures(*in.topology, in.positions, mass);
-    timer.done(static_cast<std::size_t>(in.positions.cols()));
-    if (c.invalid_vertices > c.unoriented_vertices) {
-      tools::warn(kName, std::to_string(c.invalid_vertices - c.unoriented_vertices) +
-                             " vertices without area (NaN)");
-    }
-    if (c.unoriented_vertices > 0) {
-      tools::warn(kName, std::to_string(c.unoriented_vertices) +
-                             " vertices whose face normals cancel (reversed duplicate faces?): "
-                             "H, k1, k2 NaN there");
-    }
-    if (c.clamped_vertices > 0) {
-      tools::warn(kName, std::to_string(c.clamped_vertices) +
-                             " vertices with H^2 < K (umbilic or noisy): k1 = k2 = H there");
-    }
-    mean = c.mean_curvature;
-    gauss = c.gauss_curvature;
-    kappa1 = c.k1;
-    kappa2 = c.k2;
-    setVertexField(in.mesh.cloud, "vertex_area", c.vertex_area, precision);
-  } else {
-    const LocalFitOptions options = tools::localFitArguments(args, in, LocalFitMethod::Quadric);
-    tools::Timer timer("Fitting quadrics");
-    const LocalFitResult result = [&] {
-      const tools::QuietPCLWarnings quiet;
-      return fitLocalSurfaces(in.points, in.topology, options);
-    }();
-    timer.done(in.points->size());
-    tools::warnAboutLocalFit(kName, result);
-    const auto n = static_cast<Eigen::Index>(result.curvatures.size());
-    kappa1.resize(n);
-    kappa2.resize(n);
-    Eigen::Matrix3Xd direction(3, n);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const pcl::PrincipalCurvatures& c = result.curvatures[i];
-      kappa1[i] = c.pc1;
-      kappa2[i] = c.pc2;
-      direction.col(i) << c.principal_curvature_x, c.principal_curvature_y, c.principal_curvature_z;
-    }
-    mean = 0.5 * (kappa1 + kappa2);
-    gauss = kappa1.cwiseProduct(kappa2);
-    const char* names[] = {"k1_direction_x", "k1_direction_y", "k1_direction_z"};
-    for (int d = 0; d < 3; ++d)
-      setVertexField(in.mesh.cloud, names[d], direction.row(d).transpose(), precision);
-    tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
-  }
-  if (args.has("smooth")) {
-    if (!in.topology) throw tools::UsageError("-smooth needs a mesh; this input is a point cloud");
-    const double h = meanEdgeLength(*in.topology, in.positions);
-    if (!(h > 0.0)) {
-      throw std::runtime_error(
-          "-smooth: the mesh has no edge of positive length to measure the "
-          "time in");
-    }
-    HeatFlowParameters heat;
-    heat.diffusion_time = smooth_time * h * h;
-    Eigen::MatrixXd curvatures(mean.size(), 4);
-    curvatures << mean, gauss, kappa1, kappa2;
-    tools::Timer timer("Smoothing curvatures");
-    curvatures = smoothScalarFields(*in.topology, in.positions, curvatures, heat);
-    timer.done(static_cast<std::size_t>(mean.size()));
-    mean = curvatures.col(0);
-    gauss = curvatures.col(1);
-    kappa1 = curvatures.col(2);
-    kappa2 = curvatures.col(3);
-  }
-  const std::pair<const char*, const Eigen::VectorXd*> fields[] = {
-      {"mean_curvature", &mean}, {"gauss_curvature", &gauss}, {"k1", &kappa1}, {"k2", &kappa2}};
-  for (const auto& [name, values] : fields) setVertexField(in.mesh.cloud, name, *values, precision);
-  if (color != "none") {
-    const Eigen::VectorXd& values = color == "mean"    ? mean
-                                    : color == "gauss" ? gauss
-                                    : color == "k1"    ? kappa1
-                                                       : kappa2;
-    tools::setColorMapFields(
-        kName, in.mesh.cloud, output, color == "mean" || color == "gauss" ? color + "_curvature" : color,
-        values, colorize(values, ColorMap::Diverging, {percentile, 100.0 - percentile}));
-  }
-  tools::saveResult(kName, output, in.mesh, in.positions,
-                    tools::coordinatePrecision(in.coordinate_precision, precision), in.sensor_pose);
-  return 0;
+  return tools::forEachInput(
+      args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+        tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
+        const std::string method =
+            !requested.empty() ? requested : (in.topology ? "cotan" : "quadric");
+        Eigen::VectorXd mean, gauss, kappa1, kappa2;
+        if (method == "cotan") {
+          if (!in.topology)
+            throw tools::UsageError("-method cotan needs a mesh; this input is a point cloud");
+          tools::Timer timer("Computing curvatures");
+          const VertexCurvatures c = computeCurvatures(*in.topology, in.positions, mass);
+          timer.done(static_cast<std::size_t>(in.positions.cols()));
+          if (c.invalid_vertices > c.unoriented_vertices) {
+            tools::warn(kName, std::to_string(c.invalid_vertices - c.unoriented_vertices) +
+                                   " vertices without area (NaN)");
+          }
+          if (c.unoriented_vertices > 0) {
+            tools::warn(kName,
+                        std::to_string(c.unoriented_vertices) +
+                            " vertices whose face normals cancel (reversed duplicate faces?): "
+                            "H, k1, k2 NaN there");
+          }
+          if (c.clamped_vertices > 0) {
+            tools::warn(kName, std::to_string(c.clamped_vertices) +
+                                   " vertices with H^2 < K (umbilic or noisy): k1 = k2 = H there");
+          }
+          mean = c.mean_curvature;
+          gauss = c.gauss_curvature;
+          kappa1 = c.k1;
+          kappa2 = c.k2;
+          setVertexField(in.mesh.cloud, "vertex_area", c.vertex_area, precision);
+        } else {
+          const LocalFitOptions options =
+              tools::localFitArguments(args, in, LocalFitMethod::Quadric);
+          tools::Timer timer("Fitting quadrics");
+          const LocalFitResult result = [&] {
+            const tools::QuietPCLWarnings quiet;
+            return fitLocalSurfaces(in.points, in.topology, options);
+          }();
+          timer.done(in.points->size());
+          tools::warnAboutLocalFit(kName, result);
+          const auto n = static_cast<Eigen::Index>(result.curvatures.size());
+          kappa1.resize(n);
+          kappa2.resize(n);
+          Eigen::Matrix3Xd direction(3, n);
+          for (Eigen::Index i = 0; i < n; ++i) {
+            const pcl::PrincipalCurvatures& c = result.curvatures[i];
+            kappa1[i] = c.pc1;
+            kappa2[i] = c.pc2;
+            direction.col(i) << c.principal_curvature_x, c.principal_curvature_y,
+                c.principal_curvature_z;
+          }
+          mean = 0.5 * (kappa1 + kappa2);
+          gauss = kappa1.cwiseProduct(kappa2);
+          const char* names[] = {"k1_direction_x", "k1_direction_y", "k1_direction_z"};
+          for (int d = 0; d < 3; ++d)
+            setVertexField(in.mesh.cloud, names[d], direction.row(d).transpose(), precision);
+          tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
+        }
+        if (args.has("smooth")) {
+          if (!in.topology)
+            throw tools::UsageError("-smooth needs a mesh; this input is a point cloud");
+          const double h = meanEdgeLength(*in.topology, in.positions);
+          if (!(h > 0.0)) {
+            throw std::runtime_error(
+                "-smooth: the mesh has no edge of positive length to measure the "
+                "time in");
+          }
+          HeatFlowParameters heat;
+          heat.diffusion_time = smooth_time * h * h;
+          Eigen::MatrixXd curvatures(mean.size(), 4);
+          curvatures << mean, gauss, kappa1, kappa2;
+          tools::Timer timer("Smoothing curvatures");
+          curvatures = smoothScalarFields(*in.topology, in.positions, curvatures, heat);
+          timer.done(static_cast<std::size_t>(mean.size()));
+          mean = curvatures.col(0);
+          gauss = curvatures.col(1);
+          kappa1 = curvatures.col(2);
+          kappa2 = curvatures.col(3);
+        }
+        const std::pair<const char*, const Eigen::VectorXd*> fields[] = {
+            {"mean_curvature", &mean},
+            {"gauss_curvature", &gauss},
+            {"k1", &kappa1},
+            {"k2", &kappa2}};
+        for (const auto& [name, values] : fields)
+          setVertexField(in.mesh.cloud, name, *values, precision);
+        if (color != "none") {
+          const Eigen::VectorXd& values = color == "mean"    ? mean
+                                          : color == "gauss" ? gauss
+                                          : color == "k1"    ? kappa1
+                                                             : kappa2;
+          tools::setColorMapFields(
+              kName, in.mesh.cloud, output,
+              color == "mean" || color == "gauss" ? color + "_curvature" : color, values,
+              colorize(values, ColorMap::Diverging, {percentile, 100.0 - percentile}));
+        }
+        tools::saveResult(kName, output, in.mesh, in.positions,
+                          tools::coordinatePrecision(in.coordinate_precision, precision),
+                          in.sensor_pose);
+      });
 }
 
 }  // namespace

@@ -13,29 +13,29 @@ namespace {
 constexpr const char* kName = "pcl_ddg_info";
 constexpr const char* kDescription =
     "Reports the topology and defects of a mesh (or the layout of a point cloud).";
-constexpr const char* kSyntax = "input.{ply,obj,off,stl,vtk,pcd} [-json]";
+constexpr const char* kSyntax =
+    "input.{ply,obj,off,stl,vtk,pcd} [-json] | -input_dir DIR [-json] (one report per file)";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(argc, argv, {}, {"json"});
-  if (args.positional().size() != 1) throw tools::UsageError("expected one input file");
-  const std::string& path = args.positional()[0];
+  return tools::forEachInput(args, kName, {}, [&](const std::string& path, const std::string&) {
+    tools::Timer load_timer("Loading " + path);
+    const MeshFile file = readMeshFile(path);
+    const pcl::PolygonMesh& mesh = file.mesh;
+    load_timer.done(static_cast<std::size_t>(file.positions.cols()));
 
-  tools::Timer load_timer("Loading " + path);
-  const MeshFile file = readMeshFile(path);
-  const pcl::PolygonMesh& mesh = file.mesh;
-  load_timer.done(static_cast<std::size_t>(file.positions.cols()));
-
-  const bool json = args.has("json");
-  if (mesh.polygons.empty()) {
-    const CloudReport report = makeCloudReport(mesh.cloud);
+    const bool json = args.has("json");
+    if (args.has("input_dir") && !json) std::cout << "== " << path << "\n";
+    if (mesh.polygons.empty()) {
+      const CloudReport report = makeCloudReport(mesh.cloud);
+      std::cout << (json ? report.toJson() + "\n" : report.toText());
+      return;
+    }
+    const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);
+    const MeshReport report = makeMeshReport(topology, file.positions);
     std::cout << (json ? report.toJson() + "\n" : report.toText());
-    return 0;
-  }
-  const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);
-  const MeshReport report = makeMeshReport(topology, file.positions);
-  std::cout << (json ? report.toJson() + "\n" : report.toText());
-  return 0;
+  });
 }
 
 }  // namespace

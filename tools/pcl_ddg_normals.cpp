@@ -42,13 +42,7 @@ int run(int argc, char** argv) {
   const tools::ToolArguments args(
       argc, argv,
       {"method", "epsilon", "neighbours", "k", "radius", "max_nn", "viewpoint", "precision"}, {});
-  if (args.positional().size() != 2)
-    throw tools::UsageError("expected an input and an output file");
   const FieldPrecision precision = tools::precisionArgument(args);
-  const std::string output = args.positional()[1];
-  if (fileExtension(output) != "ply" && fileExtension(output) != "pcd") {
-    throw tools::UsageError("the output must be .ply or .pcd");
-  }
   const std::vector<std::string> methods = {"uniform",        "area", "angle",
                                             "mean_curvature", "pca",  "quadric"};
   const std::string requested = args.has("method") ? args.choice("method", methods, "area") : "";
@@ -63,60 +57,65 @@ int run(int argc, char** argv) {
   if (args.has("epsilon") && !(args.number("epsilon", 0.0) >= 0.0))
     throw tools::UsageError("-epsilon must be >= 0");
   tools::checkLocalFitArguments(args);
-
-  tools::SurfaceInput in = tools::loadSurfaceInput(args.positional()[0], kName);
-  const std::string method =
-      !requested.empty() ? requested : (in.topology && !neighbour_options ? "area" : "pca");
-  if (method != "pca" && method != "quadric") {
-    if (!in.topology)
-      throw tools::UsageError("-method " + method + " needs a mesh; this input is a point cloud");
-    MeshNormalOptions options;
-    options.weighting = weightingOf(method);
-    if (args.has("epsilon")) {
-      options.epsilon = args.number("epsilon", -1.0);
-      if (options.epsilon < 0.0) throw tools::UsageError("-epsilon must be >= 0");
-    }
-    const Eigen::Matrix3Xd& positions = in.positions;
-    tools::Timer timer("Computing " + method + " normals");
-    const MeshNormals normals = computeMeshNormals(*in.topology, positions, options);
-    timer.done(static_cast<std::size_t>(positions.cols()));
-    if (normals.invalid_vertices > 0) {
-      tools::warn(kName, std::to_string(normals.invalid_vertices) +
-                             " vertices without a normal (NaN), " +
-                             std::to_string(normals.cancelled_vertices) +
-                             " of them because their face normals cancel (reversed duplicate "
-                             "faces?)");
-    }
-    if (options.weighting == NormalWeighting::MeanCurvature) {
-      tools::warn(kName, std::to_string(normals.fallback_vertices) +
-                             " flat or boundary vertices took the area-weighted normal");
-    }
-    tools::setNormalTriple(in.mesh.cloud, output, normals.normals, precision);
-    if (fileExtension(output) == "pcd") {
-      // What pcl::PointNormal expects beside the normal: PCL's surface variation, over the 1-ring.
-      setVertexField(in.mesh.cloud, "curvature", ringSurfaceVariation(*in.topology, positions),
-                     precision);
-    }
-  } else {
-    const LocalFitOptions options = tools::localFitArguments(
-        args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
-    tools::Timer timer(
-        "Computing " + method + " normals (" +
-        (options.neighbourhood == NeighbourhoodKind::MeshRings ? "mesh rings" : "kd-tree") + ", " +
-        (options.radius > 0.0 ? "radius " + std::to_string(options.radius)
-                              : "k = " + std::to_string(options.k)) +
-        ")");
-    const LocalFitResult result = [&] {
-      const tools::QuietPCLWarnings quiet;
-      return fitLocalSurfaces(in.points, in.topology, options);
-    }();
-    timer.done(in.points->size());
-    tools::warnAboutLocalFit(kName, result);
-    tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
-  }
-  tools::saveResult(kName, output, in.mesh, in.positions,
-                    tools::coordinatePrecision(in.coordinate_precision, precision), in.sensor_pose);
-  return 0;
+  return tools::forEachInput(
+      args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+        tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
+        const std::string method =
+            !requested.empty() ? requested : (in.topology && !neighbour_options ? "area" : "pca");
+        if (method != "pca" && method != "quadric") {
+          if (!in.topology)
+            throw tools::UsageError("-method " + method +
+                                    " needs a mesh; this input is a point cloud");
+          MeshNormalOptions options;
+          options.weighting = weightingOf(method);
+          if (args.has("epsilon")) {
+            options.epsilon = args.number("epsilon", -1.0);
+            if (options.epsilon < 0.0) throw tools::UsageError("-epsilon must be >= 0");
+          }
+          const Eigen::Matrix3Xd& positions = in.positions;
+          tools::Timer timer("Computing " + method + " normals");
+          const MeshNormals normals = computeMeshNormals(*in.topology, positions, options);
+          timer.done(static_cast<std::size_t>(positions.cols()));
+          if (normals.invalid_vertices > 0) {
+            tools::warn(kName, std::to_string(normals.invalid_vertices) +
+                                   " vertices without a normal (NaN), " +
+                                   std::to_string(normals.cancelled_vertices) +
+                                   " of them because their face normals cancel (reversed duplicate "
+                                   "faces?)");
+          }
+          if (options.weighting == NormalWeighting::MeanCurvature) {
+            tools::warn(kName, std::to_string(normals.fallback_vertices) +
+                                   " flat or boundary vertices took the area-weighted normal");
+          }
+          tools::setNormalTriple(in.mesh.cloud, output, normals.normals, precision);
+          if (fileExtension(output) == "pcd") {
+            // What pcl::PointNormal expects beside the normal: PCL's surface variation, over the
+            // 1-ring.
+            setVertexField(in.mesh.cloud, "curvature",
+                           ringSurfaceVariation(*in.topology, positions), precision);
+          }
+        } else {
+          const LocalFitOptions options = tools::localFitArguments(
+              args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
+          tools::Timer timer(
+              "Computing " + method + " normals (" +
+              (options.neighbourhood == NeighbourhoodKind::MeshRings ? "mesh rings" : "kd-tree") +
+              ", " +
+              (options.radius > 0.0 ? "radius " + std::to_string(options.radius)
+                                    : "k = " + std::to_string(options.k)) +
+              ")");
+          const LocalFitResult result = [&] {
+            const tools::QuietPCLWarnings quiet;
+            return fitLocalSurfaces(in.points, in.topology, options);
+          }();
+          timer.done(in.points->size());
+          tools::warnAboutLocalFit(kName, result);
+          tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
+        }
+        tools::saveResult(kName, output, in.mesh, in.positions,
+                          tools::coordinatePrecision(in.coordinate_precision, precision),
+                          in.sensor_pose);
+      });
 }
 
 }  // namespace

@@ -21,11 +21,6 @@ int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(argc, argv,
                                   {"field", "map", "azimuth", "elevation", "up", "size"}, {});
-  if (args.positional().size() != 2)
-    throw tools::UsageError("expected an input and an output file");
-  const std::string& input = args.positional()[0];
-  const std::string& output = args.positional()[1];
-  if (fileExtension(output) != "png") throw tools::UsageError("the output must be a .png file");
 
   RenderOptions options;
   options.width = options.height = args.integer("size", 800);
@@ -38,29 +33,31 @@ int run(int argc, char** argv) {
                            ? ColorMap::Diverging
                            : ColorMap::Sequential;
 
-  tools::Timer load_timer("Loading " + input);
-  const MeshFile file = readMeshFile(input);
-  const pcl::PolygonMesh& mesh = file.mesh;
-  load_timer.done(static_cast<std::size_t>(file.positions.cols()));
-  if (mesh.polygons.empty()) throw std::runtime_error(input + " has no faces to render");
+  return tools::forEachInput(
+      args, kName, {"png"}, [&](const std::string& input, const std::string& output) {
+        tools::Timer load_timer("Loading " + input);
+        const MeshFile file = readMeshFile(input);
+        const pcl::PolygonMesh& mesh = file.mesh;
+        load_timer.done(static_cast<std::size_t>(file.positions.cols()));
+        if (mesh.polygons.empty()) throw std::runtime_error(input + " has no faces to render");
 
-  tools::Timer render_timer("Rendering " + output);
-  const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);
-  const Eigen::Matrix3Xd& positions = file.positions;
-  Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colors(3, positions.cols());
-  if (const auto field = args.value("field")) {
-    colors = colorize(vertexScalarField(mesh.cloud, *field), map);
-  } else if (hasVertexField(mesh.cloud, "red") && hasVertexField(mesh.cloud, "green") &&
-             hasVertexField(mesh.cloud, "blue")) {
-    colors.row(0) = vertexScalarField(mesh.cloud, "red").cast<std::uint8_t>().transpose();
-    colors.row(1) = vertexScalarField(mesh.cloud, "green").cast<std::uint8_t>().transpose();
-    colors.row(2) = vertexScalarField(mesh.cloud, "blue").cast<std::uint8_t>().transpose();
-  } else {
-    colors.setConstant(215);
-  }
-  savePNG(output, renderMesh(positions, topology.triangles(), colors, options));
-  render_timer.done(static_cast<std::size_t>(positions.cols()));
-  return 0;
+        tools::Timer render_timer("Rendering " + output);
+        const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);
+        const Eigen::Matrix3Xd& positions = file.positions;
+        Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colors(3, positions.cols());
+        if (const auto field = args.value("field")) {
+          colors = colorize(vertexScalarField(mesh.cloud, *field), map);
+        } else if (hasVertexField(mesh.cloud, "red") && hasVertexField(mesh.cloud, "green") &&
+                   hasVertexField(mesh.cloud, "blue")) {
+          colors.row(0) = vertexScalarField(mesh.cloud, "red").cast<std::uint8_t>().transpose();
+          colors.row(1) = vertexScalarField(mesh.cloud, "green").cast<std::uint8_t>().transpose();
+          colors.row(2) = vertexScalarField(mesh.cloud, "blue").cast<std::uint8_t>().transpose();
+        } else {
+          colors.setConstant(215);
+        }
+        savePNG(output, renderMesh(positions, topology.triangles(), colors, options));
+        render_timer.done(static_cast<std::size_t>(positions.cols()));
+      });
 }
 
 }  // namespace

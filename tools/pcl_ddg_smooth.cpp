@@ -22,7 +22,7 @@ constexpr const char* kDescription =
     "iteration; any step). The time step -lambda_dt is in units of h^2 (h = mean edge length), so\n"
     "one command line works on any scan; -absolute_time takes it in length^2.";
 constexpr const char* kSyntax =
-    "input.{ply,obj,off,stl,vtk} output.{ply,obj,off,pcd}\n"
+    "input.{ply,obj,off,stl,vtk} output.{ply,pcd}\n"
     "         [-method explicit|implicit (default implicit)] [-weights uniform|cotan (default "
     "cotan)]\n"
     "         [-mass mixed|voronoi|barycentric] [-lambda_dt t (default: implicit 1, explicit half "
@@ -37,8 +37,6 @@ int run(int argc, char** argv) {
       argc, argv,
       {"method", "weights", "mass", "lambda_dt", "iterations", "preserve", "solver", "precision"},
       {"absolute_time", "freeze_weights", "rebuild_weights", "fix_boundary", "allow_unstable"});
-  if (args.positional().size() != 2)
-    throw tools::UsageError("expected an input and an output file");
   MeshSmoothingParameters p;
   p.scheme = args.choice("method", {"explicit", "implicit"}, "implicit") == "explicit"
                  ? SmoothingScheme::Explicit
@@ -67,81 +65,86 @@ int run(int argc, char** argv) {
     throw tools::UsageError("-lambda_dt must be > 0");
   const FieldPrecision precision = tools::precisionArgument(args);
 
-  tools::SurfaceMesh in = tools::loadSurfaceMesh(args.positional()[0], kName);
-  const double h = meanEdgeLength(in.topology, in.positions);
-  if (!(h > 0.0)) throw std::runtime_error("the mesh has no edge of positive length");
-  if (p.scheme == SmoothingScheme::Explicit) {
-    const double bound = explicitStabilityLimit(in.topology, in.positions, p.weights, p.mass);
-    p.time_step = args.has("lambda_dt")
-                      ? (args.has("absolute_time") ? lambda_dt : lambda_dt * h * h)
-                      : 0.5 * bound;
-    std::cerr << kName << ": explicit step " << p.time_step / (h * h) << " h^2; stability bound "
-              << bound / (h * h) << " h^2\n";
-    if (p.time_step > bound) {
-      if (!args.has("allow_unstable")) {
-        throw pcl::BadArgumentException(
-            "the explicit step " + std::to_string(p.time_step / (h * h)) +
-            " h^2 exceeds the stability bound " + std::to_string(bound / (h * h)) +
-            " h^2: the surface would blow up (use -method implicit for large steps, or "
-            "-allow_unstable)");
-      }
-      tools::warn(kName,
-                  "the step exceeds the explicit stability bound: expect the surface to "
-                  "blow up");
-    }
-  } else {
-    p.time_step = args.has("absolute_time") ? lambda_dt : lambda_dt * h * h;
-  }
+  return tools::forEachInput(
+      args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+        tools::SurfaceMesh in = tools::loadSurfaceMesh(input, kName);
+        const double h = meanEdgeLength(in.topology, in.positions);
+        if (!(h > 0.0)) throw std::runtime_error("the mesh has no edge of positive length");
+        if (p.scheme == SmoothingScheme::Explicit) {
+          const double bound = explicitStabilityLimit(in.topology, in.positions, p.weights, p.mass);
+          p.time_step = args.has("lambda_dt")
+                            ? (args.has("absolute_time") ? lambda_dt : lambda_dt * h * h)
+                            : 0.5 * bound;
+          std::cerr << kName << ": explicit step " << p.time_step / (h * h)
+                    << " h^2; stability bound " << bound / (h * h) << " h^2\n";
+          if (p.time_step > bound) {
+            if (!args.has("allow_unstable")) {
+              throw pcl::BadArgumentException(
+                  "the explicit step " + std::to_string(p.time_step / (h * h)) +
+                  " h^2 exceeds the stability bound " + std::to_string(bound / (h * h)) +
+                  " h^2: the surface would blow up (use -method implicit for large steps, or "
+                  "-allow_unstable)");
+            }
+            tools::warn(kName,
+                        "the step exceeds the explicit stability bound: expect the surface to "
+                        "blow up");
+          }
+        } else {
+          p.time_step = args.has("absolute_time") ? lambda_dt : lambda_dt * h * h;
+        }
 
-  const std::size_t points = static_cast<std::size_t>(in.positions.cols());
-  tools::Timer timer("Smoothing");
-  tools::ProgressBar progress("> Smoothing");  // redrawn over the Timer's line
-  MeshSmoothingReport report;
-  const Eigen::Matrix3Xd smoothed =
-      smoothMeshPositions(in.topology, in.positions, p, &report,
-                          [&](int done, int total) { progress.update(done, total); });
-  progress.finish();
-  timer.done(points);
-  if (p.scheme == SmoothingScheme::Implicit) {
-    std::cerr << kName << ": " << report.iterations << " implicit step(s) of "
-              << p.time_step / (h * h) << " h^2, solver " << toString(report.solver) << "\n";
-  }
-  if (report.fixed_vertices == in.topology.numVertices()) {
-    tools::warn(kName,
-                "no vertex is free to move (all on the fixed boundary or without area): "
-                "the output equals the input");
-  } else if (report.fixed_vertices > 0) {
-    std::cerr << kName << ": " << report.fixed_vertices << " vertices kept in place\n";
-  }
-  if (report.volume_before != 0.0) {
-    std::cerr << kName << ": volume " << report.volume_before << " -> " << report.volume_after
-              << ", area " << report.area_before << " -> " << report.area_after << "\n";
-  } else {
-    std::cerr << kName << ": area " << report.area_before << " -> " << report.area_after << "\n";
-  }
-  std::cerr << kName << ": smallest angle " << report.quality_before.min_angle_degrees << " -> "
-            << report.quality_after.min_angle_degrees << " deg, slivers (a corner < "
-            << kSliverAngleDegrees << " deg) " << report.quality_before.slivers << " -> "
-            << report.quality_after.slivers << "\n";
-  if (report.quality_after.slivers > report.quality_before.slivers) {
-    tools::warn(kName,
-                std::to_string(report.quality_after.slivers - report.quality_before.slivers) +
-                    " slivers created (smaller steps keep the mesh healthier" +
-                    (p.weight_update == WeightUpdate::EveryIteration
-                         ? "; rebuilt cotangent weights pinch triangles: drop -rebuild_weights)"
-                         : ")"));
-  }
-  const double area_loss = 1.0 - report.area_after / report.area_before;
-  if (p.boundary == BoundaryCondition::Free && in.topology.counts().boundary_edges > 0 &&
-      area_loss > 0.01) {
-    tools::warn(kName, "the free boundary of this open mesh shrank its area by " +
-                           std::to_string(static_cast<int>(100.0 * area_loss + 0.5)) +
-                           "% (-fix_boundary keeps the boundary in place)");
-  }
+        const std::size_t points = static_cast<std::size_t>(in.positions.cols());
+        tools::Timer timer("Smoothing");
+        tools::ProgressBar progress("> Smoothing");  // redrawn over the Timer's line
+        MeshSmoothingReport report;
+        const Eigen::Matrix3Xd smoothed =
+            smoothMeshPositions(in.topology, in.positions, p, &report,
+                                [&](int done, int total) { progress.update(done, total); });
+        progress.finish();
+        timer.done(points);
+        if (p.scheme == SmoothingScheme::Implicit) {
+          std::cerr << kName << ": " << report.iterations << " implicit step(s) of "
+                    << p.time_step / (h * h) << " h^2, solver " << toString(report.solver) << "\n";
+        }
+        if (report.fixed_vertices == in.topology.numVertices()) {
+          tools::warn(kName,
+                      "no vertex is free to move (all on the fixed boundary or without area): "
+                      "the output equals the input");
+        } else if (report.fixed_vertices > 0) {
+          std::cerr << kName << ": " << report.fixed_vertices << " vertices kept in place\n";
+        }
+        if (report.volume_before != 0.0) {
+          std::cerr << kName << ": volume " << report.volume_before << " -> " << report.volume_after
+                    << ", area " << report.area_before << " -> " << report.area_after << "\n";
+        } else {
+          std::cerr << kName << ": area " << report.area_before << " -> " << report.area_after
+                    << "\n";
+        }
+        std::cerr << kName << ": smallest angle " << report.quality_before.min_angle_degrees
+                  << " -> " << report.quality_after.min_angle_degrees
+                  << " deg, slivers (a corner < " << kSliverAngleDegrees << " deg) "
+                  << report.quality_before.slivers << " -> " << report.quality_after.slivers
+                  << "\n";
+        if (report.quality_after.slivers > report.quality_before.slivers) {
+          tools::warn(
+              kName,
+              std::to_string(report.quality_after.slivers - report.quality_before.slivers) +
+                  " slivers created (smaller steps keep the mesh healthier" +
+                  (p.weight_update == WeightUpdate::EveryIteration
+                       ? "; rebuilt cotangent weights pinch triangles: drop -rebuild_weights)"
+                       : ")"));
+        }
+        const double area_loss = 1.0 - report.area_after / report.area_before;
+        if (p.boundary == BoundaryCondition::Free && in.topology.counts().boundary_edges > 0 &&
+            area_loss > 0.01) {
+          tools::warn(kName, "the free boundary of this open mesh shrank its area by " +
+                                 std::to_string(static_cast<int>(100.0 * area_loss + 0.5)) +
+                                 "% (-fix_boundary keeps the boundary in place)");
+        }
 
-  tools::saveResult(kName, args.positional()[1], in.mesh, smoothed,
-                    tools::coordinatePrecision(in.coordinate_precision, precision));
-  return 0;
+        tools::saveResult(kName, output, in.mesh, smoothed,
+                          tools::coordinatePrecision(in.coordinate_precision, precision));
+      });
 }
 
 }  // namespace

@@ -15,7 +15,9 @@ namespace {
 
 constexpr const char* kName = "pcl_ddg_smooth_organized";
 constexpr const char* kDescription =
-    "Smooths an organized cloud (width x height, e.g. a Kinect frame) by the heat equation on its\n"
+    "Smooths an organized cloud (width x height, e.g. a Kinect frame, or a PLY range_grid scan) "
+    "by\n"
+    "the heat equation on its\n"
     "pixel grid (5-point stencil), applied to each point's range along its ray from the sensor\n"
     "origin (the PCD VIEWPOINT), so points stay on their rays. NaN pixels are holes: never "
     "filled,\n"
@@ -23,7 +25,7 @@ constexpr const char* kDescription =
     "coupled,\n"
     "so object edges stay sharp. -lambda_dt is in pixel^2; explicit steps need it below 0.25.";
 constexpr const char* kSyntax =
-    "input.pcd output.{pcd,ply} [-method explicit|implicit (default implicit)]\n"
+    "input.{pcd,ply} output.{pcd,ply} [-method explicit|implicit (default implicit)]\n"
     "         [-lambda_dt t (default: implicit 1, explicit 0.2)] [-iterations n (default 1)]\n"
     "         [-max_jump f (default 0.05)] [-solver auto|cholmod|ldlt] [-allow_unstable]";
 
@@ -31,10 +33,6 @@ int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(
       argc, argv, {"method", "lambda_dt", "iterations", "max_jump", "solver"}, {"allow_unstable"});
-  if (args.positional().size() != 2)
-    throw tools::UsageError("expected an input and an output file");
-  const std::string input = args.positional()[0];
-  if (fileExtension(input) != "pcd") throw tools::UsageError("the input must be an organized .pcd");
   GridSmoothingParameters p;
   p.scheme = args.choice("method", {"explicit", "implicit"}, "implicit") == "explicit"
                  ? SmoothingScheme::Explicit
@@ -55,36 +53,39 @@ int run(int argc, char** argv) {
     tools::warn(kName, "explicit steps of 0.25 pixel^2 or more are unstable: expect noise to grow");
   }
 
-  tools::Timer load_timer("Loading " + input);
-  MeshFile file = readMeshFile(input);
-  pcl::PolygonMesh& cloud = file.mesh;
-  const SensorPose& sensor = file.sensor_pose;
-  const std::size_t points = static_cast<std::size_t>(cloud.cloud.width) * cloud.cloud.height;
-  load_timer.done(points);
-  if (cloud.cloud.height < 2) {
-    throw std::runtime_error(input + " is not organized (height " +
-                             std::to_string(cloud.cloud.height) + ")");
-  }
+  return tools::forEachInput(
+      args, kName, {"pcd", "ply"}, [&](const std::string& input, const std::string& output) {
+        tools::Timer load_timer("Loading " + input);
+        MeshFile file = readMeshFile(input);
+        pcl::PolygonMesh& cloud = file.mesh;
+        const SensorPose& sensor = file.sensor_pose;
+        const std::size_t points = static_cast<std::size_t>(cloud.cloud.width) * cloud.cloud.height;
+        load_timer.done(points);
+        if (cloud.cloud.height < 2) {
+          throw std::runtime_error(input + " is not organized (height " +
+                                   std::to_string(cloud.cloud.height) + ")");
+        }
 
-  const Eigen::Matrix3Xd& positions = file.positions;
-  tools::Timer timer("Smoothing");
-  GridSmoothingReport report;
-  const Eigen::Matrix3Xd smoothed =
-      smoothOrganizedPositions(positions, static_cast<int>(cloud.cloud.width),
-                               static_cast<int>(cloud.cloud.height), sensor.origin, p, &report);
-  timer.done(points);
-  std::cerr << kName << ": " << report.valid_pixels << " pixels, " << report.holes << " holes, "
-            << report.cut_pairs << " neighbour pairs cut at depth jumps\n";
-  if (report.valid_pixels == 0)
-    tools::warn(kName, "no valid pixel to smooth: the output equals the input");
-  if (report.points_at_origin > 0) {
-    tools::warn(kName, std::to_string(report.points_at_origin) +
-                           " points at the sensor origin kept in place (no ray to move along)");
-  }
-  tools::saveResult(kName, args.positional()[1], cloud, smoothed,
-                    tools::coordinatePrecision(file.coordinate_precision, FieldPrecision::Float),
-                    sensor);
-  return 0;
+        const Eigen::Matrix3Xd& positions = file.positions;
+        tools::Timer timer("Smoothing");
+        GridSmoothingReport report;
+        const Eigen::Matrix3Xd smoothed = smoothOrganizedPositions(
+            positions, static_cast<int>(cloud.cloud.width), static_cast<int>(cloud.cloud.height),
+            sensor.origin, p, &report);
+        timer.done(points);
+        std::cerr << kName << ": " << report.valid_pixels << " pixels, " << report.holes
+                  << " holes, " << report.cut_pairs << " neighbour pairs cut at depth jumps\n";
+        if (report.valid_pixels == 0)
+          tools::warn(kName, "no valid pixel to smooth: the output equals the input");
+        if (report.points_at_origin > 0) {
+          tools::warn(kName,
+                      std::to_string(report.points_at_origin) +
+                          " points at the sensor origin kept in place (no ray to move along)");
+        }
+        tools::saveResult(
+            kName, output, cloud, smoothed,
+            tools::coordinatePrecision(file.coordinate_precision, FieldPrecision::Float), sensor);
+      });
 }
 
 }  // namespace

@@ -7,11 +7,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <utility>
 
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
+#include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/version.h"
 
 namespace pcl_ddg {
@@ -64,7 +66,7 @@ ToolArguments::ToolArguments(int argc, char** argv, const std::set<std::string>&
       throw HelpRequested();
     } else if (name == "version") {
       throw VersionRequested();
-    } else if (value_options.count(name)) {
+    } else if (value_options.count(name) || name == "input_dir" || name == "output_dir") {
       if (i + 1 >= argc) throw UsageError("option -" + name + " needs a value");
       values_[name] = argv[++i];
     } else if (switches.count(name)) {
@@ -121,6 +123,94 @@ int ToolArguments::integer(const std::string& option, int fallback) const {
     throw UsageError("-" + option + " needs an integer, not '" + *v + "'");
   }
   return static_cast<int>(x);
+}
+
+namespace {
+
+const char* const kReadableExtensions[] = {"ply", "obj", "off", "stl", "vtk", "pcd"};
+
+std::string extensionList(const std::vector<std::string>& extensions) {
+  std::string list;
+  for (const auto& e : extensions) list += (list.empty() ? "." : " or .") + e;
+  return list;
+}
+
+std::vector<std::string> batchInputs(const std::string& folder) {
+  std::error_code error;
+  if (!std::filesystem::is_directory(folder, error))
+    throw UsageError("-input_dir " + folder + " is not a folder");
+  std::vector<std::string> inputs;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    const std::string ext = fileExtension(entry.path().string());
+    if (entry.is_regular_file(error) &&
+        std::find(std::begin(kReadableExtensions), std::end(kReadableExtensions), ext) !=
+            std::end(kReadableExtensions))
+      inputs.push_back(entry.path().string());
+  }
+  if (error) throw std::runtime_error("cannot list " + folder + ": " + error.message());
+  if (inputs.empty())
+    throw std::runtime_error(folder + " holds no .ply .obj .off .stl .vtk or .pcd file");
+  std::sort(inputs.begin(), inputs.end());
+  return inputs;
+}
+
+}  // namespace
+
+int forEachInput(const ToolArguments& args, const char* tool_name,
+                 const std::vector<std::string>& output_extensions,
+                 const std::function<void(const std::string&, const std::string&)>& process) {
+  const bool writes = !output_extensions.empty();
+  if (!args.has("input_dir")) {
+    if (args.has("output_dir")) throw UsageError("-output_dir needs -input_dir");
+    const std::size_t expected = writes ? 2 : 1;
+    if (args.positional().size() != expected)
+      throw UsageError(writes ? "expected an input and an output file" : "expected one input file");
+    const std::string output = writes ? args.positional()[1] : "";
+    if (writes && std::find(output_extensions.begin(), output_extensions.end(),
+                            fileExtension(output)) == output_extensions.end())
+      throw UsageError("the output must be " + extensionList(output_extensions));
+    process(args.positional()[0], output);
+    return 0;
+  }
+  if (!args.positional().empty())
+    throw UsageError("-input_dir replaces the input and output files");
+  if (writes != args.has("output_dir"))
+    throw UsageError(writes ? "-input_dir needs -output_dir" : "this tool writes no files");
+  const std::filesystem::path input_dir = *args.value("input_dir");
+  const std::filesystem::path output_dir = writes ? *args.value("output_dir") : "";
+  std::error_code error;
+  if (writes && std::filesystem::equivalent(input_dir, output_dir, error))
+    throw UsageError("-output_dir must differ from -input_dir (the inputs would be overwritten)");
+  const std::vector<std::string> inputs = batchInputs(input_dir.string());
+  if (writes) std::filesystem::create_directories(output_dir);
+
+  std::vector<std::string> failed;
+  for (const std::string& input : inputs) {
+    std::string output;
+    if (writes) {
+      const std::string ext = fileExtension(input);
+      const bool kept = std::find(output_extensions.begin(), output_extensions.end(), ext) !=
+                        output_extensions.end();
+      const std::filesystem::path name = std::filesystem::path(input).stem();
+      output = (output_dir / name).string() + "." + (kept ? ext : output_extensions.front());
+    }
+    try {
+      process(input, output);
+    } catch (const std::exception& e) {
+      const std::string message = errorDescription(e);
+      // Loader errors name the file already; others get it in front.
+      printError(tool_name,
+                 message.find(input) == std::string::npos ? input + ": " + message : message);
+      failed.push_back(std::filesystem::path(input).filename().string());
+    }
+  }
+  std::string summary = std::to_string(inputs.size()) + " files, " +
+                        std::to_string(inputs.size() - failed.size()) + " done, " +
+                        std::to_string(failed.size()) + " failed";
+  for (std::size_t i = 0; i < failed.size(); ++i) summary += (i ? ", " : ": ") + failed[i];
+  endOpenLine();
+  std::fprintf(stderr, "%s: %s\n", tool_name, summary.c_str());
+  return failed.empty() ? 0 : 1;
 }
 
 int runTool(const char* name, const char* description, const char* syntax,

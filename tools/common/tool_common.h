@@ -28,7 +28,8 @@ class VersionRequested : public std::exception {};
 
 class ToolArguments {
  public:
-  /** Options taking a value and switches are given without the dash: {"k", "method"}. */
+  /** Options taking a value and switches are given without the dash: {"k", "method"}; every
+   *  tool also takes -input_dir and -output_dir (forEachInput). */
   ToolArguments(int argc, char** argv, const std::set<std::string>& value_options,
                 const std::set<std::string>& switches);
 
@@ -47,6 +48,19 @@ class ToolArguments {
   std::map<std::string, std::string> values_;
   std::set<std::string> switches_;
 };
+
+/**
+ * Runs process(input, output) on the command line's input and output files, or, with
+ * -input_dir DIR -output_dir OUT (PCL's batch mode), on every .ply .obj .off .stl .vtk .pcd file of
+ * DIR in name order, writing OUT/<stem>.<ext>: the input's extension if it is one of
+ * output_extensions, else the first of them. An empty output_extensions means the tool writes no
+ * file (no output argument, no -output_dir). In a batch one failure does not stop the others: its
+ * error line is printed, a summary ends the run, and the result is 1 if any file failed.
+ */
+int forEachInput(
+    const ToolArguments& args, const char* tool_name,
+    const std::vector<std::string>& output_extensions,
+    const std::function<void(const std::string& input, const std::string& output)>& process);
 
 /**
  * Runs a tool body: prints the one-line description and syntax on -h or a usage error, and turns
