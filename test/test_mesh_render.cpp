@@ -45,6 +45,35 @@ TEST(MeshRender, NearerSurfaceHidesFartherOne) {
   EXPECT_EQ(pixel(image, 1, 1), (std::array<int, 3>{255, 255, 255}));  // margin stays background
 }
 
+int litPixels(const Image& image) {
+  int lit = 0;
+  for (std::size_t i = 0; i < image.rgb.size(); i += 3)
+    lit += image.rgb[i] != 255 || image.rgb[i + 1] != 255 || image.rgb[i + 2] != 255;
+  return lit;
+}
+
+TEST(MeshRender, CloudsAreSplatsShadedByTheirNormalsAndNaNPointsAreSkipped) {
+  // A flat grid facing the camera, one NaN point among it.
+  const SurfaceSample plane = makePlane({32, 0.0, 1});
+  Eigen::Matrix3Xd points = plane.points;
+  points(0, 7) = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> c(3, points.cols());
+  c.setConstant(200);
+  RenderOptions o;
+  o.width = o.height = 100;
+  o.azimuth_degrees = 0;
+  o.elevation_degrees = 0;  // the viewer on +z, facing the plane
+  const Image plain = renderPoints(points, Eigen::Matrix3Xd(), c, o);
+  // The splats cover most of the square the grid spans (0.9 of the picture), not single pixels.
+  EXPECT_GT(litPixels(plain), 0.6 * 90 * 90);
+  // Normals along the view axis: Lambert shading differs from the depth cue of a flat plane.
+  const Image lit = renderPoints(points, plane.normals, c, o);
+  EXPECT_NE(pixel(lit, 50, 50), pixel(plain, 50, 50));
+  // Normals tilted away from the light make it darker.
+  const Eigen::Matrix3Xd grazing = Eigen::Vector3d(1, 0, 0).replicate(1, points.cols());
+  EXPECT_LT(pixel(renderPoints(points, grazing, c, o), 50, 50)[0], pixel(lit, 50, 50)[0]);
+}
+
 TEST(MeshRender, SavesAPngAtomically) {
   const SurfaceSample sphere = makeIcosphere(2);
   Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> c(3, sphere.points.cols());

@@ -345,10 +345,17 @@ TEST_F(MeshTools, RenderMakesAPicture) {
                               sharedData("meshes/cow.off") + " " + path("cow.png") + " -size 64");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_GT(std::filesystem::file_size(path("cow.png")), 100u);
-  EXPECT_EQ(runTool(PCL_DDG_RENDER_TOOL,
-                    sharedData("meshes/cow.off") + " " + path("cow.png") + " -field nothing")
-                .exit_code,
-            1);
+  const ToolRun missing = runTool(
+      PCL_DDG_RENDER_TOOL, sharedData("meshes/cow.off") + " " + path("cow.png") + " -field nothing");
+  EXPECT_EQ(missing.exit_code, 1);
+  // The error names what there is to choose from.
+  EXPECT_NE(missing.err.find("no 'nothing' field (it has: x y z)"), std::string::npos)
+      << missing.err;
+  // Clouds are drawn too (splats in the cloud's own colours).
+  const ToolRun cloud = runTool(PCL_DDG_RENDER_TOOL, sharedData("clouds/office1.pcd") + " " +
+                                                         path("office.png") + " -size 64");
+  ASSERT_EQ(cloud.exit_code, 0) << cloud.err;
+  EXPECT_GT(std::filesystem::file_size(path("office.png")), 100u);
   // A full disk (here a 16 KiB file-size limit, SIGXFSZ ignored; the OpenMP runtime needs a few
   // KiB for itself) is an error, not an empty PNG.
   const ToolRun full =

@@ -264,3 +264,35 @@ TEST_F(ToolErrors, BatchModeOptionsAreCheckedFirst) {
 }  // namespace
 }  // namespace test
 }  // namespace pcl_ddg
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+// On a terminal a long phase shows its running time; logs and pipes get the timing line alone.
+// (The delay is set to 0 here so that short runs count as long.)
+TEST_F(ToolErrors, LongPhasesShowTheirRunningTimeOnATerminal) {
+  const std::string cow = sharedData("meshes/cow.off");
+  const std::pair<const char*, std::string> runs[] = {
+      {PCL_DDG_INFO_TOOL, cow},
+      {PCL_DDG_NORMALS_TOOL, cow + " " + path("n.ply") + " -method pca"},
+      {PCL_DDG_SMOOTH_TOOL, cow + " " + path("s.ply") + " -iterations 3"},
+  };
+  for (const auto& [binary, arguments] : runs) {
+    SCOPED_TRACE(binary);
+    // script(1) gives the tool a pseudo-terminal as its stderr.
+    const ToolRun terminal = runTool("PCL_DDG_PROGRESS_AFTER_MS=0 script -qec '" +
+                                         std::string(binary) + " " + arguments + "' /dev/null",
+                                     "");
+    ASSERT_EQ(terminal.exit_code, 0) << terminal.out << terminal.err;
+    EXPECT_NE(terminal.out.find(" s) "), std::string::npos) << terminal.out;
+    EXPECT_NE(terminal.out.find("[done, "), std::string::npos) << terminal.out;
+    const ToolRun pipe = runTool(std::string("PCL_DDG_PROGRESS_AFTER_MS=0 ") + binary, arguments);
+    ASSERT_EQ(pipe.exit_code, 0) << pipe.err;
+    EXPECT_EQ(pipe.err.find(" s) "), std::string::npos) << pipe.err;
+  }
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg

@@ -1,6 +1,8 @@
 // pcl_ddg_render: a PNG picture of a mesh, coloured by a per-vertex field or its own colours.
 #include <pcl/PolygonMesh.h>
 
+#include <array>
+
 #include "common/tool_common.h"
 #include "pcl_ddg/io/color_map.h"
 #include "pcl_ddg/io/mesh_io.h"
@@ -12,9 +14,11 @@ namespace {
 
 constexpr const char* kName = "pcl_ddg_render";
 constexpr const char* kDescription =
-    "Renders a mesh to a PNG picture (orthographic, shaded), coloured by a vertex field.";
+    "Renders a mesh (shaded triangles) or a point cloud (splats, shaded by its normals when it "
+    "has\n"
+    "them) to a PNG picture, orthographic, coloured by a vertex field or its own colours.";
 constexpr const char* kSyntax =
-    "input.{ply,obj,off,stl,vtk} output.png [-field name] [-map diverging|sequential]\n"
+    "input.{ply,obj,off,stl,vtk,pcd} output.png [-field name] [-map diverging|sequential]\n"
     "         [-azimuth deg] [-elevation deg] [-up x|y|z] [-size pixels]";
 
 int run(int argc, char** argv) {
@@ -39,23 +43,30 @@ int run(int argc, char** argv) {
         const MeshFile file = readMeshFile(input);
         const pcl::PolygonMesh& mesh = file.mesh;
         load_timer.done(static_cast<std::size_t>(file.positions.cols()));
-        if (mesh.polygons.empty()) throw std::runtime_error(input + " has no faces to render");
-
         tools::Timer render_timer("Rendering " + output);
-        const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);
         const Eigen::Matrix3Xd& positions = file.positions;
-        Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colors(3, positions.cols());
+        VertexColors colors(3, positions.cols());
         if (const auto field = args.value("field")) {
           colors = colorize(vertexScalarField(mesh.cloud, *field), map);
-        } else if (hasVertexField(mesh.cloud, "red") && hasVertexField(mesh.cloud, "green") &&
-                   hasVertexField(mesh.cloud, "blue")) {
-          colors.row(0) = vertexScalarField(mesh.cloud, "red").cast<std::uint8_t>().transpose();
-          colors.row(1) = vertexScalarField(mesh.cloud, "green").cast<std::uint8_t>().transpose();
-          colors.row(2) = vertexScalarField(mesh.cloud, "blue").cast<std::uint8_t>().transpose();
+        } else if (vertexColorLayout(mesh.cloud)) {
+          colors = vertexColors(mesh.cloud);
         } else {
           colors.setConstant(215);
         }
-        savePNG(output, renderMesh(positions, topology.triangles(), colors, options));
+        if (mesh.polygons.empty()) {
+          // A cloud: splats, shaded by its normals when it has them (either naming).
+          Eigen::Matrix3Xd normals;
+          for (const auto& names : {std::array<const char*, 3>{"normal_x", "normal_y", "normal_z"},
+                                    std::array<const char*, 3>{"nx", "ny", "nz"}}) {
+            if (!hasVertexField(mesh.cloud, names[0]) || normals.cols() > 0) continue;
+            normals.resize(3, positions.cols());
+            for (int d = 0; d < 3; ++d) normals.row(d) = vertexScalarField(mesh.cloud, names[d]);
+          }
+          savePNG(output, renderPoints(positions, normals, colors, options));
+        } else {
+          const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);
+          savePNG(output, renderMesh(positions, topology.triangles(), colors, options));
+        }
         render_timer.done(static_cast<std::size_t>(positions.cols()));
       });
 }

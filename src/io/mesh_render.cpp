@@ -32,47 +32,66 @@ Eigen::Matrix3d viewRotation(const RenderOptions& o) {
   return r;
 }
 
+// Orthographic projection of the finite points, centred and scaled to fit the image with a margin.
+struct Screen {
+  Eigen::Matrix3Xd view;  ///< positions in the camera frame
+  double scale = 1.0;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  int width = 0, height = 0;
+
+  Screen(const Eigen::Matrix3Xd& positions, const RenderOptions& options)
+      : view(viewRotation(options) * positions), width(options.width), height(options.height) {
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
+    for (Eigen::Index i = 0; i < view.cols(); ++i) {
+      if (!view.col(i).allFinite()) continue;
+      lo = lo.cwiseMin(view.col(i));
+      hi = hi.cwiseMax(view.col(i));
+    }
+    scale = 0.9 * std::min(width / std::max(hi.x() - lo.x(), 1e-300),
+                           height / std::max(hi.y() - lo.y(), 1e-300));
+    centre = 0.5 * (lo.head<2>() + hi.head<2>());
+  }
+
+  /** Pixel x, pixel y (down), depth (larger = nearer). */
+  Eigen::Vector3d project(Eigen::Index i) const {
+    const Eigen::Vector3d v = view.col(i);
+    return {width / 2.0 + scale * (v.x() - centre.x()), height / 2.0 - scale * (v.y() - centre.y()),
+            v.z()};
+  }
+};
+
+const Eigen::Vector3d kLight = Eigen::Vector3d(-0.3, 0.5, 1.0).normalized();
+
+Image blankImage(const RenderOptions& options) {
+  Image image;
+  image.width = options.width;
+  image.height = options.height;
+  image.rgb.assign(static_cast<std::size_t>(image.width) * image.height * 3, 255);
+  return image;
+}
+
 }  // namespace
 
 Image renderMesh(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xi& triangles,
                  const Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic>& colors,
                  const RenderOptions& options) {
-  Image image;
-  image.width = options.width;
-  image.height = options.height;
-  image.rgb.assign(static_cast<std::size_t>(image.width) * image.height * 3, 255);
+  Image image = blankImage(options);
   if (triangles.cols() == 0) return image;
-
-  // View coordinates, centred and scaled to fit the image with a margin.
-  const Eigen::Matrix3d rotation = viewRotation(options);
-  Eigen::Matrix3Xd view = rotation * positions;
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (Eigen::Index i = 0; i < view.cols(); ++i) {
-    if (!view.col(i).allFinite()) continue;
-    lo = lo.cwiseMin(view.col(i));
-    hi = hi.cwiseMax(view.col(i));
-  }
-  const double scale = 0.9 * std::min(image.width / std::max(hi.x() - lo.x(), 1e-300),
-                                      image.height / std::max(hi.y() - lo.y(), 1e-300));
-  const Eigen::Vector2d centre = 0.5 * (lo.head<2>() + hi.head<2>());
-  const Eigen::Vector3d light = Eigen::Vector3d(-0.3, 0.5, 1.0).normalized();
+  const Screen screen(positions, options);
+  const Eigen::Matrix3Xd& view = screen.view;
 
   std::vector<double> depth(static_cast<std::size_t>(image.width) * image.height,
                             -std::numeric_limits<double>::infinity());
   for (Eigen::Index t = 0; t < triangles.cols(); ++t) {
     Eigen::Vector3d p[3];
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d v = view.col(triangles(k, t));
-      p[k] = {image.width / 2.0 + scale * (v.x() - centre.x()),
-              image.height / 2.0 - scale * (v.y() - centre.y()), v.z()};
-    }
+    for (int k = 0; k < 3; ++k) p[k] = screen.project(triangles(k, t));
     if (!(p[0].allFinite() && p[1].allFinite() && p[2].allFinite())) continue;
     const Eigen::Vector3d normal =
         (view.col(triangles(1, t)) - view.col(triangles(0, t)))
             .cross(view.col(triangles(2, t)) - view.col(triangles(0, t)));
     if (normal.norm() == 0.0) continue;
-    const double shade = 0.25 + 0.75 * std::abs(normal.normalized().dot(light));
+    const double shade = 0.25 + 0.75 * std::abs(normal.normalized().dot(kLight));
     const double area = (p[1].x() - p[0].x()) * (p[2].y() - p[0].y()) -
                         (p[2].x() - p[0].x()) * (p[1].y() - p[0].y());
     if (area == 0.0) continue;
@@ -103,6 +122,59 @@ Image renderMesh(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xi& tria
           for (int k = 0; k < 3; ++k) value += w[k] * colors(c, triangles(k, t));
           image.rgb[3 * pixel + c] =
               static_cast<std::uint8_t>(std::clamp(shade * value, 0.0, 255.0));
+        }
+      }
+    }
+  }
+  return image;
+}
+
+Image renderPoints(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xd& normals,
+                   const Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic>& colors,
+                   const RenderOptions& options) {
+  Image image = blankImage(options);
+  const Screen screen(positions, options);
+  std::vector<Eigen::Index> finite;
+  double z_lo = std::numeric_limits<double>::infinity(), z_hi = -z_lo;
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+    if (!positions.col(i).allFinite()) continue;
+    finite.push_back(i);
+    z_lo = std::min(z_lo, screen.view(2, i));
+    z_hi = std::max(z_hi, screen.view(2, i));
+  }
+  if (finite.empty()) return image;
+  // Splats about as wide as the spacing of a surface sampled evenly across the picture.
+  const double radius =
+      options.point_radius_pixels > 0.0
+          ? options.point_radius_pixels
+          : std::clamp(0.75 * std::sqrt(0.3 * image.width * image.height / finite.size()), 1.0,
+                       6.0);
+  const Eigen::Matrix3d rotation = viewRotation(options);
+  const bool shaded = normals.cols() == positions.cols();
+  std::vector<double> depth(static_cast<std::size_t>(image.width) * image.height,
+                            -std::numeric_limits<double>::infinity());
+  for (const Eigen::Index i : finite) {
+    const Eigen::Vector3d p = screen.project(i);
+    // Lambert by the normal where there is one, else nearer points lighter (a depth cue).
+    const Eigen::Vector3d n =
+        shaded ? Eigen::Vector3d(rotation * normals.col(i)) : Eigen::Vector3d();
+    const double shade = shaded && n.allFinite() && n.norm() > 0.0
+                             ? 0.25 + 0.75 * std::abs(n.normalized().dot(kLight))
+                             : 0.55 + 0.45 * (p.z() - z_lo) / std::max(z_hi - z_lo, 1e-300);
+    const int x0 = std::max(0, static_cast<int>(std::floor(p.x() - radius)));
+    const int x1 = std::min(image.width - 1, static_cast<int>(std::ceil(p.x() + radius)));
+    const int y0 = std::max(0, static_cast<int>(std::floor(p.y() - radius)));
+    const int y1 = std::min(image.height - 1, static_cast<int>(std::ceil(p.y() + radius)));
+    for (int y = y0; y <= y1; ++y) {
+      for (int x = x0; x <= x1; ++x) {
+        const double dx = x + 0.5 - p.x(), dy = y + 0.5 - p.y();
+        if (dx * dx + dy * dy > radius * radius) continue;
+        const std::size_t pixel = static_cast<std::size_t>(y) * image.width + x;
+        if (p.z() <= depth[pixel]) continue;
+        depth[pixel] = p.z();
+        for (int c = 0; c < 3; ++c) {
+          image.rgb[3 * pixel + c] =
+              static_cast<std::uint8_t>(std::clamp(shade * colors(c, i), 0.0, 255.0));
         }
       }
     }

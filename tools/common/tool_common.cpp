@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -21,11 +22,18 @@ namespace tools {
 namespace {
 
 // Whether stderr holds a line that has not been ended yet (a Timer label or a progress bar), and
-// what it shows.
+// what it shows. Guarded by stderrMutex() where a Timer's ticker may draw at the same time.
 struct OpenLine {
   bool open = false;
   std::string label;
+  bool ticking = false;  ///< a Timer's running time follows the label
+  bool bar = false;      ///< a ProgressBar owns the line
 };
+
+std::mutex& stderrMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
 OpenLine& openLine() {
   static OpenLine line;
   return line;
@@ -37,12 +45,17 @@ bool stderrIsTerminal() {
 
 void endOpenLine() {
   if (openLine().open) std::fputc('\n', stderr);
-  openLine().open = false;
+  openLine().open = openLine().ticking = openLine().bar = false;
 }
 
 void printLabel(const std::string& label) {
   pcl::console::print_highlight(stderr, "%s ", label.c_str());
-  openLine() = {true, label};
+  openLine() = {true, label, false, false};
+}
+
+std::chrono::milliseconds progressDelay() {
+  const char* text = std::getenv("PCL_DDG_PROGRESS_AFTER_MS");
+  return std::chrono::milliseconds(text ? std::max(0L, std::atol(text)) : 2000L);
 }
 
 bool isOption(const std::string& arg) {
@@ -241,6 +254,7 @@ int runTool(const char* name, const char* description, const char* syntax,
 }
 
 void printError(const char* tool_name, const std::string& message) {
+  const std::lock_guard<std::mutex> lock(stderrMutex());
   endOpenLine();
   std::string line = message.empty() ? std::string("unknown error") : message;
   std::replace(line.begin(), line.end(), '\n', ' ');
@@ -249,6 +263,7 @@ void printError(const char* tool_name, const std::string& message) {
 }
 
 void warn(const char* tool_name, const std::string& message) {
+  const std::lock_guard<std::mutex> lock(stderrMutex());
   endOpenLine();
   std::fprintf(stderr, "%s: warning: %s\n", tool_name, message.c_str());
 }
@@ -258,28 +273,69 @@ ProgressBar::ProgressBar(std::string label)
 
 void ProgressBar::update(int done, int total) {
   if (!enabled_ || total < 2) return;
+  const std::lock_guard<std::mutex> lock(stderrMutex());
   constexpr int kWidth = 30;
   const int filled = static_cast<int>(static_cast<long long>(kWidth) * done / total);
   std::fprintf(stderr, "\r%s [%s%s] %d/%d", label_.c_str(), std::string(filled, '#').c_str(),
                std::string(kWidth - filled, '.').c_str(), done, total);
   std::fflush(stderr);
-  openLine().open = true;
+  openLine().open = openLine().bar = true;
   drawn_ = true;
 }
 
 void ProgressBar::finish() {
+  const std::lock_guard<std::mutex> lock(stderrMutex());
   if (drawn_) std::fprintf(stderr, "\r%s \033[K", label_.c_str());
+  openLine().bar = false;
   drawn_ = false;
 }
 
 Timer::Timer(std::string what) : label_(std::move(what)) {
-  if (stderrIsTerminal()) printLabel(label_);
   clock_.tic();
+  if (!stderrIsTerminal()) return;
+  printLabel(label_);
+  ticker_ = std::thread([this] { showElapsedTime(); });
+}
+
+Timer::~Timer() {
+  stopTicker();
+}
+
+void Timer::stopTicker() {
+  if (!ticker_.joinable()) return;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    finished_ = true;
+  }
+  wake_.notify_one();
+  ticker_.join();
+}
+
+void Timer::showElapsedTime() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (wake_.wait_for(lock, progressDelay(), [this] { return finished_; })) return;
+  do {
+    const std::lock_guard<std::mutex> out(stderrMutex());
+    // Only over our own label: a warning or a progress bar since then owns the line.
+    if (openLine().open && openLine().label == label_ && !openLine().bar) {
+      std::fprintf(stderr, "\r");
+      pcl::console::print_highlight(stderr, "%s ", label_.c_str());
+      std::fprintf(stderr, "(%.0f s) ", clock_.toc() / 1000.0);
+      std::fflush(stderr);
+      openLine().ticking = true;
+    }
+  } while (!wake_.wait_for(lock, std::chrono::seconds(1), [this] { return finished_; }));
 }
 
 void Timer::done(std::size_t points) {
-  // Re-labelled when something else was printed since (or nothing was, off a terminal).
-  if (!openLine().open || openLine().label != label_) {
+  stopTicker();
+  const std::lock_guard<std::mutex> lock(stderrMutex());
+  // Re-labelled when something else was printed since (or nothing was, off a terminal), or
+  // when the running time follows the label.
+  if (openLine().ticking && openLine().label == label_) {
+    std::fprintf(stderr, "\r\033[K");
+    printLabel(label_);
+  } else if (!openLine().open || openLine().label != label_) {
     endOpenLine();
     printLabel(label_);
   }

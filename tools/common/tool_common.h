@@ -3,12 +3,15 @@
 // errors ("pcl_ddg_x: error: ...") with exit codes 0 ok / 1 failure / 2 usage, and timing lines.
 #include <pcl/console/time.h>
 
+#include <condition_variable>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace pcl_ddg {
@@ -93,17 +96,29 @@ class ProgressBar {
 
 /**
  * Prints "> Loading x [done, 12 ms : 35947 points]" lines, as PCL's tools do. On a terminal the
- * label appears at once (the user sees what is running); elsewhere (logs, pipes, tests) the whole
- * line is written by done(), so that a failure leaves exactly one line: the error.
+ * label appears at once (the user sees what is running), and a phase that takes longer than 2 s
+ * shows its running time after it, updated every second (PCL_DDG_PROGRESS_AFTER_MS changes the
+ * delay); elsewhere (logs, pipes, tests) the whole line is written by done(), so that a failure
+ * leaves exactly one line: the error.
  */
 class Timer {
  public:
   explicit Timer(std::string what);
+  ~Timer();
+  Timer(const Timer&) = delete;
+  Timer& operator=(const Timer&) = delete;
   void done(std::size_t points);
 
  private:
+  void showElapsedTime();
+  void stopTicker();
+
   std::string label_;
   pcl::console::TicToc clock_;
+  std::thread ticker_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  bool finished_ = false;
 };
 
 }  // namespace tools

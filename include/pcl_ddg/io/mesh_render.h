@@ -1,7 +1,8 @@
 #pragma once
 // A small software renderer for pictures of results (README figures, quick looks on headless
 // machines): orthographic view, z-buffer, per-vertex colours interpolated across each triangle,
-// Lambert shading by the face normal (two-sided), written as PNG.
+// Lambert shading by the face normal (two-sided); point clouds as round splats, shaded by their
+// normals when they have them; written as PNG.
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>
@@ -15,6 +16,7 @@ struct RenderOptions {
   double azimuth_degrees = 30.0;    ///< rotation about the up (y) axis
   double elevation_degrees = 20.0;  ///< camera above the horizontal plane
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  double point_radius_pixels = 0.0;  ///< splat radius for clouds; 0 = from the point count
 };
 
 struct Image {
@@ -27,6 +29,12 @@ struct Image {
 Image renderMesh(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xi& triangles,
                  const Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic>& colors,
                  const RenderOptions& options = {});
+
+/** Renders points (3 x N, NaN ones skipped) as splats with per-point colours; normals (3 x N, or
+ *  empty) shade them two-sided, else nearer points are drawn lighter. */
+Image renderPoints(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xd& normals,
+                   const Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic>& colors,
+                   const RenderOptions& options = {});
 
 /** Writes a PNG through a temporary file (atomic); throws FileFormatException. */
 void savePNG(const std::string& path, const Image& image);
