@@ -21,7 +21,7 @@ constexpr const char* kDescription =
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk} output.{ply,pcd} [-method pca|quadric] [-k N (default 16)]\n"
     "         [-radius r or 2.5h (instead of -k)] [-max_nn N (with -radius; default 64)]\n"
-    "         [-color angle_difference|overlap|none] [-precision float|double]";
+    "         [-viewpoint x,y,z] [-color angle_difference|overlap|none] [-precision float|double]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;

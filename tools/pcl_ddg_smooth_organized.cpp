@@ -15,15 +15,12 @@ namespace {
 
 constexpr const char* kName = "pcl_ddg_smooth_organized";
 constexpr const char* kDescription =
-    "Smooths an organized cloud (width x height, e.g. a Kinect frame, or a PLY range_grid scan) "
-    "by\n"
-    "the heat equation on its\n"
-    "pixel grid (5-point stencil), applied to each point's range along its ray from the sensor\n"
-    "origin (the PCD VIEWPOINT), so points stay on their rays. NaN pixels are holes: never "
-    "filled,\n"
-    "never spread. Neighbours whose ranges differ by more than -max_jump (relative) are not "
-    "coupled,\n"
-    "so object edges stay sharp. -lambda_dt is in pixel^2; explicit steps need it below 0.25.";
+    "Smooths an organized cloud (width x height: a Kinect frame, a PLY range_grid scan) by the\n"
+    "heat equation on its pixel grid (5-point stencil), applied to each point's range along its\n"
+    "ray from the sensor origin (the PCD VIEWPOINT), so points stay on their rays. NaN pixels are\n"
+    "holes: never filled, never spread. Neighbours whose ranges differ by more than -max_jump\n"
+    "(relative) are not coupled, so object edges stay sharp. -lambda_dt is in pixel^2; explicit\n"
+    "steps need it below 0.25.";
 constexpr const char* kSyntax =
     "input.{pcd,ply} output.{pcd,ply} [-method explicit|implicit (default implicit)]\n"
     "         [-lambda_dt t (default: implicit 1, explicit 0.2)] [-iterations n (default 1)]\n"

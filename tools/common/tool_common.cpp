@@ -140,6 +140,13 @@ int ToolArguments::integer(const std::string& option, int fallback) const {
 
 namespace {
 
+const char* const kCommonHelp =
+    "Every tool also takes:\n"
+    "         -input_dir DIR [-output_dir OUT]  every .ply .obj .off .stl .vtk .pcd file of DIR "
+    "(PCL's\n"
+    "                  batch mode; outputs OUT/<name>.<ext>, a failure does not stop the others)\n"
+    "         -h, -help  this text;  --version  pcl_ddg's version\n";
+
 const char* const kReadableExtensions[] = {"ply", "obj", "off", "stl", "vtk", "pcd"};
 
 std::string extensionList(const std::vector<std::string>& extensions) {
@@ -232,7 +239,7 @@ int runTool(const char* name, const char* description, const char* syntax,
   try {
     return body();
   } catch (const HelpRequested&) {
-    std::cout << description << "\nSyntax is: " << name << " " << syntax << "\n";
+    std::cout << description << "\nSyntax is: " << name << " " << syntax << "\n" << kCommonHelp;
     return 0;
   } catch (const VersionRequested&) {
     std::cout << name << " " << PCL_DDG_VERSION_STRING << "\n";
