@@ -213,10 +213,11 @@ TEST_F(MeshTools, FittedNormalsOnEverySharedCloud) {
     ASSERT_EQ(run.exit_code, 0) << run.err;
     EXPECT_NE(run.err.find("[done, "), std::string::npos);
     const pcl::PolygonMesh out = loadMesh(path("out.pcd"));
-    const Eigen::Matrix3Xd in = vertexPositions(
-        loadMesh(sharedData(std::string("clouds/") + file)).cloud, NonFinitePolicy::Keep);
+    const pcl::PolygonMesh input = loadMesh(sharedData(std::string("clouds/") + file));
+    const Eigen::Matrix3Xd in = vertexPositions(input.cloud, NonFinitePolicy::Keep);
     EXPECT_EQ(static_cast<Eigen::Index>(out.cloud.width) * out.cloud.height, in.cols())
         << "one normal per point";
+    EXPECT_EQ(out.cloud.height, input.cloud.height) << "organized stays organized";
     const int invalid = checkUnitNormals(out.cloud, "normal_x", "normal_y", "normal_z");
     EXPECT_GE(invalid, findNonFiniteVertices(in).count);
     EXPECT_TRUE(hasVertexField(out.cloud, "curvature"));

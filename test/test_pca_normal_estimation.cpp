@@ -6,6 +6,7 @@
 #include <pcl/search/kdtree.h>
 
 #include <Eigen/Eigenvalues>
+#include <atomic>
 #include <cstdio>
 #include <limits>
 
@@ -288,6 +289,56 @@ TEST(PCANormals, RadiusWithMaxNeighboursIsTheNearestWithinTheRadius) {
       normalsOf(ourNormals(cloud, std::make_shared<KdTreeSearch<pcl::PointXYZ>>(), 16));
   EXPECT_EQ(radiusEstimate(100.0, 16), by_k);
   EXPECT_NE(radiusEstimate(100.0, 0), by_k);  // uncapped: every point of the cloud
+}
+
+// Counts the neighbours every radius query hands the estimator: the work of a fit.
+class CountingKdTree : public KdTreeSearch<pcl::PointXYZ> {
+ public:
+  using KdTreeSearch<pcl::PointXYZ>::radiusSearch;
+  int radiusSearch(const pcl::PointXYZ& point, double radius, pcl::Indices& k_indices,
+                   std::vector<float>& k_sqr_distances, unsigned int max_nn) const override {
+    const int found = KdTreeSearch<pcl::PointXYZ>::radiusSearch(point, radius, k_indices,
+                                                                k_sqr_distances, max_nn);
+    neighbours_ += found;
+    return found;
+  }
+  std::int64_t neighbours() const { return neighbours_; }
+
+ private:
+  mutable std::atomic<std::int64_t> neighbours_{0};
+};
+
+TEST(PCANormals, MaxNeighboursBoundsTheWorkOfARadiusOnTheRoomScan) {
+  // Half of tutorials_room_scan1.pcd is exact duplicates: 2.5 mean spacings (0.078) hold hundreds
+  // of points in its dense parts, which made -radius 2.5h take a minute before -max_nn.
+  auto cloud = std::make_shared<Cloud>();
+  ASSERT_EQ(pcl::io::loadPCDFile(sharedData("clouds/tutorials_room_scan1.pcd"), *cloud), 0);
+  constexpr double kRadius = 0.078;
+  constexpr unsigned int kMaxNeighbours = 64;
+  const auto tree = std::make_shared<CountingKdTree>();
+  PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+  estimator.setInputCloud(cloud);
+  estimator.setSearchMethod(tree);
+  estimator.setRadiusSearch(kRadius);
+  estimator.setRadiusSearchMaxNeighbours(kMaxNeighbours);
+  Normals normals;
+  estimator.compute(normals);
+  const auto n = static_cast<std::int64_t>(cloud->size());
+  const std::int64_t capped = tree->neighbours();
+  EXPECT_LE(capped, kMaxNeighbours * n);
+  // Uncapped, the same radius finds several times more (measured on every 100th point).
+  tree->setInputCloud(cloud);
+  pcl::Indices found;
+  std::vector<float> distances;
+  std::int64_t uncapped = 0, sampled = 0;
+  for (std::size_t i = 0; i < cloud->size(); i += 100, ++sampled) {
+    if (pcl::isFinite((*cloud)[i]))
+      uncapped += tree->radiusSearch((*cloud)[i], kRadius, found, distances, 0);
+  }
+  const double capped_mean = static_cast<double>(capped) / n;
+  std::printf("room scan, radius %.3f: %.1f neighbours per point with max_nn %u, %.1f without\n",
+              kRadius, capped_mean, kMaxNeighbours, static_cast<double>(uncapped) / sampled);
+  EXPECT_GT(static_cast<double>(uncapped) / sampled, 2.0 * capped_mean);
 }
 
 TEST(PCANormals, EmptyInputFailsThroughPCLsContract) {
