@@ -272,11 +272,14 @@ namespace {
 // On a terminal a long phase shows its running time; logs and pipes get the timing line alone.
 // (The delay is set to 0 here so that short runs count as long.)
 TEST_F(ToolErrors, LongPhasesShowTheirRunningTimeOnATerminal) {
-  const std::string cow = sharedData("meshes/cow.off");
+  // Each run has a phase of a tenth of a second or more, so that the running time, drawn by a
+  // thread started with the phase, has long enough to appear.
+  const std::string igea = sharedData("meshes/igea.ply");
   const std::pair<const char*, std::string> runs[] = {
-      {PCL_DDG_INFO_TOOL, cow},
-      {PCL_DDG_NORMALS_TOOL, cow + " " + path("n.ply") + " -method pca"},
-      {PCL_DDG_SMOOTH_TOOL, cow + " " + path("s.ply") + " -iterations 3"},
+      {PCL_DDG_INFO_TOOL, igea},
+      {PCL_DDG_NORMALS_TOOL,
+       sharedData("clouds/rs1.pcd") + " " + path("n.pcd") + " -method quadric"},
+      {PCL_DDG_SMOOTH_TOOL, igea + " " + path("s.ply")},
   };
   for (const auto& [binary, arguments] : runs) {
     SCOPED_TRACE(binary);
