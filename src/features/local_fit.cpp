@@ -12,9 +12,10 @@ namespace {
 
 template <typename Estimator>
 void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
-               const std::shared_ptr<const MeshTopology>& topology,
-               const LocalFitOptions& options) {
+               const std::shared_ptr<const MeshTopology>& topology, const LocalFitOptions& options,
+               const pcl::IndicesPtr& indices) {
   estimator.setInputCloud(cloud);
+  if (indices) estimator.setIndices(indices);
   if (options.neighbourhood == NeighbourhoodKind::MeshRings) {
     estimator.setSearchMethod(std::make_shared<MeshRingSearch<pcl::PointXYZ>>(topology));
   } else {
@@ -40,6 +41,12 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
 LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
                                 const std::shared_ptr<const MeshTopology>& topology,
                                 const LocalFitOptions& options) {
+  return fitLocalSurfaces(cloud, topology, options, nullptr);
+}
+
+LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+                                const std::shared_ptr<const MeshTopology>& topology,
+                                const LocalFitOptions& options, const pcl::IndicesPtr& indices) {
   if (options.neighbourhood == NeighbourhoodKind::MeshRings && !topology) {
     throw pcl::BadArgumentException("mesh-ring neighbourhoods need a mesh (faces)");
   }
@@ -50,17 +57,17 @@ LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
   LocalFitResult result;
   if (options.method == LocalFitMethod::PCA) {
     PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
-    configure(estimator, cloud, topology, options);
+    configure(estimator, cloud, topology, options, indices);
     estimator.compute(result.normals);
     result.failed_points = estimator.getFailedPoints();
   } else {
     QuadricNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
-    configure(estimator, cloud, topology, options);
+    configure(estimator, cloud, topology, options, indices);
     estimator.computeWithCurvatures(result.normals, result.curvatures);
     result.failed_points = estimator.getFailedPoints();
     result.fallback_points = estimator.getFallbackPoints();
   }
-  if (result.normals.size() != cloud->size()) {
+  if (result.normals.size() != (indices ? indices->size() : cloud->size())) {
     throw pcl::ComputeFailedException("normal estimation failed (see the PCL error above)");
   }
   return result;

@@ -4,6 +4,7 @@
 #include <flann/algorithms/kdtree_single_index.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <numeric>
 
@@ -13,32 +14,46 @@ namespace {
 
 constexpr int kLeafSize = 10;  // FLANN's default; measured faster than PCL's 15 for k = 16
 
-// Keeps the k nearest in the caller's vectors, sorted by insertion.
+// Keeps the k nearest in the caller's vectors, ordered by (distance, index): ties are broken by
+// the point's index, so the answer is one set in one order whatever the tree's shape or the order
+// the points were visited in (a tile of a cloud, indexed in the cloud's order, gets the same
+// neighbours as the whole cloud; see pcl_ddg/tiling).
 class NearestK : public flann::ResultSet<float> {
  public:
-  NearestK(std::size_t k, pcl::Indices& indices, std::vector<float>& distances)
-      : k_(k), indices_(indices), distances_(distances) {
+  NearestK(std::size_t k, const std::vector<pcl::index_t>& ids, pcl::Indices& indices,
+           std::vector<float>& distances)
+      : k_(k), ids_(ids), indices_(indices), distances_(distances) {
     indices_.resize(k);
     distances_.resize(k);
   }
   bool full() const override { return count_ == k_; }
-  float worstDist() const override {
-    return count_ == k_ ? distances_[k_ - 1] : std::numeric_limits<float>::max();
-  }
+  // FLANN admits a point or a cell only strictly below this: one ulp above the k-th distance lets
+  // the ties through, to be decided by index.
+  float worstDist() const override { return worst_; }
   void addPoint(float distance, std::size_t index) override {
-    if (distance >= worstDist()) return;
+    const auto id = static_cast<pcl::index_t>(index);
+    if (count_ == k_ && !precedes(distance, id, k_ - 1)) return;
     std::size_t i = count_ < k_ ? count_++ : k_ - 1;
-    for (; i > 0 && distances_[i - 1] > distance; --i) {
+    for (; i > 0 && precedes(distance, id, i - 1); --i) {
       distances_[i] = distances_[i - 1];
       indices_[i] = indices_[i - 1];
     }
     distances_[i] = distance;
-    indices_[i] = static_cast<pcl::index_t>(index);
+    indices_[i] = id;
+    if (count_ == k_)
+      worst_ = std::nextafter(distances_[k_ - 1], std::numeric_limits<float>::infinity());
   }
   std::size_t count() const { return count_; }
 
  private:
+  bool precedes(float distance, pcl::index_t index, std::size_t slot) const {
+    return distance < distances_[slot] ||
+           (distance == distances_[slot] && ids_[index] < ids_[indices_[slot]]);
+  }
+
   std::size_t k_, count_ = 0;
+  const std::vector<pcl::index_t>& ids_;  // the caller's numbering, by FLANN's index
+  float worst_ = std::numeric_limits<float>::max();
   pcl::Indices& indices_;
   std::vector<float>& distances_;
 };
@@ -89,7 +104,7 @@ int PointKdTree::nearestK(const float* query, int k, pcl::Indices& indices,
     squared_distances.clear();
     return 0;
   }
-  NearestK result(std::min<std::size_t>(k, ids_.size()), indices, squared_distances);
+  NearestK result(std::min<std::size_t>(k, ids_.size()), ids_, indices, squared_distances);
   index_->tree.findNeighbors(result, query, flann::SearchParams(-1, 0.0f));
   indices.resize(result.count());
   squared_distances.resize(result.count());
@@ -126,7 +141,7 @@ int PointKdTree::withinRadius(const float* query, double radius, pcl::Indices& i
     std::iota(order.begin(), order.end(), 0);
     std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
       return squared_distances[a] < squared_distances[b] ||
-             (squared_distances[a] == squared_distances[b] && indices[a] < indices[b]);
+             (squared_distances[a] == squared_distances[b] && ids_[indices[a]] < ids_[indices[b]]);
     });
     pcl::Indices sorted_indices(order.size());
     std::vector<float> sorted_distances(order.size());

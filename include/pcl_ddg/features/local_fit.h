@@ -2,6 +2,7 @@
 // One call for the fitted estimators on a plain xyz cloud, with either kind of neighbourhood:
 // what the tools and the neighbourhood comparison use. (The estimators themselves take any PCL
 // search method; this only chooses between the two this library is about.)
+#include <pcl/pcl_base.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
@@ -50,5 +51,11 @@ struct LocalFitResult {
 LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
                                 const std::shared_ptr<const MeshTopology>& topology,
                                 const LocalFitOptions& options);
+
+/** The same for the points `indices` only (one output per index, in their order), their
+ *  neighbours taken from the whole cloud: how a tile with a halo is processed. */
+LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+                                const std::shared_ptr<const MeshTopology>& topology,
+                                const LocalFitOptions& options, const pcl::IndicesPtr& indices);
 
 }  // namespace pcl_ddg

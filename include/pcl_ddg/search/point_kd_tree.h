@@ -25,8 +25,9 @@ class PointKdTree {
 
   std::size_t size() const { return ids_.size(); }
 
-  /** The k nearest points, sorted by squared distance; returns how many (fewer if the tree is
-   *  smaller). */
+  /** The k nearest points, sorted by squared distance, ties by id: one answer whatever the tree's
+   *  shape (what makes tiled processing equal to whole-cloud processing); returns how many (fewer
+   *  if the tree is smaller). */
   int nearestK(const float* query, int k, pcl::Indices& indices,
                std::vector<float>& squared_distances) const;
 

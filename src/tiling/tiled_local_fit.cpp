@@ -1,0 +1,215 @@
+#include "pcl_ddg/tiling/tiled_local_fit.h"
+
+#include <pcl/common/point_tests.h>
+#include <pcl/exceptions.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "pcl_ddg/search/kd_tree_search.h"
+
+namespace pcl_ddg {
+namespace {
+
+// Float squared distances of points that differ in their last bits can round either way: a point
+// counts as inside the halo only with this relative margin.
+constexpr double kRoundingMargin = 1e-5;
+
+Eigen::Vector3d position(const pcl::PointXYZ& p) {
+  return p.getVector3fMap().cast<double>();
+}
+
+// How far the point may look before it could meet a point that is not gathered: the distance to
+// the nearest face of the halo box that does not lie beyond the cloud's bounds.
+double reach(const Eigen::Vector3d& q, const Eigen::AlignedBox3d& halo_box,
+             const Eigen::AlignedBox3d& bounds) {
+  double reach = std::numeric_limits<double>::infinity();
+  for (int d = 0; d < 3; ++d) {
+    if (halo_box.min()[d] > bounds.min()[d]) reach = std::min(reach, q[d] - halo_box.min()[d]);
+    if (halo_box.max()[d] < bounds.max()[d]) reach = std::min(reach, halo_box.max()[d] - q[d]);
+  }
+  return reach;
+}
+
+Eigen::AlignedBox3d grown(const Eigen::AlignedBox3d& box, double by) {
+  return {box.min().array() - by, box.max().array() + by};
+}
+
+// For k nearest: how far each own point looks (its k-th neighbour among the gathered points, never
+// nearer than the true one, widened by the rounding margin; infinite when there are fewer than k).
+std::vector<double> lookingDistances(const TilePoints& tile, int k) {
+  KdTreeSearch<pcl::PointXYZ> search;
+  search.setInputCloud(tile.points);
+  std::vector<double> distance(tile.own->size());
+#pragma omp parallel
+  {
+    pcl::Indices neighbours;
+    std::vector<float> squared_distances;
+#pragma omp for schedule(static)
+    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(tile.own->size()); ++i) {
+      const pcl::PointXYZ& q = (*tile.points)[(*tile.own)[i]];
+      const int found = search.nearestKSearch(q, k, neighbours, squared_distances);
+      distance[i] = found < k ? std::numeric_limits<double>::infinity()
+                              : std::sqrt(static_cast<double>(squared_distances.back())) *
+                                        (1.0 + kRoundingMargin) +
+                                    1e-30;
+    }
+  }
+  return distance;
+}
+
+// The positions in `points` of the given global indices (all present: gathered in order).
+pcl::IndicesPtr positionsOf(const TilePoints& points, const std::vector<std::int64_t>& wanted) {
+  auto positions = std::make_shared<pcl::Indices>();
+  for (const std::int64_t g : wanted) {
+    const auto it = std::lower_bound(points.global_index.begin(), points.global_index.end(), g);
+    positions->push_back(static_cast<pcl::index_t>(it - points.global_index.begin()));
+  }
+  return positions;
+}
+
+}  // namespace
+
+void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointGatherer& gather,
+              const FitConsumer& consume, TilingReport* report) {
+  if (options.neighbourhood != NeighbourhoodKind::KdTree)
+    throw pcl::BadArgumentException("tiles are fitted with kd-tree neighbourhoods only");
+  const Eigen::AlignedBox3d& bounds = plan.histogram.bounds();
+  TilingReport local;
+  const auto fit = [&](TilePoints& points) {
+    local.largest_gather = std::max<std::int64_t>(local.largest_gather,
+                                                  static_cast<std::int64_t>(points.points->size()));
+    if (!points.own->empty())
+      consume(points, fitLocalSurfaces(points.points, nullptr, options, points.own));
+  };
+  // k nearest: the halo the tile before needed (neighbouring tiles have alike densities).
+  double guess = 0.0;
+  for (int t = 0; t < static_cast<int>(plan.tiles.size()); ++t) {
+    const Eigen::AlignedBox3d& box = plan.tiles[t].box;
+    double halo = options.radius > 0.0 ? options.radius * (1.0 + kRoundingMargin) : guess;
+    TilePoints points = gather(t, grown(box, halo));
+    if (options.radius > 0.0) {
+      local.widest_halo = std::max(local.widest_halo, halo);
+      fit(points);
+      continue;
+    }
+    for (int round = 0;; ++round) {
+      const Eigen::AlignedBox3d halo_box = grown(box, halo);
+      const std::vector<double> looking = lookingDistances(points, options.k);
+      // The halo each point needs (its look beyond what the current halo gives it).
+      std::vector<double> needed(looking.size());
+      for (std::size_t i = 0; i < looking.size(); ++i) {
+        const Eigen::Vector3d q = position((*points.points)[(*points.own)[i]]);
+        needed[i] = std::max(0.0, halo + looking[i] - reach(q, halo_box, bounds));
+      }
+      std::vector<double> sorted = needed;
+      const std::size_t p99 = sorted.size() - 1 - sorted.size() / 100;
+      std::nth_element(sorted.begin(), sorted.begin() + p99, sorted.end());
+      guess = std::isfinite(sorted[p99]) ? sorted[p99] : halo;
+      if (sorted[p99] > halo && round < 2) {
+        // More than 1% look beyond: the halo itself is too narrow.
+        halo = std::isfinite(sorted[p99]) ? 1.05 * sorted[p99] : 2.0 * halo + box.sizes().norm();
+        points = gather(t, grown(box, halo));
+        ++local.halo_growths;
+        continue;
+      }
+      local.widest_halo = std::max(local.widest_halo, halo);
+      // The points that look beyond the halo are fitted apart, with what lies around them.
+      std::vector<std::int64_t> far;
+      Eigen::AlignedBox3d around;
+      auto inside = std::make_shared<pcl::Indices>();
+      for (std::size_t i = 0; i < needed.size(); ++i) {
+        const pcl::index_t at = (*points.own)[i];
+        if (needed[i] <= halo) {
+          inside->push_back(at);
+          continue;
+        }
+        far.push_back(points.global_index[at]);
+        const Eigen::Vector3d q = position((*points.points)[at]);
+        around.extend(std::isfinite(looking[i]) ? grown(Eigen::AlignedBox3d(q, q), looking[i])
+                                                : bounds);
+      }
+      points.own = inside;
+      fit(points);
+      if (!far.empty()) {
+        TilePoints far_points = gather(-1, around.intersection(grown(bounds, 1.0)));
+        far_points.own = positionsOf(far_points, far);
+        local.far_points += static_cast<std::int64_t>(far.size());
+        fit(far_points);
+      }
+      break;
+    }
+  }
+  local.tiles = plan.tiles.size();
+  if (report) *report = local;
+}
+
+LocalFitResult fitLocalSurfacesTiled(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+                                     const LocalFitOptions& options, const TilingOptions& tiling,
+                                     TilingReport* report) {
+  if (!cloud || cloud->empty()) throw pcl::BadArgumentException("the cloud is empty");
+  const std::size_t n = cloud->size();
+  Eigen::AlignedBox3d bounds;
+  for (const auto& p : *cloud)
+    if (pcl::isXYZFinite(p)) bounds.extend(position(p));
+
+  LocalFitResult result;
+  pcl::Normal invalid;
+  invalid.normal_x = invalid.normal_y = invalid.normal_z = invalid.curvature =
+      std::numeric_limits<float>::quiet_NaN();
+  result.normals.assign(n, invalid);
+  result.normals.width = cloud->width;  // an organized cloud stays organized, as in PCL
+  result.normals.height = cloud->height;
+  if (options.method == LocalFitMethod::Quadric) {
+    pcl::PrincipalCurvatures none;
+    none.principal_curvature_x = none.principal_curvature_y = none.principal_curvature_z =
+        none.pc1 = none.pc2 = std::numeric_limits<float>::quiet_NaN();
+    result.curvatures.assign(n, none);
+  }
+  result.normals.is_dense = true;
+  for (const auto& p : *cloud) {
+    if (pcl::isXYZFinite(p)) continue;
+    ++result.failed_points;  // as the estimator counts them
+    result.normals.is_dense = false;
+  }
+  if (bounds.isEmpty()) return result;
+
+  PointHistogram histogram(bounds, tiling.resolution);
+  std::vector<int> cell(n, -1);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!pcl::isXYZFinite((*cloud)[i])) continue;
+    cell[i] = histogram.cellOf(position((*cloud)[i]));
+    histogram.add(position((*cloud)[i]));
+  }
+  const TilePlan plan = planTiles(histogram, tiling.max_points_per_tile);
+
+  const auto gather = [&](int tile, const Eigen::AlignedBox3d& region) {
+    TilePoints points;
+    points.points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+    points.own = std::make_shared<pcl::Indices>();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (cell[i] < 0) continue;
+      const bool own = tile >= 0 && plan.tile_of_cell[cell[i]] == tile;
+      if (!own && !region.contains(position((*cloud)[i]))) continue;
+      if (own) points.own->push_back(static_cast<pcl::index_t>(points.points->size()));
+      points.points->push_back((*cloud)[i]);
+      points.global_index.push_back(static_cast<std::int64_t>(i));
+    }
+    return points;
+  };
+  const auto consume = [&](const TilePoints& points, const LocalFitResult& fit) {
+    for (std::size_t j = 0; j < points.own->size(); ++j) {
+      const std::int64_t i = points.global_index[(*points.own)[j]];
+      result.normals[i] = fit.normals[j];
+      if (!fit.curvatures.empty()) result.curvatures[i] = fit.curvatures[j];
+    }
+    result.failed_points += fit.failed_points;
+    result.fallback_points += fit.fallback_points;
+    if (!fit.normals.is_dense) result.normals.is_dense = false;
+  };
+  fitTiles(plan, options, gather, consume, report);
+  return result;
+}
+
+}  // namespace pcl_ddg

@@ -1,0 +1,143 @@
+// Tiles give the whole-cloud result bit for bit: on every shared cloud with tiles forced small, for
+// PCA and quadric, k nearest and radius; the halo grows where a tile's points look far (a dense
+// cluster in a sparse cloud); the plan gives every point one tile.
+#include <gtest/gtest.h>
+
+#include <pcl/io/pcd_io.h>
+
+#include <cstring>
+#include <random>
+
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/tiling/tiled_local_fit.h"
+#include "test_data.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+Cloud::Ptr loadCloud(const std::string& file) {
+  auto cloud = std::make_shared<Cloud>();
+  pcl::fromPCLPointCloud2(loadMesh(sharedData(file)).cloud, *cloud);
+  return cloud;
+}
+
+// Bitwise equality, NaN included.
+template <typename Point>
+void expectSameBits(const pcl::PointCloud<Point>& a, const pcl::PointCloud<Point>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(a.width, b.width);
+  EXPECT_EQ(a.height, b.height);
+  EXPECT_EQ(a.is_dense, b.is_dense);
+  std::size_t different = 0, first = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (std::memcmp(&a[i], &b[i], sizeof(Point)) == 0) continue;
+    if (different++ == 0) first = i;
+  }
+  EXPECT_EQ(different, 0u) << "first at point " << first;
+}
+
+void expectTiledEqualsWhole(const Cloud::Ptr& cloud, const LocalFitOptions& options,
+                            std::int64_t tile_points, TilingReport* report = nullptr) {
+  const LocalFitResult whole = fitLocalSurfaces(cloud, nullptr, options);
+  TilingOptions tiling;
+  tiling.max_points_per_tile = tile_points;
+  TilingReport local;
+  const LocalFitResult tiled = fitLocalSurfacesTiled(cloud, options, tiling, &local);
+  EXPECT_GT(local.tiles, 1u);
+  expectSameBits(tiled.normals, whole.normals);
+  expectSameBits(tiled.curvatures, whole.curvatures);
+  EXPECT_EQ(tiled.failed_points, whole.failed_points);
+  EXPECT_EQ(tiled.fallback_points, whole.fallback_points);
+  if (report) *report = local;
+}
+
+TEST(TiledLocalFit, PCAOnEverySharedCloudEqualsTheWholeCloudBitForBit) {
+  for (const char* file :
+       {"clouds/bun0.pcd", "clouds/milk.pcd", "clouds/office1.pcd", "clouds/rs1.pcd",
+        "clouds/table_scene_mug_stereo_textured.pcd", "clouds/terrain_CSite1_red2-utm.pcd",
+        "clouds/tutorials_room_scan1.pcd", "range/bun000.ply"}) {
+    SCOPED_TRACE(file);
+    const Cloud::Ptr cloud = loadCloud(file);
+    LocalFitOptions options;
+    options.k = 16;
+    options.viewpoint = Eigen::Vector3d(0.1, 0.2, 0.3);
+    TilingReport report;
+    // About twenty tiles, and at most a few thousand points in each.
+    expectTiledEqualsWhole(
+        cloud, options, std::max<std::int64_t>(50, static_cast<std::int64_t>(cloud->size()) / 20),
+        &report);
+    std::printf(
+        "%s: %zu points, %zu tiles, %lld halo growths, %lld far points, at most %lld "
+        "gathered\n",
+        file, cloud->size(), report.tiles, static_cast<long long>(report.halo_growths),
+        static_cast<long long>(report.far_points), static_cast<long long>(report.largest_gather));
+  }
+}
+
+TEST(TiledLocalFit, QuadricAndRadiusSearchesToo) {
+  LocalFitOptions quadric;
+  quadric.method = LocalFitMethod::Quadric;
+  quadric.k = 20;
+  expectTiledEqualsWhole(loadCloud("clouds/milk.pcd"), quadric, 1000);
+  // Half of the room scan is exact duplicates: ties everywhere, decided by index.
+  LocalFitOptions radius;
+  radius.radius = 0.078;
+  radius.max_neighbours = 64;
+  expectTiledEqualsWhole(loadCloud("clouds/tutorials_room_scan1.pcd"), radius, 8000);
+  radius.max_neighbours = 0;
+  radius.radius = 0.03;
+  expectTiledEqualsWhole(loadCloud("clouds/bun0.pcd"), radius, 40);
+}
+
+TEST(TiledLocalFit, TheHaloGrowsAroundADenseClusterInASparseCloud) {
+  // 20,000 points in a ball of radius 0.01 at the centre of 2,000 points spread over a unit cube:
+  // the tiles around the cluster are tiny in space, and the sparse points in them find their k
+  // nearest far outside.
+  auto cloud = std::make_shared<Cloud>();
+  std::mt19937 random(3);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  std::normal_distribution<float> cluster(0.0f, 0.004f);
+  for (int i = 0; i < 2000; ++i) cloud->push_back({unit(random), unit(random), unit(random)});
+  for (int i = 0; i < 20000; ++i)
+    cloud->push_back({0.5f + cluster(random), 0.5f + cluster(random), 0.5f + cluster(random)});
+  LocalFitOptions options;
+  options.k = 24;
+  TilingReport report;
+  expectTiledEqualsWhole(cloud, options, 500, &report);
+  EXPECT_GT(report.halo_growths + report.far_points, 0);
+  std::printf("dense cluster: %zu tiles, %lld halo growths, %lld far points, widest halo %.3f\n",
+              report.tiles, static_cast<long long>(report.halo_growths),
+              static_cast<long long>(report.far_points), report.widest_halo);
+}
+
+TEST(TilePlan, EveryPointHasOneTileAndTilesKeepTheirLimitWhereCellsAllow) {
+  const Cloud::Ptr cloud = loadCloud("clouds/rs1.pcd");
+  Eigen::AlignedBox3d bounds;
+  for (const auto& p : *cloud) bounds.extend(p.getVector3fMap().cast<double>());
+  PointHistogram histogram(bounds, 32);
+  for (const auto& p : *cloud) histogram.add(p.getVector3fMap().cast<double>());
+  const TilePlan plan = planTiles(histogram, 10000);
+  std::vector<std::int64_t> counted(plan.tiles.size(), 0);
+  for (const auto& p : *cloud) {
+    const int t = plan.tileOf(p.getVector3fMap().cast<double>());
+    ASSERT_GE(t, 0);
+    ++counted[t];
+  }
+  std::int64_t total = 0;
+  for (std::size_t t = 0; t < plan.tiles.size(); ++t) {
+    EXPECT_EQ(counted[t], plan.tiles[t].points);
+    const bool single_cell = (plan.tiles[t].end_cell - plan.tiles[t].first_cell).maxCoeff() == 1;
+    if (!single_cell) EXPECT_LE(plan.tiles[t].points, 10000);
+    total += counted[t];
+  }
+  EXPECT_EQ(total, static_cast<std::int64_t>(cloud->size()));
+  EXPECT_GT(plan.tiles.size(), 29u);  // 290k points
+  EXPECT_NE(plan.toJson().find("\"resolution\": 32"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
