@@ -1,11 +1,17 @@
 // pcl_ddg_normals: per-vertex normals of a mesh (face-weighted or mean-curvature), or of a mesh or
 // point cloud by a plane (pca) or quadric fit to each point's neighbours.
+#include <pcl/exceptions.h>
+
+#include <cstdio>
+
 #include "common/local_fit_job.h"
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
+#include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/features/ring_surface_variation.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/surface/mesh_normals.h"
+#include "pcl_ddg/tiling/out_of_core_fit.h"
 
 namespace {
 
@@ -27,7 +33,9 @@ constexpr const char* kSyntax =
     "         [-radius r (a length, or a multiple of the mean spacing like 2.5h; instead of -k)]\n"
     "         [-max_nn N (with -radius: at most the N nearest; default 64)]\n"
     "         [-viewpoint x,y,z (clouds: orient normals towards it; default the PCD's VIEWPOINT)]\n"
-    "         [-precision float|double]";
+    "         [-precision float|double]\n"
+    "         [-memory SIZE (clouds larger than memory: fitted tile by tile within SIZE, like 2G;\n"
+    "                  input binary PCD or PLY, output binary; the same values as in memory)]";
 
 pcl_ddg::NormalWeighting weightingOf(const std::string& method) {
   using pcl_ddg::NormalWeighting;
@@ -39,9 +47,10 @@ pcl_ddg::NormalWeighting weightingOf(const std::string& method) {
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
-  const tools::ToolArguments args(
-      argc, argv,
-      {"method", "epsilon", "neighbours", "k", "radius", "max_nn", "viewpoint", "precision"}, {});
+  const tools::ToolArguments args(argc, argv,
+                                  {"method", "epsilon", "neighbours", "k", "radius", "max_nn",
+                                   "viewpoint", "precision", "memory"},
+                                  {});
   const FieldPrecision precision = tools::precisionArgument(args);
   const std::vector<std::string> methods = {"uniform",        "area", "angle",
                                             "mean_curvature", "pca",  "quadric"};
@@ -57,6 +66,48 @@ int run(int argc, char** argv) {
   if (args.has("epsilon") && !(args.number("epsilon", 0.0) >= 0.0))
     throw tools::UsageError("-epsilon must be >= 0");
   tools::checkLocalFitArguments(args);
+  if (args.has("memory")) {
+    // A cloud larger than memory: fitted tile by tile from the file (pcl_ddg/tiling).
+    if (!requested.empty() && !fitted)
+      throw tools::UsageError("-memory applies to pca and quadric on clouds");
+    OutOfCoreOptions limits;
+    try {
+      limits.memory_budget = parseByteSize(*args.value("memory"));
+    } catch (const pcl::BadArgumentException& e) {
+      throw tools::UsageError("-memory needs " + errorDescription(e));
+    }
+    const LocalFitMethod fit_method =
+        requested == "quadric" ? LocalFitMethod::Quadric : LocalFitMethod::PCA;
+    const LocalFitOptions options = tools::outOfCoreFitArguments(args, fit_method);
+    return tools::forEachInput(
+        args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+          tools::Timer timer(
+              "Fitting " + std::string(fit_method == LocalFitMethod::PCA ? "pca" : "quadric") +
+              " normals out of core (" + input + ", budget " + *args.value("memory") + ")");
+          const OutOfCoreReport report = [&] {
+            const tools::QuietPCLWarnings quiet;
+            return fitCloudFileOutOfCore(
+                input, output, options, limits,
+                tools::outOfCoreFields(
+                    output, precision, [&](pcl::PCLPointCloud2& piece, const LocalFitResult& fit) {
+                      tools::setNormalFields(piece, output, fit.normals, precision);
+                    }));
+          }();
+          timer.done(static_cast<std::size_t>(report.points));
+          std::fprintf(
+              stderr,
+              "%s: %zu tiles of at most %lld points, %lld halo growths, %lld points fitted "
+              "apart, at most %lld points at once\n",
+              kName, report.tiling.tiles, static_cast<long long>(report.points_per_tile),
+              static_cast<long long>(report.tiling.halo_growths),
+              static_cast<long long>(report.tiling.far_points),
+              static_cast<long long>(report.tiling.largest_gather));
+          LocalFitResult counts;
+          counts.failed_points = report.failed_points;
+          counts.fallback_points = report.fallback_points;
+          tools::warnAboutLocalFit(kName, counts);
+        });
+  }
   return tools::forEachInput(
       args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
         tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);

@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <ostream>
+#include <string>
 #include <string_view>
 
 #include "pcl_ddg/io/mesh_io.h"
@@ -29,9 +30,33 @@ pcl::PolygonMesh parseVTK(std::string_view data);
  *  VIEWPOINT into sensor_pose when given. */
 pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose = nullptr);
 
+/** How the points of a binary cloud file lie on disk, for reading it a piece at a time. */
+struct BinaryCloudLayout {
+  std::int64_t header_bytes = 0;  ///< the first point starts here
+  std::int64_t points = 0;
+  std::int64_t point_bytes = 0;  ///< one point's record
+  std::uint32_t width = 0, height = 0;
+  SensorPose sensor_pose;
+  std::string header;  ///< the file's header text
+  /** The header rewritten for a piece of `count` points: with the piece's records it is a file
+   *  that parsePCD / parsePLY read as they read the whole. */
+  std::string (*header_for)(const std::string& header, std::int64_t count) = nullptr;
+};
+
+/** The layout of a PCD file whose DATA is binary (head: the file's first bytes, the whole header
+ *  among them); FileFormatException for any other. */
+BinaryCloudLayout pcdBinaryLayout(std::string_view head);
+/** The layout of a binary PLY cloud: one vertex element of scalar properties, other elements
+ *  empty (no faces) and no range grid; FileFormatException for any other. */
+BinaryCloudLayout plyBinaryLayout(std::string_view head);
+
 void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding);
 /** A cloud as a binary_compressed PCD file (padding fields left out). */
 std::string encodePCD(const pcl::PCLPointCloud2& cloud, const SensorPose& sensor_pose);
+/** The header of a binary (uncompressed) PCD file of `points` points with the cloud's fields
+ *  (every field, padding included, so that the records are cloud.data's rows as they are). */
+std::string binaryPCDHeader(const pcl::PCLPointCloud2& cloud, std::int64_t width,
+                            std::int64_t height, const SensorPose& sensor_pose);
 
 /** A corner index from a file; anything outside 0..INT_MAX becomes -1, which MeshTopology reports
  *  as out of range. */

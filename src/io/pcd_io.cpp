@@ -209,6 +209,41 @@ void readCompressed(ByteCursor& cursor, const PcdHeader& header, pcl::PCLPointCl
 
 }  // namespace
 
+namespace {
+
+// The header with WIDTH, HEIGHT and POINTS set for a piece of `count` points.
+std::string pcdHeaderFor(const std::string& header, std::int64_t count) {
+  std::istringstream lines(header);
+  std::string out;
+  for (std::string line; std::getline(lines, line);) {
+    const std::string key = line.substr(0, line.find(' '));
+    if (key == "WIDTH" || key == "POINTS") line = key + " " + std::to_string(count);
+    if (key == "HEIGHT") line = "HEIGHT 1";
+    out += line + "\n";
+  }
+  return out;
+}
+
+}  // namespace
+
+BinaryCloudLayout pcdBinaryLayout(std::string_view head) {
+  ByteCursor cursor(head);
+  const PcdHeader header = parseHeader(cursor);
+  if (header.data != PcdData::Binary) {
+    cursor.fail("only an uncompressed binary PCD (DATA binary) is read a piece at a time");
+  }
+  BinaryCloudLayout layout;
+  layout.header_bytes = static_cast<std::int64_t>(cursor.position());
+  layout.points = header.points;
+  layout.point_bytes = header.point_size;
+  layout.width = static_cast<std::uint32_t>(header.width);
+  layout.height = static_cast<std::uint32_t>(header.height);
+  layout.sensor_pose = header.sensor_pose;
+  layout.header = std::string(head.substr(0, cursor.position()));
+  layout.header_for = pcdHeaderFor;
+  return layout;
+}
+
 pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose) {
   ByteCursor cursor(data);
   const PcdHeader header = parseHeader(cursor);
@@ -274,17 +309,8 @@ char pcdType(std::uint8_t datatype) {
   }
 }
 
-}  // namespace
-
-// binary_compressed, as PCL's tools write it: the fields one after the other (each as an array
-// over all points), LZF-compressed. Padding fields ("_") carry nothing and are left out.
-std::string encodePCD(const pcl::PCLPointCloud2& cloud, const SensorPose& sensor_pose) {
-  std::vector<const pcl::PCLPointField*> fields;
-  for (const auto& f : cloud.fields) {
-    if (f.name != "_" && pcl::getFieldSize(f.datatype) > 0) fields.push_back(&f);
-  }
-  if (fields.empty()) throw FileFormatException("the cloud has no fields to write");
-  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+std::string pcdHeader(const std::vector<const pcl::PCLPointField*>& fields, std::int64_t width,
+                      std::int64_t height, const SensorPose& sensor_pose, const char* data) {
   std::string header = "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS";
   for (const auto* f : fields) header += " " + f->name;
   header += "\nSIZE";
@@ -299,9 +325,32 @@ std::string encodePCD(const pcl::PCLPointCloud2& cloud, const SensorPose& sensor
             << ' ' << sensor_pose.origin.z() << ' ' << sensor_pose.orientation.w() << ' '
             << sensor_pose.orientation.x() << ' ' << sensor_pose.orientation.y() << ' '
             << sensor_pose.orientation.z();
-  header += "\nWIDTH " + std::to_string(cloud.width) + "\nHEIGHT " + std::to_string(cloud.height) +
-            "\nVIEWPOINT " + viewpoint.str() + "\nPOINTS " + std::to_string(n) +
-            "\nDATA binary_compressed\n";
+  header += "\nWIDTH " + std::to_string(width) + "\nHEIGHT " + std::to_string(height) +
+            "\nVIEWPOINT " + viewpoint.str() + "\nPOINTS " + std::to_string(width * height) +
+            "\nDATA " + data + "\n";
+  return header;
+}
+
+}  // namespace
+
+std::string binaryPCDHeader(const pcl::PCLPointCloud2& cloud, std::int64_t width,
+                            std::int64_t height, const SensorPose& sensor_pose) {
+  std::vector<const pcl::PCLPointField*> fields;
+  for (const auto& f : cloud.fields) fields.push_back(&f);
+  return pcdHeader(fields, width, height, sensor_pose, "binary");
+}
+
+// binary_compressed, as PCL's tools write it: the fields one after the other (each as an array
+// over all points), LZF-compressed. Padding fields ("_") carry nothing and are left out.
+std::string encodePCD(const pcl::PCLPointCloud2& cloud, const SensorPose& sensor_pose) {
+  std::vector<const pcl::PCLPointField*> fields;
+  for (const auto& f : cloud.fields) {
+    if (f.name != "_" && pcl::getFieldSize(f.datatype) > 0) fields.push_back(&f);
+  }
+  if (fields.empty()) throw FileFormatException("the cloud has no fields to write");
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  const std::string header =
+      pcdHeader(fields, cloud.width, cloud.height, sensor_pose, "binary_compressed");
 
   std::string planar;
   for (const auto* f : fields) {

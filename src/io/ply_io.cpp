@@ -338,6 +338,54 @@ pcl::PCLPointCloud2 organizeOnGrid(const pcl::PCLPointCloud2& points,
 
 }  // namespace
 
+namespace {
+
+// The header with the vertex count set for a piece of `count` points.
+std::string plyHeaderFor(const std::string& header, std::int64_t count) {
+  std::istringstream lines(header);
+  std::string out;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("element vertex ", 0) == 0) line = "element vertex " + std::to_string(count);
+    out += line + "\n";
+  }
+  return out;
+}
+
+}  // namespace
+
+BinaryCloudLayout plyBinaryLayout(std::string_view head) {
+  ByteCursor cursor(head);
+  const PlyHeader header = parseHeader(cursor);
+  if (header.format == PlyFormat::Ascii) cursor.fail("only a binary PLY is read a piece at a time");
+  BinaryCloudLayout layout;
+  bool has_vertices = false;
+  for (const PlyElement& element : header.elements) {
+    if (element.name != "vertex") {
+      if (element.count > 0) {
+        cursor.fail("PLY element '" + element.name +
+                    "' has rows: only a cloud (vertices alone) "
+                    "is read a piece at a time");
+      }
+      continue;
+    }
+    if (has_vertices) cursor.fail("PLY file has a second vertex element");
+    has_vertices = true;
+    layout.points = element.count;
+    for (const auto& p : element.properties) {
+      if (p.is_list) cursor.fail("PLY vertex property '" + p.name + "' is a list");
+      layout.point_bytes += typeSize(p.type);
+    }
+  }
+  if (!has_vertices || layout.points == 0) cursor.fail("PLY file has no vertices");
+  layout.header_bytes = static_cast<std::int64_t>(cursor.position());
+  layout.width = static_cast<std::uint32_t>(
+      std::min<std::int64_t>(layout.points, std::numeric_limits<std::uint32_t>::max()));
+  layout.height = 1;
+  layout.header = std::string(head.substr(0, cursor.position()));
+  layout.header_for = plyHeaderFor;
+  return layout;
+}
+
 pcl::PolygonMesh parsePLY(std::string_view data) {
   ByteCursor cursor(data);
   const PlyHeader header = parseHeader(cursor);

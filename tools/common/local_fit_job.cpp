@@ -3,6 +3,7 @@
 #include <pcl/common/point_tests.h>
 #include <pcl/search/kdtree.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <optional>
@@ -177,6 +178,46 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
         static_cast<unsigned int>(args.integer("max_nn", kDefaultMaxNeighbours));
   }
   return options;
+}
+
+LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod method) {
+  checkLocalFitArguments(args);
+  if (args.choice("neighbours", {"bfs", "knn"}, "knn") == "bfs")
+    throw UsageError("-memory fits clouds with kd-tree neighbourhoods (-neighbours knn)");
+  LocalFitOptions options;
+  options.method = method;
+  options.neighbourhood = NeighbourhoodKind::KdTree;
+  options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20 : 16);
+  options.viewpoint = viewpointArgument(args);
+  const RadiusArgument radius = radiusArgument(args);
+  if (radius.in_spacings)
+    throw UsageError("with -memory, -radius is a length (a multiple of h needs the whole cloud)");
+  if (radius.value > 0.0) {
+    options.radius = radius.value;
+    options.max_neighbours =
+        static_cast<unsigned int>(args.integer("max_nn", kDefaultMaxNeighbours));
+  }
+  return options;
+}
+
+ResultFields outOfCoreFields(
+    const std::string& output_path, FieldPrecision precision,
+    const std::function<void(pcl::PCLPointCloud2&, const LocalFitResult&)>& add) {
+  return [output_path, precision, add](pcl::PCLPointCloud2& piece, const LocalFitResult& fit) {
+    const Eigen::Matrix3Xd positions = vertexPositions(piece, NonFinitePolicy::Keep);
+    const bool declared_double =
+        std::any_of(piece.fields.begin(), piece.fields.end(), [](const pcl::PCLPointField& f) {
+          return (f.name == "x" || f.name == "y" || f.name == "z") &&
+                 f.datatype == pcl::PCLPointField::FLOAT64;
+        });
+    // As loading (float x y z for PCL), adding the fields, and saving do in memory.
+    setVertexCoordinates(piece, positions, FieldPrecision::Float);
+    add(piece, fit);
+    setVertexCoordinates(
+        piece, positions,
+        coordinatePrecision(declared_double ? FieldPrecision::Double : FieldPrecision::Float,
+                            precision));
+  };
 }
 
 void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,

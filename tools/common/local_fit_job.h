@@ -16,6 +16,7 @@
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/tiling/out_of_core_fit.h"
 
 namespace pcl_ddg {
 namespace tools {
@@ -46,6 +47,18 @@ void checkLocalFitArguments(const ToolArguments& args);
  *  -viewpoint x,y,z orients cloud normals (default: the file's VIEWPOINT). */
 LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput& input,
                                   LocalFitMethod method);
+
+/** The options of localFitArguments for a cloud file fitted out of core (-memory): kd-tree
+ *  neighbourhoods, -k, or -radius as a length (a multiple of the spacing needs the whole cloud),
+ *  -max_nn, -viewpoint (unset: the file's VIEWPOINT). */
+LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod method);
+
+/** Adds the fields a tool writes for a fit to a piece of a cloud read out of core, as the
+ *  in-memory path writes them: float x y z first (double when the file declares double or
+ *  `precision` asks), then the fields `add` sets. */
+ResultFields outOfCoreFields(
+    const std::string& output_path, FieldPrecision precision,
+    const std::function<void(pcl::PCLPointCloud2&, const LocalFitResult&)>& add);
 
 /** Writes normals as nx ny nz (PLY) or normal_x normal_y normal_z (PCD), and PCL's curvature
  *  (surface variation) as "curvature". */

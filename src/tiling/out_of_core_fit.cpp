@@ -1,0 +1,433 @@
+#include "pcl_ddg/tiling/out_of_core_fit.h"
+
+#include <fcntl.h>
+#include <pcl/exceptions.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "../io/formats.h"
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/atomic_file.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+
+namespace pcl_ddg {
+namespace {
+
+[[noreturn]] void failSystem(const std::string& what) {
+  throw FileFormatException(what + ": " + std::strerror(errno));
+}
+
+// The input, a piece at a time, each piece read by the same parser as the whole file would be
+// (so every value converts exactly as it does in memory).
+class CloudPieces {
+ public:
+  explicit CloudPieces(const std::string& path) : path_(path), ext_(fileExtension(path)) {
+    if (ext_ != "pcd" && ext_ != "ply")
+      throw FileFormatException(path + ": only .pcd and .ply clouds are read a piece at a time");
+    in_.open(path, std::ios::binary);
+    if (!in_) failSystem(path);
+    std::string head(4 << 20, '\0');
+    in_.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in_.gcount()));
+    in_.clear();
+    try {
+      layout_ = ext_ == "pcd" ? detail::pcdBinaryLayout(head) : detail::plyBinaryLayout(head);
+    } catch (const pcl::PCLException& e) {
+      throw FileFormatException(path + ": " + errorDescription(e));
+    }
+    const auto size = static_cast<std::int64_t>(std::filesystem::file_size(path));
+    if (size - layout_.header_bytes < layout_.points * layout_.point_bytes)
+      throw FileFormatException(path + ": shorter than its points (truncated?)");
+  }
+
+  const detail::BinaryCloudLayout& layout() const { return layout_; }
+
+  pcl::PCLPointCloud2 read(std::int64_t first, std::int64_t count) {
+    std::string file = layout_.header_for(layout_.header, count);
+    const std::size_t header = file.size();
+    file.resize(header + static_cast<std::size_t>(count * layout_.point_bytes));
+    in_.seekg(layout_.header_bytes + first * layout_.point_bytes);
+    in_.read(file.data() + header, static_cast<std::streamsize>(file.size() - header));
+    if (in_.gcount() != static_cast<std::streamsize>(file.size() - header))
+      throw FileFormatException(path_ + ": cannot read points " + std::to_string(first) + "..");
+    try {
+      return (ext_ == "pcd" ? detail::parsePCD(file) : detail::parsePLY(file)).cloud;
+    } catch (const pcl::PCLException& e) {
+      throw FileFormatException(path_ + ": " + errorDescription(e));
+    }
+  }
+
+ private:
+  std::string path_, ext_;
+  std::ifstream in_;
+  detail::BinaryCloudLayout layout_;
+};
+
+// What the tools hand PCL: float coordinates from the exact ones (as toXYZ in memory does).
+pcl::PointXYZ floatPoint(const Eigen::Matrix3Xd& positions, Eigen::Index i) {
+  pcl::PointXYZ p;
+  p.getVector3fMap() = positions.col(i).cast<float>();
+  return p;
+}
+
+Eigen::Vector3d position(const pcl::PointXYZ& p) {
+  return p.getVector3fMap().cast<double>();
+}
+
+// One record per finite point in its tile's file: the point's index in the input, and x, y, z.
+struct TileRecord {
+  std::int64_t index;
+  float xyz[3];
+};
+
+class TileFiles {
+ public:
+  TileFiles(std::string folder, std::size_t tiles, std::size_t buffer_records)
+      : folder_(std::move(folder)), buffers_(tiles), buffer_records_(buffer_records) {}
+
+  void add(int tile, std::int64_t index, const pcl::PointXYZ& p) {
+    auto& buffer = buffers_[tile];
+    buffer.push_back({index, {p.x, p.y, p.z}});
+    if (buffer.size() >= buffer_records_) flush(tile);
+  }
+  void flushAll() {
+    for (std::size_t t = 0; t < buffers_.size(); ++t) flush(static_cast<int>(t));
+  }
+  std::vector<TileRecord> read(int tile) const {
+    std::ifstream in(path(tile), std::ios::binary);
+    std::vector<TileRecord> records;
+    if (!in) return records;  // no point was written for it
+    in.seekg(0, std::ios::end);
+    records.resize(static_cast<std::size_t>(in.tellg()) / sizeof(TileRecord));
+    in.seekg(0);
+    in.read(reinterpret_cast<char*>(records.data()),
+            static_cast<std::streamsize>(records.size() * sizeof(TileRecord)));
+    if (!in) failSystem("cannot read " + path(tile));
+    return records;
+  }
+
+ private:
+  std::string path(int tile) const { return folder_ + "/tile_" + std::to_string(tile) + ".bin"; }
+  void flush(int tile) {
+    auto& buffer = buffers_[tile];
+    if (buffer.empty()) return;
+    std::ofstream out(path(tile), std::ios::binary | std::ios::app);
+    out.write(reinterpret_cast<const char*>(buffer.data()),
+              static_cast<std::streamsize>(buffer.size() * sizeof(TileRecord)));
+    if (!out) failSystem("cannot write " + path(tile));
+    buffer.clear();
+  }
+
+  std::string folder_;
+  std::vector<std::vector<TileRecord>> buffers_;
+  std::size_t buffer_records_;
+};
+
+// The fit of every point at its place: normal x y z, curvature, and for the quadric pc1, pc2 and
+// the k1 direction; NaN until written.
+class ResultFile {
+ public:
+  ResultFile(const std::string& path, std::int64_t points, bool curvatures)
+      : floats_(curvatures ? 9 : 4) {
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0600);
+    if (fd_ < 0) failSystem("cannot create " + path);
+    const std::vector<float> nan(static_cast<std::size_t>(floats_) * 65536,
+                                 std::numeric_limits<float>::quiet_NaN());
+    for (std::int64_t i = 0; i < points; i += 65536) {
+      const std::int64_t n = std::min<std::int64_t>(65536, points - i);
+      writeAt(i, nan.data(), n);
+    }
+  }
+  ~ResultFile() { ::close(fd_); }
+  ResultFile(const ResultFile&) = delete;
+  ResultFile& operator=(const ResultFile&) = delete;
+
+  void put(std::int64_t point, const pcl::Normal& n, const pcl::PrincipalCurvatures* c) {
+    float record[9] = {n.normal_x, n.normal_y, n.normal_z, n.curvature};
+    if (c) {
+      const float more[5] = {c->pc1, c->pc2, c->principal_curvature_x, c->principal_curvature_y,
+                             c->principal_curvature_z};
+      std::copy(more, more + 5, record + 4);
+    }
+    writeAt(point, record, 1);
+  }
+
+  /** The results of points [first, first + count) as a fit of that piece. */
+  LocalFitResult get(std::int64_t first, std::int64_t count) const {
+    std::vector<float> records(static_cast<std::size_t>(count * floats_));
+    const std::size_t bytes = records.size() * sizeof(float);
+    if (::pread(fd_, records.data(), bytes, first * floats_ * 4) != static_cast<ssize_t>(bytes))
+      failSystem("cannot read the results");
+    LocalFitResult fit;
+    fit.normals.resize(static_cast<std::size_t>(count));
+    if (floats_ == 9) fit.curvatures.resize(static_cast<std::size_t>(count));
+    for (std::int64_t i = 0; i < count; ++i) {
+      const float* r = records.data() + i * floats_;
+      pcl::Normal& n = fit.normals[i];
+      n.normal_x = r[0];
+      n.normal_y = r[1];
+      n.normal_z = r[2];
+      n.curvature = r[3];
+      if (floats_ == 9) {
+        pcl::PrincipalCurvatures& c = fit.curvatures[i];
+        c.pc1 = r[4];
+        c.pc2 = r[5];
+        c.principal_curvature_x = r[6];
+        c.principal_curvature_y = r[7];
+        c.principal_curvature_z = r[8];
+      }
+    }
+    return fit;
+  }
+
+ private:
+  void writeAt(std::int64_t point, const float* values, std::int64_t count) {
+    const std::size_t bytes = static_cast<std::size_t>(count * floats_) * sizeof(float);
+    if (::pwrite(fd_, values, bytes, point * floats_ * 4) != static_cast<ssize_t>(bytes))
+      failSystem("cannot write the results");
+  }
+
+  int fd_ = -1;
+  int floats_;
+};
+
+// A folder of our own for the tile files, removed however the run ends.
+class ScratchFolder {
+ public:
+  explicit ScratchFolder(const std::string& parent) {
+    std::string name = (parent.empty() ? std::string(".") : parent) + "/.pcl_ddg_tiles_XXXXXX";
+    if (!::mkdtemp(name.data())) failSystem("cannot create a scratch folder in " + parent);
+    path_ = name;
+  }
+  ~ScratchFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  ScratchFolder(const ScratchFolder&) = delete;
+  ScratchFolder& operator=(const ScratchFolder&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+// Writes the output a piece at a time: binary PCD (the header from the first piece's fields) or
+// binary PLY (each piece through the PLY writer, its header kept once with the total count).
+class OutputPieces {
+ public:
+  OutputPieces(const std::string& path, bool ply, const detail::BinaryCloudLayout& layout)
+      : ply_(ply), layout_(layout), out_(path, std::ios::binary) {
+    if (!out_) failSystem("cannot write " + path);
+  }
+  void write(pcl::PCLPointCloud2& piece) {
+    // Colours in the format's layout and no padding in a PCD, as saveMesh writes them.
+    const ColorLayout colors = ply_ ? ColorLayout::Channels : ColorLayout::PackedRGB;
+    const auto current = vertexColorLayout(piece);
+    if (current && *current != colors) setVertexColors(piece, vertexColors(piece), colors);
+    if (!ply_) {
+      while (removeVertexField(piece, "_")) {
+      }
+      if (first_) {
+        out_ << detail::binaryPCDHeader(piece, layout_.width, layout_.height, layout_.sensor_pose);
+      }
+      out_.write(reinterpret_cast<const char*>(piece.data.data()),
+                 static_cast<std::streamsize>(piece.data.size()));
+    } else {
+      pcl::PolygonMesh mesh;
+      mesh.cloud = piece;
+      std::ostringstream encoded;
+      detail::writePLY(encoded, mesh, PlyEncoding::Binary);
+      const std::string bytes = encoded.str();
+      const std::size_t body = bytes.find("end_header\n") + 11;
+      if (first_) {
+        std::istringstream lines(bytes.substr(0, body));
+        for (std::string line; std::getline(lines, line);) {
+          if (line.rfind("element vertex ", 0) == 0)
+            line = "element vertex " + std::to_string(layout_.points);
+          out_ << line << '\n';
+        }
+      }
+      out_.write(bytes.data() + body, static_cast<std::streamsize>(bytes.size() - body));
+    }
+    first_ = false;
+    if (!out_) failSystem("cannot write the output");
+  }
+  void close() {
+    out_.close();
+    if (!out_) failSystem("cannot write the output");
+  }
+
+ private:
+  bool ply_;
+  const detail::BinaryCloudLayout& layout_;
+  std::ofstream out_;
+  bool first_ = true;
+};
+
+}  // namespace
+
+std::uint64_t parseByteSize(const std::string& text) {
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  const std::string unit = text.substr(used);
+  const double scale = unit.empty() || unit == "B"  ? 1.0
+                       : unit == "k" || unit == "K" ? 1024.0
+                       : unit == "M"                ? 1024.0 * 1024.0
+                       : unit == "G"                ? 1024.0 * 1024.0 * 1024.0
+                       : unit == "T"                ? 1024.0 * 1024.0 * 1024.0 * 1024.0
+                                                    : -1.0;
+  if (used == 0 || scale < 0.0 || !(value > 0.0) || !std::isfinite(value * scale) ||
+      value * scale > 1e18)
+    throw pcl::BadArgumentException("a size like 2G, 512M or 64k, not '" + text + "'");
+  return static_cast<std::uint64_t>(value * scale);
+}
+
+OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::string& output,
+                                      LocalFitOptions options, const OutOfCoreOptions& limits,
+                                      const ResultFields& add_fields) {
+  if (options.neighbourhood != NeighbourhoodKind::KdTree)
+    throw pcl::BadArgumentException("a cloud out of core is fitted with kd-tree neighbourhoods");
+  if (fileExtension(output) != "ply" && fileExtension(output) != "pcd")
+    throw FileFormatException(output + ": the output must be .ply or .pcd");
+  CloudPieces pieces(input);
+  const detail::BinaryCloudLayout& layout = pieces.layout();
+  OutOfCoreReport report;
+  report.points = layout.points;
+  report.sensor_pose = layout.sensor_pose;
+  if (!options.viewpoint) options.viewpoint = layout.sensor_pose.origin;
+  if (options.radius == 0.0 && options.k > layout.points)
+    throw pcl::BadArgumentException("k is more than the " + std::to_string(layout.points) +
+                                    " points of the input");
+  // About 400 bytes per own point at once: the point, its index, two kd-trees, the halo's share,
+  // the fit's output; a piece of the file costs its records and their parsed copy.
+  report.points_per_tile = static_cast<std::int64_t>(limits.memory_budget / 400);
+  report.points_per_piece = std::clamp<std::int64_t>(
+      static_cast<std::int64_t>(limits.memory_budget / 8 / (layout.point_bytes * 3 + 64)), 1024,
+      std::int64_t{1} << 22);
+  if (report.points_per_tile < 4096)
+    throw pcl::BadArgumentException("a memory budget of at least 2M is needed");
+  const auto forEachPiece = [&](const std::function<void(std::int64_t, pcl::PCLPointCloud2&,
+                                                         const Eigen::Matrix3Xd&)>& visit) {
+    for (std::int64_t first = 0; first < layout.points; first += report.points_per_piece) {
+      const std::int64_t count = std::min(report.points_per_piece, layout.points - first);
+      pcl::PCLPointCloud2 piece = pieces.read(first, count);
+      const Eigen::Matrix3Xd positions = vertexPositions(piece, NonFinitePolicy::Keep);
+      visit(first, piece, positions);
+    }
+  };
+
+  // 1. Bounds of the finite points (as PCL's float points, which is what is fitted).
+  Eigen::AlignedBox3d bounds;
+  forEachPiece([&](std::int64_t first, pcl::PCLPointCloud2&, const Eigen::Matrix3Xd& positions) {
+    for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+      if (positions.col(i).allFinite() &&
+          positions.col(i).cwiseAbs().maxCoeff() > std::numeric_limits<float>::max())
+        throw FileFormatException(input + ": point " + std::to_string(first + i) +
+                                  " is beyond float's range (PCL's point types are float)");
+      const pcl::PointXYZ p = floatPoint(positions, i);
+      if (p.getVector3fMap().allFinite())
+        bounds.extend(position(p));
+      else
+        ++report.failed_points;
+    }
+  });
+
+  const std::string folder = limits.scratch_folder.empty()
+                                 ? std::filesystem::path(output).parent_path().string()
+                                 : limits.scratch_folder;
+  const ScratchFolder scratch(folder);
+  ResultFile results(scratch.path() + "/results.bin", layout.points,
+                     options.method == LocalFitMethod::Quadric);
+  if (!bounds.isEmpty()) {
+    // 2. The plan, from a histogram of a second pass.
+    PointHistogram histogram(bounds, 128);
+    forEachPiece([&](std::int64_t, pcl::PCLPointCloud2&, const Eigen::Matrix3Xd& positions) {
+      for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+        const pcl::PointXYZ p = floatPoint(positions, i);
+        if (p.getVector3fMap().allFinite()) histogram.add(position(p));
+      }
+    });
+    const TilePlan plan = planTiles(histogram, report.points_per_tile);
+    std::ofstream(scratch.path() + "/plan.json") << plan.toJson() << "\n";
+
+    // 3. Every point into its tile's file.
+    const std::size_t buffer_records = std::clamp<std::size_t>(
+        limits.memory_budget / 8 / sizeof(TileRecord) / plan.tiles.size(), 256, 65536);
+    TileFiles tiles(scratch.path(), plan.tiles.size(), buffer_records);
+    forEachPiece([&](std::int64_t first, pcl::PCLPointCloud2&, const Eigen::Matrix3Xd& positions) {
+      for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+        const pcl::PointXYZ p = floatPoint(positions, i);
+        if (p.getVector3fMap().allFinite()) tiles.add(plan.tileOf(position(p)), first + i, p);
+      }
+    });
+    tiles.flushAll();
+
+    // 4. Each tile with its halo, gathered from the tile files it touches.
+    const auto gather = [&](int tile, const Eigen::AlignedBox3d& region) {
+      TilePoints points;
+      points.points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+      points.own = std::make_shared<pcl::Indices>();
+      std::vector<std::pair<std::int64_t, pcl::PointXYZ>> gathered;
+      std::vector<char> own_flags;
+      for (int t = 0; t < static_cast<int>(plan.tiles.size()); ++t) {
+        if (t != tile && !plan.tiles[t].box.intersects(region)) continue;
+        for (const TileRecord& r : tiles.read(t)) {
+          const pcl::PointXYZ p(r.xyz[0], r.xyz[1], r.xyz[2]);
+          if (t != tile && !region.contains(position(p))) continue;
+          gathered.emplace_back(r.index, p);
+          own_flags.push_back(t == tile);
+        }
+      }
+      // In the input's order, as the whole cloud is indexed.
+      std::vector<std::size_t> order(gathered.size());
+      for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+      std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return gathered[a].first < gathered[b].first;
+      });
+      points.points->reserve(order.size());
+      for (const std::size_t i : order) {
+        if (own_flags[i]) points.own->push_back(static_cast<pcl::index_t>(points.points->size()));
+        points.points->push_back(gathered[i].second);
+        points.global_index.push_back(gathered[i].first);
+      }
+      return points;
+    };
+    const auto consume = [&](const TilePoints& points, const LocalFitResult& fit) {
+      for (std::size_t j = 0; j < points.own->size(); ++j) {
+        results.put(points.global_index[(*points.own)[j]], fit.normals[j],
+                    fit.curvatures.empty() ? nullptr : &fit.curvatures[j]);
+      }
+      report.failed_points += fit.failed_points;
+      report.fallback_points += fit.fallback_points;
+    };
+    fitTiles(plan, options, gather, consume, &report.tiling);
+  }
+
+  // 5. The input's pieces with the results beside them.
+  AtomicFile file(output);
+  OutputPieces out(file.temporaryPath(), fileExtension(output) == "ply", layout);
+  forEachPiece([&](std::int64_t first, pcl::PCLPointCloud2& piece, const Eigen::Matrix3Xd&) {
+    const auto count = static_cast<std::int64_t>(piece.width) * piece.height;
+    add_fields(piece, results.get(first, count));
+    out.write(piece);
+  });
+  out.close();
+  file.commit();
+  return report;
+}
+
+}  // namespace pcl_ddg
