@@ -1,5 +1,6 @@
-// Clouds larger than memory: pcl_ddg_normals -memory reads the file a piece at a time, fits it tile
-// by tile, and writes exactly what the in-memory run writes, within its memory budget.
+// Clouds larger than memory: pcl_ddg_normals (and pcl_ddg_curvature) -memory reads the file a piece
+// at a time, fits it tile by tile, and writes exactly what the in-memory run writes, within its
+// memory budget.
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
 #include <sys/resource.h>
@@ -47,13 +48,12 @@ class OutOfCore : public ::testing::Test {
   std::string path(const std::string& name) const { return dir_ + "/" + name; }
   // The tool in memory and out of core on the same input: the outputs must be the same bytes.
   void expectSameOutput(const std::string& input, const std::string& options,
-                        const std::string& memory) {
+                        const std::string& memory, const char* tool = PCL_DDG_NORMALS_TOOL) {
     SCOPED_TRACE(input + options);
-    const ToolRun whole =
-        runTool(PCL_DDG_NORMALS_TOOL, input + " " + path("whole.ply") + " " + options);
+    const ToolRun whole = runTool(tool, input + " " + path("whole.ply") + " " + options);
     ASSERT_EQ(whole.exit_code, 0) << whole.err;
-    const ToolRun tiled = runTool(PCL_DDG_NORMALS_TOOL, input + " " + path("tiled.ply") + " " +
-                                                            options + " -memory " + memory);
+    const ToolRun tiled =
+        runTool(tool, input + " " + path("tiled.ply") + " " + options + " -memory " + memory);
     ASSERT_EQ(tiled.exit_code, 0) << tiled.err;
     EXPECT_NE(tiled.err.find("out of core"), std::string::npos) << tiled.err;
     EXPECT_TRUE(fileBytes(path("whole.ply")) == fileBytes(path("tiled.ply")))
@@ -79,6 +79,8 @@ TEST_F(OutOfCore, EverySharedCloudGivesTheInMemoryOutputByteForByte) {
   }
   saveMesh(path("in.ply"), loadMesh(sharedData("clouds/rs1.pcd")));
   expectSameOutput(path("in.ply"), "-method quadric -k 20", "4M");
+  // The curvature tool's quadric path too (k1, k2, their direction, H, K, normals).
+  expectSameOutput(path("in.ply"), "-method quadric -k 20", "4M", PCL_DDG_CURVATURE_TOOL);
   saveMesh(path("room.ply"), loadMesh(sharedData("clouds/tutorials_room_scan1.pcd")));
   expectSameOutput(path("room.ply"), "-radius 0.05 -max_nn 32", "3M");
   expectNoScratchLeft();

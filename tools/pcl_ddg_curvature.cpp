@@ -29,13 +29,50 @@ constexpr const char* kSyntax =
     "         [-viewpoint x,y,z] (quadric)\n"
     "         [-smooth t (heat flow time in h^2, meshes)]\n"
     "         [-color mean|gauss|k1|k2] [-percentile p (colour scale clamp, default 2)]\n"
-    "         [-precision float|double]";
+    "         [-precision float|double]\n"
+    "         [-memory SIZE (clouds larger than memory, quadric: fitted tile by tile within SIZE\n"
+    "                  like 2G; input binary PCD or PLY, output binary; no -smooth, no -color)]";
+
+// The four curvature fields, as written.
+struct CurvatureFields {
+  Eigen::VectorXd mean, gauss, k1, k2;
+};
+
+// Sets the quadric's k1 direction and normal fields; returns its curvatures (H and K from k1, k2).
+CurvatureFields quadricFields(pcl::PCLPointCloud2& cloud, const std::string& output,
+                              const pcl_ddg::LocalFitResult& result,
+                              pcl_ddg::FieldPrecision precision) {
+  const auto n = static_cast<Eigen::Index>(result.curvatures.size());
+  CurvatureFields c{{}, {}, Eigen::VectorXd(n), Eigen::VectorXd(n)};
+  Eigen::Matrix3Xd direction(3, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const pcl::PrincipalCurvatures& p = result.curvatures[i];
+    c.k1[i] = p.pc1;
+    c.k2[i] = p.pc2;
+    direction.col(i) << p.principal_curvature_x, p.principal_curvature_y, p.principal_curvature_z;
+  }
+  c.mean = 0.5 * (c.k1 + c.k2);
+  c.gauss = c.k1.cwiseProduct(c.k2);
+  const char* names[] = {"k1_direction_x", "k1_direction_y", "k1_direction_z"};
+  for (int d = 0; d < 3; ++d)
+    pcl_ddg::setVertexField(cloud, names[d], direction.row(d).transpose(), precision);
+  pcl_ddg::tools::setNormalFields(cloud, output, result.normals, precision);
+  return c;
+}
+
+void setCurvatureFields(pcl::PCLPointCloud2& cloud, const CurvatureFields& c,
+                        pcl_ddg::FieldPrecision precision) {
+  const std::pair<const char*, const Eigen::VectorXd*> fields[] = {
+      {"mean_curvature", &c.mean}, {"gauss_curvature", &c.gauss}, {"k1", &c.k1}, {"k2", &c.k2}};
+  for (const auto& [name, values] : fields)
+    pcl_ddg::setVertexField(cloud, name, *values, precision);
+}
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(argc, argv,
                                   {"method", "area", "neighbours", "k", "radius", "max_nn",
-                                   "smooth", "color", "percentile", "precision"},
+                                   "smooth", "color", "percentile", "precision", "memory"},
                                   {});
   const std::string color = args.choice("color", {"none", "mean", "gauss", "k1", "k2"}, "none");
   const double percentile = args.number("percentile", 2.0);
@@ -53,13 +90,32 @@ int run(int argc, char** argv) {
   tools::checkLocalFitArguments(args);
   const double smooth_time = args.number("smooth", 1.0);
   if (!(smooth_time > 0.0)) throw tools::UsageError("-smooth must be > 0");
+  if (args.has("memory")) {
+    // A cloud larger than memory: quadrics fitted tile by tile from the file (pcl_ddg/tiling).
+    if (requested == "cotan") throw tools::UsageError("-memory applies to -method quadric");
+    if (args.has("smooth") || color != "none") {
+      throw tools::UsageError("-smooth and -color need the whole field at once; not with -memory");
+    }
+    tools::memoryArgument(args);
+    const LocalFitOptions options = tools::outOfCoreFitArguments(args, LocalFitMethod::Quadric);
+    return tools::forEachInput(
+        args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+          tools::fitOutOfCore(
+              kName, args, input, output, options,
+              tools::outOfCoreFields(
+                  output, precision, [&](pcl::PCLPointCloud2& piece, const LocalFitResult& fit) {
+                    setCurvatureFields(piece, quadricFields(piece, output, fit, precision),
+                                       precision);
+                  }));
+        });
+  }
 
   return tools::forEachInput(
       args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
         tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
         const std::string method =
             !requested.empty() ? requested : (in.topology ? "cotan" : "quadric");
-        Eigen::VectorXd mean, gauss, kappa1, kappa2;
+        CurvatureFields curvatures;
         if (method == "cotan") {
           if (!in.topology)
             throw tools::UsageError("-method cotan needs a mesh; this input is a point cloud");
@@ -80,10 +136,7 @@ int run(int argc, char** argv) {
             tools::warn(kName, std::to_string(c.clamped_vertices) +
                                    " vertices with H^2 < K (umbilic or noisy): k1 = k2 = H there");
           }
-          mean = c.mean_curvature;
-          gauss = c.gauss_curvature;
-          kappa1 = c.k1;
-          kappa2 = c.k2;
+          curvatures = {c.mean_curvature, c.gauss_curvature, c.k1, c.k2};
           setVertexField(in.mesh.cloud, "vertex_area", c.vertex_area, precision);
         } else {
           const LocalFitOptions options =
@@ -95,23 +148,7 @@ int run(int argc, char** argv) {
           }();
           timer.done(in.points->size());
           tools::warnAboutLocalFit(kName, result);
-          const auto n = static_cast<Eigen::Index>(result.curvatures.size());
-          kappa1.resize(n);
-          kappa2.resize(n);
-          Eigen::Matrix3Xd direction(3, n);
-          for (Eigen::Index i = 0; i < n; ++i) {
-            const pcl::PrincipalCurvatures& c = result.curvatures[i];
-            kappa1[i] = c.pc1;
-            kappa2[i] = c.pc2;
-            direction.col(i) << c.principal_curvature_x, c.principal_curvature_y,
-                c.principal_curvature_z;
-          }
-          mean = 0.5 * (kappa1 + kappa2);
-          gauss = kappa1.cwiseProduct(kappa2);
-          const char* names[] = {"k1_direction_x", "k1_direction_y", "k1_direction_z"};
-          for (int d = 0; d < 3; ++d)
-            setVertexField(in.mesh.cloud, names[d], direction.row(d).transpose(), precision);
-          tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
+          curvatures = quadricFields(in.mesh.cloud, output, result, precision);
         }
         if (args.has("smooth")) {
           if (!in.topology)
@@ -124,28 +161,19 @@ int run(int argc, char** argv) {
           }
           HeatFlowParameters heat;
           heat.diffusion_time = smooth_time * h * h;
-          Eigen::MatrixXd curvatures(mean.size(), 4);
-          curvatures << mean, gauss, kappa1, kappa2;
+          Eigen::MatrixXd fields(curvatures.mean.size(), 4);
+          fields << curvatures.mean, curvatures.gauss, curvatures.k1, curvatures.k2;
           tools::Timer timer("Smoothing curvatures");
-          curvatures = smoothScalarFields(*in.topology, in.positions, curvatures, heat);
-          timer.done(static_cast<std::size_t>(mean.size()));
-          mean = curvatures.col(0);
-          gauss = curvatures.col(1);
-          kappa1 = curvatures.col(2);
-          kappa2 = curvatures.col(3);
+          fields = smoothScalarFields(*in.topology, in.positions, fields, heat);
+          timer.done(static_cast<std::size_t>(fields.rows()));
+          curvatures = {fields.col(0), fields.col(1), fields.col(2), fields.col(3)};
         }
-        const std::pair<const char*, const Eigen::VectorXd*> fields[] = {
-            {"mean_curvature", &mean},
-            {"gauss_curvature", &gauss},
-            {"k1", &kappa1},
-            {"k2", &kappa2}};
-        for (const auto& [name, values] : fields)
-          setVertexField(in.mesh.cloud, name, *values, precision);
+        setCurvatureFields(in.mesh.cloud, curvatures, precision);
         if (color != "none") {
-          const Eigen::VectorXd& values = color == "mean"    ? mean
-                                          : color == "gauss" ? gauss
-                                          : color == "k1"    ? kappa1
-                                                             : kappa2;
+          const Eigen::VectorXd& values = color == "mean"    ? curvatures.mean
+                                          : color == "gauss" ? curvatures.gauss
+                                          : color == "k1"    ? curvatures.k1
+                                                             : curvatures.k2;
           tools::setColorMapFields(
               kName, in.mesh.cloud, output,
               color == "mean" || color == "gauss" ? color + "_curvature" : color, values,

@@ -1,13 +1,8 @@
 // pcl_ddg_normals: per-vertex normals of a mesh (face-weighted or mean-curvature), or of a mesh or
 // point cloud by a plane (pca) or quadric fit to each point's neighbours.
-#include <pcl/exceptions.h>
-
-#include <cstdio>
-
 #include "common/local_fit_job.h"
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
-#include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/features/ring_surface_variation.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/surface/mesh_normals.h"
@@ -70,42 +65,17 @@ int run(int argc, char** argv) {
     // A cloud larger than memory: fitted tile by tile from the file (pcl_ddg/tiling).
     if (!requested.empty() && !fitted)
       throw tools::UsageError("-memory applies to pca and quadric on clouds");
-    OutOfCoreOptions limits;
-    try {
-      limits.memory_budget = parseByteSize(*args.value("memory"));
-    } catch (const pcl::BadArgumentException& e) {
-      throw tools::UsageError("-memory needs " + errorDescription(e));
-    }
-    const LocalFitMethod fit_method =
-        requested == "quadric" ? LocalFitMethod::Quadric : LocalFitMethod::PCA;
-    const LocalFitOptions options = tools::outOfCoreFitArguments(args, fit_method);
+    tools::memoryArgument(args);
+    const LocalFitOptions options = tools::outOfCoreFitArguments(
+        args, requested == "quadric" ? LocalFitMethod::Quadric : LocalFitMethod::PCA);
     return tools::forEachInput(
         args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
-          tools::Timer timer(
-              "Fitting " + std::string(fit_method == LocalFitMethod::PCA ? "pca" : "quadric") +
-              " normals out of core (" + input + ", budget " + *args.value("memory") + ")");
-          const OutOfCoreReport report = [&] {
-            const tools::QuietPCLWarnings quiet;
-            return fitCloudFileOutOfCore(
-                input, output, options, limits,
-                tools::outOfCoreFields(
-                    output, precision, [&](pcl::PCLPointCloud2& piece, const LocalFitResult& fit) {
-                      tools::setNormalFields(piece, output, fit.normals, precision);
-                    }));
-          }();
-          timer.done(static_cast<std::size_t>(report.points));
-          std::fprintf(
-              stderr,
-              "%s: %zu tiles of at most %lld points, %lld halo growths, %lld points fitted "
-              "apart, at most %lld points at once\n",
-              kName, report.tiling.tiles, static_cast<long long>(report.points_per_tile),
-              static_cast<long long>(report.tiling.halo_growths),
-              static_cast<long long>(report.tiling.far_points),
-              static_cast<long long>(report.tiling.largest_gather));
-          LocalFitResult counts;
-          counts.failed_points = report.failed_points;
-          counts.fallback_points = report.fallback_points;
-          tools::warnAboutLocalFit(kName, counts);
+          tools::fitOutOfCore(
+              kName, args, input, output, options,
+              tools::outOfCoreFields(
+                  output, precision, [&](pcl::PCLPointCloud2& piece, const LocalFitResult& fit) {
+                    tools::setNormalFields(piece, output, fit.normals, precision);
+                  }));
         });
   }
   return tools::forEachInput(

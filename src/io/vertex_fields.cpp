@@ -23,7 +23,7 @@ std::uint32_t appendField(pcl::PCLPointCloud2& cloud, const std::string& name,
   const std::uint32_t old_step = cloud.point_step;
   const std::uint32_t new_step = old_step + size;
   std::vector<std::uint8_t> data(n * new_step, 0);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n && old_step > 0; ++i) {  // (no bytes: no pointers to copy from)
     std::memcpy(data.data() + i * new_step, cloud.data.data() + i * old_step, old_step);
   }
   pcl::PCLPointField field;
@@ -51,7 +51,7 @@ bool removeVertexField(pcl::PCLPointCloud2& cloud, const std::string& name) {
   const std::uint32_t new_step = old_step - size;
   const std::size_t n = pointCount(cloud);
   std::vector<std::uint8_t> data(n * new_step);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n && new_step > 0; ++i) {  // (the last field: nothing is left)
     const std::uint8_t* src = cloud.data.data() + i * old_step;
     std::uint8_t* dst = data.data() + i * new_step;
     std::memcpy(dst, src, begin);
@@ -110,7 +110,7 @@ void setVertexCoordinates(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& po
     const std::uint32_t old_step = cloud.point_step;
     const std::uint32_t new_step = old_step + 3 * size;
     std::vector<std::uint8_t> data(n * new_step, 0);
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = 0; i < n && old_step > 0; ++i) {
       std::memcpy(data.data() + i * new_step + 3 * size, cloud.data.data() + i * old_step,
                   old_step);
     }

@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <optional>
 
 #include "common/mesh_job.h"
+#include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -198,6 +200,40 @@ LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod 
         static_cast<unsigned int>(args.integer("max_nn", kDefaultMaxNeighbours));
   }
   return options;
+}
+
+std::uint64_t memoryArgument(const ToolArguments& args) {
+  try {
+    return parseByteSize(*args.value("memory"));
+  } catch (const pcl::BadArgumentException& e) {
+    throw UsageError("-memory needs " + errorDescription(e));
+  }
+}
+
+void fitOutOfCore(const char* tool_name, const ToolArguments& args, const std::string& input,
+                  const std::string& output, const LocalFitOptions& options,
+                  const ResultFields& fields) {
+  OutOfCoreOptions limits;
+  limits.memory_budget = memoryArgument(args);
+  Timer timer(std::string("Fitting ") +
+              (options.method == LocalFitMethod::PCA ? "planes" : "quadrics") +
+              " out of core (budget " + *args.value("memory") + ")");
+  const OutOfCoreReport report = [&] {
+    const QuietPCLWarnings quiet;
+    return fitCloudFileOutOfCore(input, output, options, limits, fields);
+  }();
+  timer.done(static_cast<std::size_t>(report.points));
+  std::fprintf(stderr,
+               "%s: %zu tiles of at most %lld points, %lld halo growths, %lld points fitted "
+               "apart, at most %lld points at once\n",
+               tool_name, report.tiling.tiles, static_cast<long long>(report.points_per_tile),
+               static_cast<long long>(report.tiling.halo_growths),
+               static_cast<long long>(report.tiling.far_points),
+               static_cast<long long>(report.tiling.largest_gather));
+  LocalFitResult counts;
+  counts.failed_points = report.failed_points;
+  counts.fallback_points = report.fallback_points;
+  warnAboutLocalFit(tool_name, counts);
 }
 
 ResultFields outOfCoreFields(

@@ -53,6 +53,15 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
  *  -max_nn, -viewpoint (unset: the file's VIEWPOINT). */
 LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod method);
 
+/** -memory SIZE (like 2G, 512M), checked before any file is read (UsageError). */
+std::uint64_t memoryArgument(const ToolArguments& args);
+
+/** The -memory path of the fitting tools: fitCloudFileOutOfCore from input to output with a
+ *  timing line, the tiling's figures and the warnings of warnAboutLocalFit. */
+void fitOutOfCore(const char* tool_name, const ToolArguments& args, const std::string& input,
+                  const std::string& output, const LocalFitOptions& options,
+                  const ResultFields& fields);
+
 /** Adds the fields a tool writes for a fit to a piece of a cloud read out of core, as the
  *  in-memory path writes them: float x y z first (double when the file declares double or
  *  `precision` asks), then the fields `add` sets. */
