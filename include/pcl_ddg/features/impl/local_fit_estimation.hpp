@@ -4,6 +4,7 @@
 #include <string>
 
 #include "pcl_ddg/features/local_fit_estimation.h"
+#include "pcl_ddg/features/spatial_order.h"
 #include "pcl_ddg/search/mesh_ring_search.h"
 
 #ifdef _OPENMP
@@ -62,6 +63,12 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut
 #endif
   std::int64_t failed = 0, fell_back = 0;
   output.is_dense = true;
+  // Queried in space-filling order (each result still goes to its point's place): consecutive
+  // queries share tree nodes and neighbours, whatever order the cloud is stored in.
+  std::vector<Eigen::Vector3f> query_positions(indices.size());
+  for (std::size_t i = 0; i < indices.size(); ++i)
+    query_positions[i] = (*this->input_)[indices[i]].getVector3fMap();
+  const std::vector<int> order = detail::spatialOrder(query_positions);
 #pragma omp parallel num_threads(threads) reduction(+ : failed, fell_back)
   {
     // Per-thread buffers, grown once and reused for every point.
@@ -69,7 +76,8 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut
     std::vector<float> squared_distances;
     Eigen::Matrix3Xd local(3, 64);
 #pragma omp for schedule(dynamic, 256)
-    for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(indices.size()); ++i) {
+    for (std::ptrdiff_t visit = 0; visit < static_cast<std::ptrdiff_t>(indices.size()); ++visit) {
+      const std::ptrdiff_t i = order[visit];
       const PointInT& query = (*this->input_)[indices[i]];
       FitOutcome outcome = FitOutcome::Failed;
       const bool capped_radius = this->search_radius_ > 0.0 && max_neighbours_ > 0;
