@@ -1,0 +1,13 @@
+# Real scans are read in place from the shared data folder (never copied into the repository).
+set(PCL_DDG_SHARED_DATA_DIR "" CACHE PATH "Folder holding CATALOG.md and meshes/, clouds/, range/")
+if(NOT PCL_DDG_SHARED_DATA_DIR)
+  foreach(candidate "$ENV{PCL_DDG_SHARED_DATA}" "${PROJECT_SOURCE_DIR}/../shared/data" "/work/shared/data")
+    if(candidate AND EXISTS "${candidate}/CATALOG.md")
+      get_filename_component(PCL_DDG_SHARED_DATA_DIR "${candidate}" ABSOLUTE)
+      break()
+    endif()
+  endforeach()
+endif()
+if(NOT PCL_DDG_SHARED_DATA_DIR)
+  message(WARNING "shared data not found: regression tests will fail (set PCL_DDG_SHARED_DATA_DIR)")
+endif()
