@@ -68,8 +68,9 @@ class OutOfCore : public ::testing::Test {
 };
 
 TEST_F(OutOfCore, EverySharedCloudGivesTheInMemoryOutputByteForByte) {
-  for (const char* file : {"bun0", "milk", "office1", "rs1", "table_scene_mug_stereo_textured",
-                           "terrain_CSite1_red2-utm", "tutorials_room_scan1"}) {
+  // (test_tiled_local_fit covers every shared cloud; here the tool's path on the kinds there
+  // are: organized with colours and NaN, far from the origin, half duplicates.)
+  for (const char* file : {"office1", "terrain_CSite1_red2-utm", "tutorials_room_scan1"}) {
     // The binary encodings that can be read in pieces: PCD "binary" (PCL's writer) and PLY.
     pcl::PCLPointCloud2 cloud;
     ASSERT_EQ(pcl::io::loadPCDFile(sharedData(std::string("clouds/") + file + ".pcd"), cloud), 0);
@@ -145,8 +146,9 @@ std::int64_t peakMemory(const std::string& arguments) {
 }
 
 TEST_F(OutOfCore, StaysWithinItsBudgetWhereMemoryWouldHoldTheWholeCloud) {
-  // Three million points of a torus, written as a scanner would: row after row.
-  const int around = 3000, tube = 1000;
+  // Three million points of a torus, written as a scanner would: row after row (a tenth of it
+  // under AddressSanitizer, where the peaks are not compared and the time would be long).
+  const int around = kUnderAddressSanitizer ? 300 : 3000, tube = 1000;
   {
     std::ofstream out(path("torus.ply"), std::ios::binary);
     out << "ply\nformat binary_little_endian 1.0\nelement vertex " << around * tube
@@ -166,9 +168,9 @@ TEST_F(OutOfCore, StaysWithinItsBudgetWhereMemoryWouldHoldTheWholeCloud) {
   constexpr std::int64_t kBudget = 48 << 20;
   const std::int64_t tiled =
       peakMemory(path("torus.ply") + " " + path("tiled.ply") + " -memory 48M");
-  std::printf("3M points: peak %lld MiB in memory, %lld MiB with -memory 48M (idle %lld MiB)\n",
-              static_cast<long long>(whole >> 20), static_cast<long long>(tiled >> 20),
-              static_cast<long long>(idle >> 20));
+  std::printf("%d points: peak %lld MiB in memory, %lld MiB with -memory 48M (idle %lld MiB)\n",
+              around * tube, static_cast<long long>(whole >> 20),
+              static_cast<long long>(tiled >> 20), static_cast<long long>(idle >> 20));
   if (!kUnderAddressSanitizer) {  // its shadow memory and quarantine make peaks meaningless
     EXPECT_LT(tiled - idle, 2 * kBudget);
     EXPECT_GT(whole, 2 * tiled);
