@@ -85,8 +85,8 @@ SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name) {
   if (bad.count > 0)
     warn(tool_name, std::to_string(bad.count) + " non-finite points (NaN output there)");
   input.points = toXYZ(positions);
-  input.spacing = meanSpacing(input.points);
-  return input;
+  return input;  // the spacing of a cloud costs a kd-tree: measured only when asked for
+                 // (-radius 2.5h)
 }
 
 namespace {
@@ -175,7 +175,13 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
   if (!options.viewpoint) options.viewpoint = input.sensor_pose.origin;
   const RadiusArgument radius = radiusArgument(args);
   if (radius.value > 0.0) {
-    options.radius = radius.value * (radius.in_spacings ? input.spacing : 1.0);
+    double spacing = input.spacing;
+    if (radius.in_spacings && !input.topology) {
+      Timer timer("Measuring the point spacing");
+      spacing = meanSpacing(input.points);
+      timer.done(input.points->size());
+    }
+    options.radius = radius.value * (radius.in_spacings ? spacing : 1.0);
     options.max_neighbours =
         static_cast<unsigned int>(args.integer("max_nn", kDefaultMaxNeighbours));
   }

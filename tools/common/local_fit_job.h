@@ -27,7 +27,8 @@ struct SurfaceInput {
   std::shared_ptr<const MeshTopology> topology;
   Eigen::Matrix3Xd positions;                  ///< double, as read
   pcl::PointCloud<pcl::PointXYZ>::Ptr points;  ///< the same, as PCL points
-  /** Mean edge length of a mesh, or mean nearest-neighbour distance of a cloud. */
+  /** Mean edge length of a mesh (a cloud's mean nearest-neighbour distance costs a kd-tree, and
+   *  is measured by localFitArguments when -radius asks for it). */
   double spacing = 0.0;
   SensorPose sensor_pose;  ///< a PCD's VIEWPOINT (kept for the output)
   FieldPrecision coordinate_precision = FieldPrecision::Float;  ///< as the file declares them
