@@ -170,14 +170,6 @@ TEST_F(ToolErrors, AFileWithoutExtensionOrOfAnUnknownKindIsNamedAsSuch) {
   EXPECT_NE(unknown.err.find("unknown file type '.xyz'"), std::string::npos) << unknown.err;
 }
 
-}  // namespace
-}  // namespace test
-}  // namespace pcl_ddg
-
-namespace pcl_ddg {
-namespace test {
-namespace {
-
 // PCL's batch mode: every file of a folder, one broken file not stopping the others, a summary,
 // exit 1 when something failed.
 TEST_F(ToolErrors, BatchModeGoesOnPastABrokenFileAndSaysSo) {
@@ -260,14 +252,6 @@ TEST_F(ToolErrors, BatchModeOptionsAreCheckedFirst) {
   EXPECT_EQ(runTool(normals, " -input_dir " + path("in") + " -output_dir " + path("out")).exit_code,
             1);
 }
-
-}  // namespace
-}  // namespace test
-}  // namespace pcl_ddg
-
-namespace pcl_ddg {
-namespace test {
-namespace {
 
 // On a terminal a long phase shows its running time; logs and pipes get the timing line alone.
 // (The delay is set to 0 here so that short runs count as long.)

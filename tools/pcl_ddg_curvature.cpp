@@ -96,17 +96,11 @@ int run(int argc, char** argv) {
     if (args.has("smooth") || color != "none") {
       throw tools::UsageError("-smooth and -color need the whole field at once; not with -memory");
     }
-    tools::memoryArgument(args);
     const LocalFitOptions options = tools::outOfCoreFitArguments(args, LocalFitMethod::Quadric);
-    return tools::forEachInput(
-        args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
-          tools::fitOutOfCore(
-              kName, args, input, output, options,
-              tools::outOfCoreFields(
-                  output, precision, [&](pcl::PCLPointCloud2& piece, const LocalFitResult& fit) {
-                    setCurvatureFields(piece, quadricFields(piece, output, fit, precision),
-                                       precision);
-                  }));
+    return tools::fitEachInputOutOfCore(
+        kName, args, options, precision,
+        [&](pcl::PCLPointCloud2& piece, const std::string& output, const LocalFitResult& fit) {
+          setCurvatureFields(piece, quadricFields(piece, output, fit, precision), precision);
         });
   }
 

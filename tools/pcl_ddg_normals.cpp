@@ -65,17 +65,12 @@ int run(int argc, char** argv) {
     // A cloud larger than memory: fitted tile by tile from the file (pcl_ddg/tiling).
     if (!requested.empty() && !fitted)
       throw tools::UsageError("-memory applies to pca and quadric on clouds");
-    tools::memoryArgument(args);
     const LocalFitOptions options = tools::outOfCoreFitArguments(
         args, requested == "quadric" ? LocalFitMethod::Quadric : LocalFitMethod::PCA);
-    return tools::forEachInput(
-        args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
-          tools::fitOutOfCore(
-              kName, args, input, output, options,
-              tools::outOfCoreFields(
-                  output, precision, [&](pcl::PCLPointCloud2& piece, const LocalFitResult& fit) {
-                    tools::setNormalFields(piece, output, fit.normals, precision);
-                  }));
+    return tools::fitEachInputOutOfCore(
+        kName, args, options, precision,
+        [&](pcl::PCLPointCloud2& piece, const std::string& output, const LocalFitResult& fit) {
+          tools::setNormalFields(piece, output, fit.normals, precision);
         });
   }
   return tools::forEachInput(

@@ -43,6 +43,13 @@ struct BinaryCloudLayout {
   std::string (*header_for)(const std::string& header, std::int64_t count) = nullptr;
 };
 
+/** text with every line passed through edit (the header rewriting of BinaryCloudLayout). */
+std::string editLines(const std::string& text, void (*edit)(std::string& line, std::int64_t count),
+                      std::int64_t count);
+
+/** A PLY header with its vertex count set to count. */
+std::string plyHeaderWithVertices(const std::string& header, std::int64_t count);
+
 /** The layout of a PCD file whose DATA is binary (head: the file's first bytes, the whole header
  *  among them); FileFormatException for any other. */
 BinaryCloudLayout pcdBinaryLayout(std::string_view head);

@@ -213,15 +213,14 @@ namespace {
 
 // The header with WIDTH, HEIGHT and POINTS set for a piece of `count` points.
 std::string pcdHeaderFor(const std::string& header, std::int64_t count) {
-  std::istringstream lines(header);
-  std::string out;
-  for (std::string line; std::getline(lines, line);) {
-    const std::string key = line.substr(0, line.find(' '));
-    if (key == "WIDTH" || key == "POINTS") line = key + " " + std::to_string(count);
-    if (key == "HEIGHT") line = "HEIGHT 1";
-    out += line + "\n";
-  }
-  return out;
+  return editLines(
+      header,
+      [](std::string& line, std::int64_t n) {
+        const std::string key = line.substr(0, line.find(' '));
+        if (key == "WIDTH" || key == "POINTS") line = key + " " + std::to_string(n);
+        if (key == "HEIGHT") line = "HEIGHT 1";
+      },
+      count);
 }
 
 }  // namespace

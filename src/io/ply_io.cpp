@@ -338,20 +338,25 @@ pcl::PCLPointCloud2 organizeOnGrid(const pcl::PCLPointCloud2& points,
 
 }  // namespace
 
-namespace {
-
-// The header with the vertex count set for a piece of `count` points.
-std::string plyHeaderFor(const std::string& header, std::int64_t count) {
-  std::istringstream lines(header);
+std::string editLines(const std::string& text, void (*edit)(std::string& line, std::int64_t count),
+                      std::int64_t count) {
+  std::istringstream lines(text);
   std::string out;
   for (std::string line; std::getline(lines, line);) {
-    if (line.rfind("element vertex ", 0) == 0) line = "element vertex " + std::to_string(count);
+    edit(line, count);
     out += line + "\n";
   }
   return out;
 }
 
-}  // namespace
+std::string plyHeaderWithVertices(const std::string& header, std::int64_t count) {
+  return editLines(
+      header,
+      [](std::string& line, std::int64_t n) {
+        if (line.rfind("element vertex ", 0) == 0) line = "element vertex " + std::to_string(n);
+      },
+      count);
+}
 
 BinaryCloudLayout plyBinaryLayout(std::string_view head) {
   ByteCursor cursor(head);
@@ -382,7 +387,7 @@ BinaryCloudLayout plyBinaryLayout(std::string_view head) {
       std::min<std::int64_t>(layout.points, std::numeric_limits<std::uint32_t>::max()));
   layout.height = 1;
   layout.header = std::string(head.substr(0, cursor.position()));
-  layout.header_for = plyHeaderFor;
+  layout.header_for = plyHeaderWithVertices;
   return layout;
 }
 

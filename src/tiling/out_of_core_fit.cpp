@@ -151,14 +151,29 @@ class ResultFile {
   ResultFile(const ResultFile&) = delete;
   ResultFile& operator=(const ResultFile&) = delete;
 
-  void put(std::int64_t point, const pcl::Normal& n, const pcl::PrincipalCurvatures* c) {
-    float record[9] = {n.normal_x, n.normal_y, n.normal_z, n.curvature};
-    if (c) {
-      const float more[5] = {c->pc1, c->pc2, c->principal_curvature_x, c->principal_curvature_y,
-                             c->principal_curvature_z};
-      std::copy(more, more + 5, record + 4);
+  /** Writes the fit of the points `positions` (into the fit's order) whose indices in the input
+   *  are `global` (ascending): one write per run of consecutive indices, not one per point. */
+  void put(const std::vector<std::int64_t>& global, const pcl::Indices& positions,
+           const LocalFitResult& fit) {
+    std::vector<float> run;
+    std::int64_t run_first = 0;
+    for (std::size_t j = 0; j < positions.size(); ++j) {
+      const std::int64_t point = global[positions[j]];
+      if (!run.empty() && point != run_first + static_cast<std::int64_t>(run.size()) / floats_) {
+        writeAt(run_first, run.data(), static_cast<std::int64_t>(run.size()) / floats_);
+        run.clear();
+      }
+      if (run.empty()) run_first = point;
+      const pcl::Normal& n = fit.normals[j];
+      run.insert(run.end(), {n.normal_x, n.normal_y, n.normal_z, n.curvature});
+      if (floats_ == 9) {
+        const pcl::PrincipalCurvatures& c = fit.curvatures[j];
+        run.insert(run.end(), {c.pc1, c.pc2, c.principal_curvature_x, c.principal_curvature_y,
+                               c.principal_curvature_z});
+      }
     }
-    writeAt(point, record, 1);
+    if (!run.empty())
+      writeAt(run_first, run.data(), static_cast<std::int64_t>(run.size()) / floats_);
   }
 
   /** The results of points [first, first + count) as a fit of that piece. */
@@ -248,14 +263,7 @@ class OutputPieces {
       detail::writePLY(encoded, mesh, PlyEncoding::Binary);
       const std::string bytes = encoded.str();
       const std::size_t body = bytes.find("end_header\n") + 11;
-      if (first_) {
-        std::istringstream lines(bytes.substr(0, body));
-        for (std::string line; std::getline(lines, line);) {
-          if (line.rfind("element vertex ", 0) == 0)
-            line = "element vertex " + std::to_string(layout_.points);
-          out_ << line << '\n';
-        }
-      }
+      if (first_) out_ << detail::plyHeaderWithVertices(bytes.substr(0, body), layout_.points);
       out_.write(bytes.data() + body, static_cast<std::streamsize>(bytes.size() - body));
     }
     first_ = false;
@@ -407,10 +415,7 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
       return points;
     };
     const auto consume = [&](const TilePoints& points, const LocalFitResult& fit) {
-      for (std::size_t j = 0; j < points.own->size(); ++j) {
-        results.put(points.global_index[(*points.own)[j]], fit.normals[j],
-                    fit.curvatures.empty() ? nullptr : &fit.curvatures[j]);
-      }
+      results.put(points.global_index, *points.own, fit);
       report.failed_points += fit.failed_points;
       report.fallback_points += fit.fallback_points;
     };

@@ -216,6 +216,8 @@ std::uint64_t memoryArgument(const ToolArguments& args) {
   }
 }
 
+namespace {
+
 void fitOutOfCore(const char* tool_name, const ToolArguments& args, const std::string& input,
                   const std::string& output, const LocalFitOptions& options,
                   const ResultFields& fields) {
@@ -242,9 +244,8 @@ void fitOutOfCore(const char* tool_name, const ToolArguments& args, const std::s
   warnAboutLocalFit(tool_name, counts);
 }
 
-ResultFields outOfCoreFields(
-    const std::string& output_path, FieldPrecision precision,
-    const std::function<void(pcl::PCLPointCloud2&, const LocalFitResult&)>& add) {
+ResultFields outOfCoreFields(const std::string& output_path, FieldPrecision precision,
+                             const PieceFields& add) {
   return [output_path, precision, add](pcl::PCLPointCloud2& piece, const LocalFitResult& fit) {
     const Eigen::Matrix3Xd positions = vertexPositions(piece, NonFinitePolicy::Keep);
     const bool declared_double =
@@ -254,12 +255,25 @@ ResultFields outOfCoreFields(
         });
     // As loading (float x y z for PCL), adding the fields, and saving do in memory.
     setVertexCoordinates(piece, positions, FieldPrecision::Float);
-    add(piece, fit);
+    add(piece, output_path, fit);
     setVertexCoordinates(
         piece, positions,
         coordinatePrecision(declared_double ? FieldPrecision::Double : FieldPrecision::Float,
                             precision));
   };
+}
+
+}  // namespace
+
+int fitEachInputOutOfCore(const char* tool_name, const ToolArguments& args,
+                          const LocalFitOptions& options, FieldPrecision precision,
+                          const PieceFields& add) {
+  memoryArgument(args);  // checked before any file is read
+  return forEachInput(args, tool_name, {"ply", "pcd"},
+                      [&](const std::string& input, const std::string& output) {
+                        fitOutOfCore(tool_name, args, input, output, options,
+                                     outOfCoreFields(output, precision, add));
+                      });
 }
 
 void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,

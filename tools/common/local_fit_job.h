@@ -57,18 +57,20 @@ LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod 
 /** -memory SIZE (like 2G, 512M), checked before any file is read (UsageError). */
 std::uint64_t memoryArgument(const ToolArguments& args);
 
-/** The -memory path of the fitting tools: fitCloudFileOutOfCore from input to output with a
- *  timing line, the tiling's figures and the warnings of warnAboutLocalFit. */
-void fitOutOfCore(const char* tool_name, const ToolArguments& args, const std::string& input,
-                  const std::string& output, const LocalFitOptions& options,
-                  const ResultFields& fields);
+/** Adds a tool's fields for a fit to a piece of its output (the piece of the input the fit is of).
+ */
+using PieceFields = std::function<void(pcl::PCLPointCloud2& piece, const std::string& output,
+                                       const LocalFitResult& fit)>;
 
-/** Adds the fields a tool writes for a fit to a piece of a cloud read out of core, as the
- *  in-memory path writes them: float x y z first (double when the file declares double or
- *  `precision` asks), then the fields `add` sets. */
-ResultFields outOfCoreFields(
-    const std::string& output_path, FieldPrecision precision,
-    const std::function<void(pcl::PCLPointCloud2&, const LocalFitResult&)>& add);
+/**
+ * The -memory path of the fitting tools, on every input (forEachInput): fitCloudFileOutOfCore
+ * with a timing line, the tiling's figures and the warnings of warnAboutLocalFit. Each piece gets
+ * what the in-memory path writes: float x y z first (double when the file declares double or
+ * `precision` asks), and the fields `add` sets.
+ */
+int fitEachInputOutOfCore(const char* tool_name, const ToolArguments& args,
+                          const LocalFitOptions& options, FieldPrecision precision,
+                          const PieceFields& add);
 
 /** Writes normals as nx ny nz (PLY) or normal_x normal_y normal_z (PCD), and PCL's curvature
  *  (surface variation) as "curvature". */
