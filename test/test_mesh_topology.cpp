@@ -1,7 +1,12 @@
 // MeshTopology on hand-made dirty meshes (each defect alone) and on analytic meshes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
+#include <map>
+#include <random>
+#include <set>
+#include <string>
 
 #include "analytic_surfaces.h"
 #include "mesh/disjoint_sets.h"  // internal: the union-find under the orientation check
@@ -105,6 +110,65 @@ TEST(MeshTopology, DuplicateFaceIsCountedAndKept) {
   const MeshTopology t = topologyOf(4, {{0, 1, 2}, {1, 2, 0}, {0, 2, 3}});
   EXPECT_EQ(t.counts().duplicate_polygons, 1);
   EXPECT_EQ(t.numTriangles(), 3);
+}
+
+// Random polygon soups with every kind of overlap (the same corners in another order or winding,
+// repeated corners, quads, shared and non-manifold edges) against counts made by brute force
+// from the definitions: duplicates are polygons whose corner multiset appeared before; an edge is
+// non-manifold on more than two triangles; the mesh is consistently oriented when every edge of
+// two triangles is run once in each direction.
+TEST(MeshTopology, CountsMatchBruteForceOnRandomPolygonSoups) {
+  std::mt19937 random(11);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int num_vertices = 4 + trial % 9;
+    std::uniform_int_distribution<int> vertex(0, num_vertices - 1), size(3, 5), coin(0, 3);
+    std::vector<std::vector<int>> polygons;
+    for (int p = 0; p < 12; ++p) {
+      if (!polygons.empty() && coin(random) == 0) {  // an earlier polygon, rotated or reversed
+        std::vector<int> copy =
+            polygons[std::uniform_int_distribution<std::size_t>(0, polygons.size() - 1)(random)];
+        std::rotate(copy.begin(), copy.begin() + 1, copy.end());
+        if (coin(random) < 2) std::reverse(copy.begin(), copy.end());
+        polygons.push_back(copy);
+        continue;
+      }
+      std::vector<int> corners(static_cast<std::size_t>(size(random) == 5 ? 4 : 3));
+      for (int& c : corners) c = vertex(random);
+      polygons.push_back(corners);
+    }
+    const MeshTopology t = topologyOf(num_vertices, polygons);
+
+    std::set<std::vector<int>> seen;
+    std::int64_t duplicates = 0;
+    std::map<std::pair<int, int>, int> directed;  // triangle sides, in their direction
+    for (const auto& polygon : polygons) {
+      std::vector<int> key = polygon;
+      std::sort(key.begin(), key.end());
+      duplicates += !seen.insert(key).second;
+    }
+    for (int f = 0; f < t.numTriangles(); ++f) {
+      for (int k = 0; k < 3; ++k) ++directed[{t.triangles()(k, f), t.triangles()((k + 1) % 3, f)}];
+    }
+    std::int64_t nonmanifold = 0;
+    bool consistent = true;
+    for (const auto& [side, count] : directed) {
+      if (side.first > side.second) continue;
+      const auto reverse = directed.find({side.second, side.first});
+      const int backward = reverse == directed.end() ? 0 : reverse->second;
+      nonmanifold += count + backward > 2;
+      if (count + backward == 2 && count != 1) consistent = false;
+    }
+    for (const auto& [side, count] : directed) {  // edges run only backwards
+      if (side.first > side.second && directed.count({side.second, side.first}) == 0) {
+        nonmanifold += count > 2;
+        if (count == 2) consistent = false;
+      }
+    }
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    EXPECT_EQ(t.counts().duplicate_polygons, duplicates);
+    EXPECT_EQ(t.counts().nonmanifold_edges, nonmanifold);
+    EXPECT_EQ(t.counts().consistently_oriented, consistent);
+  }
 }
 
 TEST(MeshTopology, QuadAndPentagonAreFanTriangulated) {

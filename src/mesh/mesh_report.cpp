@@ -11,20 +11,21 @@
 namespace pcl_ddg {
 
 std::int64_t countZeroAreaFaces(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+  // A face counts when all its triangles are degenerate; its triangles are consecutive, and it is
+  // counted from its first one.
   const Eigen::Matrix3Xi& tris = topology.triangles();
   const std::vector<int>& source = topology.triangleSource();
+  const int num_triangles = topology.numTriangles();
   std::int64_t count = 0;
-  for (int t = 0; t < topology.numTriangles();) {
-    // Triangles of one face are consecutive.
+#pragma omp parallel for schedule(static) reduction(+ : count)
+  for (int t = 0; t < num_triangles; ++t) {
+    if (t > 0 && source[t - 1] == source[t]) continue;
     bool all_degenerate = true;
-    int end = t;
-    for (; end < topology.numTriangles() && source[end] == source[t]; ++end) {
-      all_degenerate = all_degenerate && isDegenerateTriangle(positions.col(tris(0, end)),
-                                                              positions.col(tris(1, end)),
-                                                              positions.col(tris(2, end)));
+    for (int u = t; u < num_triangles && source[u] == source[t] && all_degenerate; ++u) {
+      all_degenerate = isDegenerateTriangle(positions.col(tris(0, u)), positions.col(tris(1, u)),
+                                            positions.col(tris(2, u)));
     }
-    if (all_degenerate) ++count;
-    t = end;
+    count += all_degenerate;
   }
   return count;
 }

@@ -4,6 +4,10 @@
 #include <numeric>
 #include <sstream>
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #include "disjoint_sets.h"
 #include "pcl_ddg/exceptions.h"
 
@@ -18,6 +22,29 @@ std::vector<pcl::Vertices> trianglesAsPolygons(const Eigen::Matrix3Xi& triangles
     }
   }
   return polygons;
+}
+
+// Runs body(first, last) once per thread, on the thread's own contiguous range of vertices. Passes
+// that scatter per-triangle or per-edge data into per-vertex rows use it: every thread reads the
+// whole input but writes only its own rows, so no atomics are needed and each thread's random
+// writes land in a smaller part of memory.
+template <class Body>
+void forEachVertexRange(int num_vertices, const Body& body) {
+#pragma omp parallel
+  {
+#ifdef _OPENMP
+    const std::int64_t threads = omp_get_num_threads(), id = omp_get_thread_num();
+#else
+    const std::int64_t threads = 1, id = 0;
+#endif
+    body(static_cast<int>(num_vertices * id / threads),
+         static_cast<int>(num_vertices * (id + 1) / threads));
+  }
+}
+
+bool isPlainTriangle(const pcl::Indices& corners) {
+  return corners.size() == 3 && corners[0] != corners[1] && corners[1] != corners[2] &&
+         corners[0] != corners[2];
 }
 
 bool hasRepeatedCorner(const pcl::Indices& corners) {
@@ -51,16 +78,17 @@ MeshTopology::MeshTopology(int num_vertices, const Eigen::Matrix3Xi& triangles,
 void MeshTopology::build(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy) {
   if (num_vertices_ <= 0) throw InvalidMeshException("mesh has no vertices");
   triangulate(polygons, policy);
-  countDuplicatePolygons(polygons);
   {
-    const Wedges wedges = buildVertexTriangles();
+    const Wedges wedges = buildVertexTriangles(polygons);
     buildVertexNeighbours(wedges);
     buildEdges(wedges);
     classifyEdgesAndVertices();
     findBowTieVertices(wedges);
+    countDuplicatePolygons(polygons, wedges);
   }
   findComponents();
-  checkOrientation();
+  // A consistently oriented mesh is orientable; only an inconsistent one needs the search.
+  if (!counts_.consistently_oriented) checkOrientability();
   countBoundaryLoops();
 }
 
@@ -113,71 +141,98 @@ void MeshTopology::triangulate(const std::vector<pcl::Vertices>& polygons,
   triangles_.conservativeResize(3, t);
 }
 
-void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons) {
-  // Two polygons are duplicates when they have the same corner set. Bucket the polygons by their
-  // smallest corner (a counting sort: linear), then compare sorted corner sets within a bucket,
-  // which holds a handful of polygons. Polygons out of range take no part (they are not faces of
-  // the mesh), nor do those with fewer than three corners.
+void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons,
+                                          const Wedges& wedges) {
+  // Two polygons are duplicates when they have the same corners (as a multiset). Plain triangles,
+  // nearly every polygon of a scan, are compared at their smallest corner by the other two, which
+  // the wedges of that corner's row hold: a local, parallel pass. Other polygons (more corners, a
+  // repeated corner) are bucketed by their smallest corner and compared by sorted corner lists.
+  // Out-of-range polygons take no part (they are not faces of the mesh), nor do those with fewer
+  // than three corners.
+  std::int64_t duplicates = 0;
+#pragma omp parallel reduction(+ : duplicates)
+  {
+    std::vector<std::uint64_t> keys;  // per thread, reused across rows
+#pragma omp for schedule(static)
+    for (int v = 0; v < num_vertices_; ++v) {
+      keys.clear();
+      for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
+        const Wedge& w = wedges[i];
+        if (!w.plain_triangle || w.next < v || w.previous < v) continue;
+        const auto [low, high] = std::minmax(w.next, w.previous);
+        keys.push_back(static_cast<std::uint64_t>(low) << 32 | static_cast<std::uint32_t>(high));
+      }
+      if (keys.size() < 2) continue;
+      std::sort(keys.begin(), keys.end());
+      for (std::size_t j = 1; j < keys.size(); ++j) duplicates += keys[j] == keys[j - 1];
+    }
+  }
+
   const auto valid = [&](const pcl::Vertices& p) {
     return p.vertices.size() >= 3 &&
            std::all_of(p.vertices.begin(), p.vertices.end(),
                        [&](pcl::index_t i) { return i >= 0 && i < num_vertices_; });
   };
-  std::vector<int> bucket_start(num_vertices_ + 1, 0);
-  std::vector<int> smallest(polygons.size(), -1);
+  std::vector<std::pair<int, int>> others;  // (smallest corner, polygon)
   for (std::size_t i = 0; i < polygons.size(); ++i) {
-    if (!valid(polygons[i])) continue;
-    smallest[i] = *std::min_element(polygons[i].vertices.begin(), polygons[i].vertices.end());
-    ++bucket_start[smallest[i] + 1];
+    const pcl::Indices& corners = polygons[i].vertices;
+    if (isPlainTriangle(corners) || !valid(polygons[i])) continue;
+    others.emplace_back(*std::min_element(corners.begin(), corners.end()), static_cast<int>(i));
   }
-  std::partial_sum(bucket_start.begin(), bucket_start.end(), bucket_start.begin());
-  std::vector<int> bucketed(bucket_start.back());
-  std::vector<int> cursor(bucket_start.begin(), bucket_start.end() - 1);
-  for (std::size_t i = 0; i < polygons.size(); ++i) {
-    if (smallest[i] >= 0) bucketed[cursor[smallest[i]]++] = static_cast<int>(i);
-  }
-
-  std::int64_t duplicates = 0;
-#pragma omp parallel reduction(+ : duplicates)
-  {
-    std::vector<std::vector<pcl::index_t>> keys;  // per thread, reused across buckets
-#pragma omp for schedule(dynamic, 4096)
-    for (int v = 0; v < num_vertices_; ++v) {
-      const int begin = bucket_start[v], end = bucket_start[v + 1];
-      if (end - begin < 2) continue;
-      keys.resize(static_cast<std::size_t>(end - begin));
-      for (int j = begin; j < end; ++j) {
-        auto& key = keys[static_cast<std::size_t>(j - begin)];
-        key.assign(polygons[bucketed[j]].vertices.begin(), polygons[bucketed[j]].vertices.end());
-        std::sort(key.begin(), key.end());
-      }
-      std::sort(keys.begin(), keys.end());
-      for (std::size_t j = 1; j < keys.size(); ++j) duplicates += keys[j] == keys[j - 1];
+  std::sort(others.begin(), others.end());
+  std::vector<std::vector<pcl::index_t>> bucket;
+  for (std::size_t begin = 0, end; begin < others.size(); begin = end) {
+    for (end = begin + 1; end < others.size() && others[end].first == others[begin].first; ++end) {
     }
+    if (end - begin < 2) continue;
+    bucket.resize(end - begin);
+    for (std::size_t j = begin; j < end; ++j) {
+      auto& key = bucket[j - begin];
+      const pcl::Indices& corners = polygons[others[j].second].vertices;
+      key.assign(corners.begin(), corners.end());
+      std::sort(key.begin(), key.end());
+    }
+    std::sort(bucket.begin(), bucket.end());
+    for (std::size_t j = 1; j < bucket.size(); ++j) duplicates += bucket[j] == bucket[j - 1];
   }
   counts_.duplicate_polygons = duplicates;
 }
 
-MeshTopology::Wedges MeshTopology::buildVertexTriangles() {
+MeshTopology::Wedges MeshTopology::buildVertexTriangles(
+    const std::vector<pcl::Vertices>& polygons) {
+  const Eigen::Index num_triangles = triangles_.cols();
   vt_offsets_.assign(num_vertices_ + 1, 0);
-  for (Eigen::Index t = 0; t < triangles_.cols(); ++t) {
-    for (int k = 0; k < 3; ++k) ++vt_offsets_[triangles_(k, t) + 1];
-  }
-  std::partial_sum(vt_offsets_.begin(), vt_offsets_.end(), vt_offsets_.begin());
-  const std::size_t incidences = static_cast<std::size_t>(vt_offsets_.back());
-  vt_triangles_.resize(incidences);
-  Wedges wedges{std::vector<int>(incidences), std::vector<int>(incidences),
-                std::vector<std::uint8_t>(incidences)};
-  std::vector<int> cursor(vt_offsets_.begin(), vt_offsets_.end() - 1);
-  for (Eigen::Index t = 0; t < triangles_.cols(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      const int at = cursor[triangles_(k, t)]++;
-      vt_triangles_[at] = static_cast<int>(t);
-      wedges.next[at] = triangles_((k + 1) % 3, t);
-      wedges.previous[at] = triangles_((k + 2) % 3, t);
-      wedges.corner[at] = static_cast<std::uint8_t>(k);
+  forEachVertexRange(num_vertices_, [&](int first, int last) {
+    for (Eigen::Index c = 0; c < 3 * num_triangles; ++c) {
+      const int v = triangles_.data()[c];
+      if (v >= first && v < last) ++vt_offsets_[v + 1];
     }
+  });
+  std::partial_sum(vt_offsets_.begin(), vt_offsets_.end(), vt_offsets_.begin());
+
+  // A triangle is a plain input triangle when its source polygon is; sources ascend with t.
+  std::vector<char> plain(num_triangles);
+#pragma omp parallel for schedule(static)
+  for (Eigen::Index t = 0; t < num_triangles; ++t) {
+    plain[t] = isPlainTriangle(polygons[triangle_source_[t]].vertices);
   }
+
+  Wedges wedges(static_cast<std::size_t>(vt_offsets_.back()));
+  std::vector<int> cursor(vt_offsets_.begin(), vt_offsets_.end() - 1);
+  forEachVertexRange(num_vertices_, [&](int first, int last) {
+    for (Eigen::Index t = 0; t < num_triangles; ++t) {
+      for (int k = 0; k < 3; ++k) {
+        const int v = triangles_(k, t);
+        if (v < first || v >= last) continue;
+        wedges[cursor[v]++] = {static_cast<int>(t), triangles_((k + 1) % 3, t),
+                               triangles_((k + 2) % 3, t), static_cast<std::uint8_t>(k),
+                               plain[t] != 0};
+      }
+    }
+  });
+  vt_triangles_.resize(wedges.size());
+#pragma omp parallel for schedule(static)
+  for (std::size_t i = 0; i < wedges.size(); ++i) vt_triangles_[i] = wedges[i].triangle;
   return wedges;
 }
 
@@ -191,8 +246,8 @@ void MeshTopology::buildVertexNeighbours(const Wedges& wedges) {
     int* out = scratch.data() + 2 * vt_offsets_[v];
     int n = 0;
     for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
-      out[n++] = wedges.next[i];
-      out[n++] = wedges.previous[i];
+      out[n++] = wedges[i].next;
+      out[n++] = wedges[i].previous;
     }
     std::sort(out, out + n);
     row_size[v] = static_cast<int>(std::unique(out, out + n) - out);
@@ -216,8 +271,9 @@ int MeshTopology::findEdge(int a, int b) const {
 
 void MeshTopology::buildEdges(const Wedges& wedges) {
   // Edge ids in order of (smaller vertex, larger vertex), from a prefix sum over each row's count
-  // of larger neighbours (rows are sorted). Every edge and every triangle side is then written by
-  // its smaller end point alone, so the rows are processed in parallel without conflicts.
+  // of larger neighbours (rows are sorted). Edge (v, w), v < w, belongs to v's row; w's row lists
+  // its smaller neighbours first and in ascending order, so visiting v in ascending order and
+  // appending each edge to w's row fills those entries in place (a CSR transpose, no searching).
   const auto firstLarger = [&](int v) {
     const IndexSpan row = neighbours(v);
     return static_cast<int>(std::upper_bound(row.begin(), row.end(), v) - row.begin());
@@ -230,29 +286,29 @@ void MeshTopology::buildEdges(const Wedges& wedges) {
 
   vv_edges_.resize(vv_neighbours_.size());
   edge_vertices_.resize(2, num_edges);
-#pragma omp parallel for schedule(static)
-  for (int v = 0; v < num_vertices_; ++v) {
-    const int larger = firstLarger(v);
-    for (int i = 0; i < neighbours(v).size(); ++i) {
-      const int w = neighbours(v)[i];
-      int e;
-      if (i >= larger) {
-        e = first_edge[v] + i - larger;
-        edge_vertices_.col(e) << v, w;
-      } else {  // the edge belongs to w's row: v's place among w's larger neighbours
-        const IndexSpan row_w = neighbours(w);
-        const int at =
-            static_cast<int>(std::lower_bound(row_w.begin(), row_w.end(), v) - row_w.begin());
-        e = first_edge[w] + at - firstLarger(w);
+  std::vector<int> smaller_filled(vv_offsets_.begin(), vv_offsets_.end() - 1);
+  forEachVertexRange(num_vertices_, [&](int first, int last) {
+    for (int v = 0; v < num_vertices_; ++v) {
+      const IndexSpan row = neighbours(v);
+      const int larger = first_edge[v + 1] - first_edge[v];
+      for (int i = row.size() - larger; i < row.size(); ++i) {
+        const int w = row[i], e = first_edge[v] + i - (row.size() - larger);
+        if (v >= first && v < last) {
+          vv_edges_[vv_offsets_[v] + i] = e;
+          edge_vertices_.col(e) << v, w;
+        }
+        if (w >= first && w < last) vv_edges_[smaller_filled[w]++] = e;
       }
-      vv_edges_[vv_offsets_[v] + i] = e;
     }
-  }
+  });
 
   // Sides (v, next) and (v, previous) of each triangle at v, written when v is their smaller end:
-  // side (v, next) is opposite corner k + 2, side (v, previous) opposite corner k + 1.
+  // side (v, next) is opposite corner k + 2 and runs forward (from the smaller vertex), side
+  // (v, previous) is opposite corner k + 1 and runs backward. Consistently oriented: every edge of
+  // two triangles is run once each way.
   triangle_edges_.resize(3, triangles_.cols());
   edge_triangle_count_.assign(num_edges, 0);
+  std::vector<std::uint8_t> forward_sides(num_edges, 0);
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < num_vertices_; ++v) {
     const IndexSpan row = neighbours(v);
@@ -261,19 +317,26 @@ void MeshTopology::buildEdges(const Wedges& wedges) {
       return vv_edges_[vv_offsets_[v] + at];
     };
     for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
-      const int t = vt_triangles_[i], k = wedges.corner[i];
-      if (wedges.next[i] > v) {
-        const int e = edgeTo(wedges.next[i]);
-        triangle_edges_((k + 2) % 3, t) = e;
+      const Wedge& wedge = wedges[i];
+      if (wedge.next > v) {
+        const int e = edgeTo(wedge.next);
+        triangle_edges_((wedge.corner + 2) % 3, wedge.triangle) = e;
         ++edge_triangle_count_[e];
+        forward_sides[e] = static_cast<std::uint8_t>(std::min(forward_sides[e] + 1, 255));
       }
-      if (wedges.previous[i] > v) {
-        const int e = edgeTo(wedges.previous[i]);
-        triangle_edges_((k + 1) % 3, t) = e;
+      if (wedge.previous > v) {
+        const int e = edgeTo(wedge.previous);
+        triangle_edges_((wedge.corner + 1) % 3, wedge.triangle) = e;
         ++edge_triangle_count_[e];
       }
     }
   }
+  bool consistent = true;
+#pragma omp parallel for schedule(static) reduction(&& : consistent)
+  for (int e = 0; e < num_edges; ++e) {
+    consistent = consistent && (edge_triangle_count_[e] != 2 || forward_sides[e] == 1);
+  }
+  counts_.consistently_oriented = consistent;
 }
 
 void MeshTopology::classifyEdgesAndVertices() {
@@ -328,7 +391,7 @@ void MeshTopology::findBowTieVertices(const Wedges& wedges) {
       int fans = tris.size();
       for (int i = 0; i < tris.size(); ++i) {
         const int wedge = vt_offsets_[v] + i;
-        for (const int w : {wedges.next[wedge], wedges.previous[wedge]}) {
+        for (const int w : {wedges[wedge].next, wedges[wedge].previous}) {
           const int slot =
               static_cast<int>(std::lower_bound(ring.begin(), ring.end(), w) - ring.begin());
           int& first = first_triangle_at_neighbour[slot];
@@ -370,7 +433,7 @@ void MeshTopology::findComponents() {
   counts_.connected_components = components;
 }
 
-void MeshTopology::checkOrientation() {
+void MeshTopology::checkOrientability() {
   // Union-find over triangles with a parity: flipped or not relative to the set's root. A
   // manifold edge traversed the same way by both of its triangles asks for a relative flip; a
   // contradiction means the component is not orientable.
@@ -388,7 +451,6 @@ void MeshTopology::checkOrientation() {
         continue;
       }
       const char relative_flip = forward == first_forward[e];
-      if (relative_flip) counts_.consistently_oriented = false;
       if (!sets.unite(first_triangle[e], t, relative_flip)) counts_.orientable = false;
     }
   }

@@ -2,6 +2,7 @@
 
 #include <pcl/PCLPointField.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -72,11 +73,16 @@ float floatFieldValue(double value, const std::string& field, std::size_t vertex
 
 NonFiniteVertices findNonFiniteVertices(const Eigen::Matrix3Xd& positions) {
   NonFiniteVertices result;
+  Eigen::Index first = positions.cols();
+  std::int64_t count = 0;
+#pragma omp parallel for schedule(static) reduction(+ : count) reduction(min : first)
   for (Eigen::Index i = 0; i < positions.cols(); ++i) {
     if (positions.col(i).allFinite()) continue;
-    if (result.first < 0) result.first = i;
-    ++result.count;
+    first = std::min(first, i);
+    ++count;
   }
+  if (count > 0) result.first = first;
+  result.count = count;
   return result;
 }
 

@@ -124,21 +124,24 @@ class MeshTopology {
   }
   void build(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
   void triangulate(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
-  void countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons);
-  /** Per incidence of a vertex in a triangle (parallel to vt_triangles_): the triangle's next and
-   *  previous corners after the vertex, and the vertex's corner index. Built once, so that every
-   *  later per-vertex pass reads its own contiguous row instead of triangles all over memory. */
-  struct Wedges {
-    std::vector<int> next, previous;
-    std::vector<std::uint8_t> corner;
+  /** One incidence of a vertex in a triangle (rows parallel to vt_triangles_): the triangle, its
+   *  next and previous corners after the vertex, the vertex's corner index, and whether the
+   *  triangle is a whole input polygon (a plain triangle). Built once, so that every later
+   *  per-vertex pass reads its own contiguous row instead of triangles all over memory. */
+  struct Wedge {
+    int triangle, next, previous;
+    std::uint8_t corner;
+    bool plain_triangle;
   };
-  Wedges buildVertexTriangles();
+  using Wedges = std::vector<Wedge>;
+  Wedges buildVertexTriangles(const std::vector<pcl::Vertices>& polygons);
   void buildVertexNeighbours(const Wedges& wedges);
   void buildEdges(const Wedges& wedges);
   void classifyEdgesAndVertices();
   void findBowTieVertices(const Wedges& wedges);
+  void countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons, const Wedges& wedges);
   void findComponents();
-  void checkOrientation();
+  void checkOrientability();
   void countBoundaryLoops();
 
   int num_vertices_ = 0;
