@@ -304,6 +304,37 @@ void readIndexLists(const PlyElement& element, PlyValueReader& reader, ByteCurso
   }
 }
 
+// The face layout nearly every binary writer uses: rows of only `list uchar int|uint
+// vertex_indices`, little-endian as on this host. Read directly rather than value by value; false
+// for any other layout (the general reader takes it).
+bool readPlainBinaryFaces(const PlyElement& element, PlyFormat format, ByteCursor& cursor,
+                          std::vector<pcl::Vertices>& polygons) {
+  if (__BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__ || format != PlyFormat::BinaryLittleEndian ||
+      element.properties.size() != 1 || indexList(element) != &element.properties.front()) {
+    return false;
+  }
+  const PlyProperty& list = element.properties.front();
+  if (list.count_type != PlyType::UInt8 ||
+      (list.type != PlyType::Int32 && list.type != PlyType::UInt32)) {
+    return false;
+  }
+  const bool is_unsigned = list.type == PlyType::UInt32;
+  for (std::int64_t row = 0; row < element.count; ++row) {
+    const auto n = static_cast<std::uint8_t>(*cursor.take(1, "face"));
+    const char* items = cursor.take(4 * std::size_t{n}, "face");
+    pcl::Vertices polygon;
+    polygon.vertices.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      std::uint32_t bits;
+      std::memcpy(&bits, items + 4 * k, 4);
+      polygon.vertices[k] = cornerIndex(
+          is_unsigned ? std::int64_t{bits} : std::int64_t{static_cast<std::int32_t>(bits)});
+    }
+    polygons.push_back(std::move(polygon));
+  }
+  return true;
+}
+
 // Lays the scan out on its range grid: row-major cells, a point where the grid names one, NaN
 // (non-float fields zero) where it is empty.
 pcl::PCLPointCloud2 organizeOnGrid(const pcl::PCLPointCloud2& points,
@@ -412,6 +443,7 @@ pcl::PolygonMesh parsePLY(std::string_view data) {
       has_vertices = true;
     } else if (element.name == "face") {
       mesh.polygons.reserve(mesh.polygons.size() + static_cast<std::size_t>(element.count));
+      if (readPlainBinaryFaces(element, header.format, cursor, mesh.polygons)) continue;
       readIndexLists(element, reader, cursor, [&](const std::vector<std::int64_t>& indices) {
         pcl::Vertices polygon;
         polygon.vertices.reserve(indices.size());

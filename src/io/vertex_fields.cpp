@@ -16,22 +16,29 @@ std::size_t pointCount(const pcl::PCLPointCloud2& cloud) {
   return static_cast<std::size_t>(cloud.width) * cloud.height;
 }
 
-// Appends an uninitialised scalar field of `size` bytes and returns its offset.
-std::uint32_t appendField(pcl::PCLPointCloud2& cloud, const std::string& name,
-                          std::uint8_t datatype, std::uint32_t size) {
+// Appends uninitialised scalar fields of one type in a single new layout; returns the offset of
+// the first (the others follow it).
+std::uint32_t appendFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                           std::uint8_t datatype) {
   const std::size_t n = pointCount(cloud);
+  const std::uint32_t size = pcl::getFieldSize(datatype);
   const std::uint32_t old_step = cloud.point_step;
-  const std::uint32_t new_step = old_step + size;
-  std::vector<std::uint8_t> data(n * new_step, 0);
-  for (std::size_t i = 0; i < n && old_step > 0; ++i) {  // (no bytes: no pointers to copy from)
-    std::memcpy(data.data() + i * new_step, cloud.data.data() + i * old_step, old_step);
+  const std::uint32_t new_step = old_step + size * static_cast<std::uint32_t>(names.size());
+  std::vector<std::uint8_t> data(n * new_step);
+  if (old_step > 0) {  // (no bytes: no pointers to copy from)
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+      std::memcpy(data.data() + i * new_step, cloud.data.data() + i * old_step, old_step);
+    }
   }
-  pcl::PCLPointField field;
-  field.name = name;
-  field.offset = old_step;
-  field.datatype = datatype;
-  field.count = 1;
-  cloud.fields.push_back(field);
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    pcl::PCLPointField field;
+    field.name = names[k];
+    field.offset = old_step + size * static_cast<std::uint32_t>(k);
+    field.datatype = datatype;
+    field.count = 1;
+    cloud.fields.push_back(field);
+  }
   cloud.data.swap(data);
   cloud.point_step = new_step;
   cloud.row_step = new_step * cloud.width;
@@ -69,24 +76,34 @@ bool removeVertexField(pcl::PCLPointCloud2& cloud, const std::string& name) {
 
 void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
                     const Eigen::VectorXd& values, FieldPrecision precision) {
+  setVertexFields(cloud, {name}, values.transpose(), precision);
+}
+
+void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                     const Eigen::MatrixXd& values, FieldPrecision precision) {
   const std::size_t n = pointCount(cloud);
-  if (static_cast<std::size_t>(values.size()) != n) {
-    throw pcl::BadArgumentException("field '" + name + "' has " + std::to_string(values.size()) +
-                                    " values for " + std::to_string(n) + " vertices");
+  if (static_cast<std::size_t>(values.rows()) != names.size() ||
+      static_cast<std::size_t>(values.cols()) != n) {
+    throw pcl::BadArgumentException(
+        std::to_string(values.rows()) + " x " + std::to_string(values.cols()) + " values for " +
+        std::to_string(names.size()) + " fields of " + std::to_string(n) + " vertices");
   }
-  removeVertexField(cloud, name);
+  for (const std::string& name : names) removeVertexField(cloud, name);
   const bool as_double = precision == FieldPrecision::Double;
-  const std::uint32_t offset = appendField(
-      cloud, name, as_double ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32,
-      as_double ? 8 : 4);
-  for (std::size_t i = 0; i < n; ++i) {
-    std::uint8_t* dst = cloud.data.data() + i * cloud.point_step + offset;
-    if (as_double) {
-      const double v = values[static_cast<Eigen::Index>(i)];
-      std::memcpy(dst, &v, 8);
-    } else {
-      const float v = floatFieldValue(values[static_cast<Eigen::Index>(i)], name, i);
-      std::memcpy(dst, &v, 4);
+  const std::uint32_t first_offset = appendFields(
+      cloud, names, as_double ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32);
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const std::uint32_t offset = first_offset + static_cast<std::uint32_t>(k) * (as_double ? 8 : 4);
+    const Eigen::Index row = static_cast<Eigen::Index>(k);
+    for (std::size_t i = 0; i < n; ++i) {
+      std::uint8_t* dst = cloud.data.data() + i * cloud.point_step + offset;
+      const double value = values(row, static_cast<Eigen::Index>(i));
+      if (as_double) {
+        std::memcpy(dst, &value, 8);
+      } else {
+        const float v = floatFieldValue(value, names[k], i);
+        std::memcpy(dst, &v, 4);
+      }
     }
   }
 }
@@ -139,7 +156,7 @@ void setVertexColors(pcl::PCLPointCloud2& cloud, const VertexColors& rgb, ColorL
     removeVertexField(cloud, name);
   }
   if (layout == ColorLayout::PackedRGB) {
-    const std::uint32_t offset = appendField(cloud, "rgb", pcl::PCLPointField::FLOAT32, 4);
+    const std::uint32_t offset = appendFields(cloud, {"rgb"}, pcl::PCLPointField::FLOAT32);
     for (std::size_t i = 0; i < n; ++i) {
       const auto c = rgb.col(static_cast<Eigen::Index>(i));
       const std::uint32_t packed =
@@ -148,11 +165,11 @@ void setVertexColors(pcl::PCLPointCloud2& cloud, const VertexColors& rgb, ColorL
     }
     return;
   }
-  const char* names[3] = {"red", "green", "blue"};
-  for (int c = 0; c < 3; ++c) {
-    const std::uint32_t offset = appendField(cloud, names[c], pcl::PCLPointField::UINT8, 1);
-    for (std::size_t i = 0; i < n; ++i) {
-      cloud.data[i * cloud.point_step + offset] = rgb(c, static_cast<Eigen::Index>(i));
+  const std::uint32_t offset =
+      appendFields(cloud, {"red", "green", "blue"}, pcl::PCLPointField::UINT8);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      cloud.data[i * cloud.point_step + offset + c] = rgb(c, static_cast<Eigen::Index>(i));
     }
   }
 }

@@ -67,11 +67,9 @@ void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
   const bool pcd_naming = hasVertexField(cloud, "normal_x") ? true
                           : hasVertexField(cloud, "nx")     ? false
                                                             : fileExtension(output_path) == "pcd";
-  for (int d = 0; d < 3; ++d) {
-    removeVertexField(cloud, pcd_naming ? ply_names[d] : pcd_names[d]);
-    setVertexField(cloud, pcd_naming ? pcd_names[d] : ply_names[d], normals.row(d).transpose(),
-                   precision);
-  }
+  for (int d = 0; d < 3; ++d) removeVertexField(cloud, pcd_naming ? ply_names[d] : pcd_names[d]);
+  const char** names = pcd_naming ? pcd_names : ply_names;
+  setVertexFields(cloud, {names[0], names[1], names[2]}, normals, precision);
 }
 
 void setColorMapFields(const char* tool_name, pcl::PCLPointCloud2& cloud,

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace pcl_ddg {
 
@@ -16,6 +17,12 @@ enum class FieldPrecision { Float, Double };
 void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
                     const Eigen::VectorXd& values,
                     FieldPrecision precision = FieldPrecision::Float);
+
+/** setVertexField for several fields at once, row r of `values` (one column per vertex) as
+ *  names[r]: the cloud is laid out anew once, not once per field. */
+void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                     const Eigen::MatrixXd& values,
+                     FieldPrecision precision = FieldPrecision::Float);
 
 /**
  * Writes positions as the x, y, z fields in the given precision: in place when they already have
