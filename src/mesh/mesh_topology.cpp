@@ -157,9 +157,9 @@ void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& poly
     for (int v = 0; v < num_vertices_; ++v) {
       keys.clear();
       for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
-        const Wedge& w = wedges[i];
-        if (!w.plain_triangle || w.next < v || w.previous < v) continue;
-        const auto [low, high] = std::minmax(w.next, w.previous);
+        const int next = wedges.next[i], previous = wedges.previous[i];
+        if (!(wedges.corner[i] & Wedges::kPlainTriangle) || next < v || previous < v) continue;
+        const auto [low, high] = std::minmax(next, previous);
         keys.push_back(static_cast<std::uint64_t>(low) << 32 | static_cast<std::uint32_t>(high));
       }
       if (keys.size() < 2) continue;
@@ -217,37 +217,41 @@ MeshTopology::Wedges MeshTopology::buildVertexTriangles(
     plain[t] = isPlainTriangle(polygons[triangle_source_[t]].vertices);
   }
 
-  Wedges wedges(static_cast<std::size_t>(vt_offsets_.back()));
+  const auto incidences = static_cast<std::size_t>(vt_offsets_.back());
+  vt_triangles_.resize(incidences);
+  Wedges wedges{std::unique_ptr<int[]>(new int[incidences]),
+                std::unique_ptr<int[]>(new int[incidences]),
+                std::unique_ptr<std::uint8_t[]>(new std::uint8_t[incidences])};
   std::vector<int> cursor(vt_offsets_.begin(), vt_offsets_.end() - 1);
   forEachVertexRange(num_vertices_, [&](int first, int last) {
     for (Eigen::Index t = 0; t < num_triangles; ++t) {
       for (int k = 0; k < 3; ++k) {
         const int v = triangles_(k, t);
         if (v < first || v >= last) continue;
-        wedges[cursor[v]++] = {static_cast<int>(t), triangles_((k + 1) % 3, t),
-                               triangles_((k + 2) % 3, t), static_cast<std::uint8_t>(k),
-                               plain[t] != 0};
+        const int at = cursor[v]++;
+        vt_triangles_[at] = static_cast<int>(t);
+        wedges.next[at] = triangles_((k + 1) % 3, t);
+        wedges.previous[at] = triangles_((k + 2) % 3, t);
+        wedges.corner[at] = static_cast<std::uint8_t>(k | (plain[t] ? Wedges::kPlainTriangle : 0));
       }
     }
   });
-  vt_triangles_.resize(wedges.size());
-#pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < wedges.size(); ++i) vt_triangles_[i] = wedges[i].triangle;
   return wedges;
 }
 
 void MeshTopology::buildVertexNeighbours(const Wedges& wedges) {
   // Each incident triangle offers two neighbours; gather them into a row of twice the triangle
   // count, sort and deduplicate it in place, then compact the rows.
-  std::vector<int> scratch(2 * vt_triangles_.size());
+  const std::unique_ptr<int[]> scratch(
+      new int[2 * vt_triangles_.size()]);  // first touched in parallel
   std::vector<int> row_size(num_vertices_, 0);
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < num_vertices_; ++v) {
-    int* out = scratch.data() + 2 * vt_offsets_[v];
+    int* out = scratch.get() + 2 * vt_offsets_[v];
     int n = 0;
     for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
-      out[n++] = wedges[i].next;
-      out[n++] = wedges[i].previous;
+      out[n++] = wedges.next[i];
+      out[n++] = wedges.previous[i];
     }
     std::sort(out, out + n);
     row_size[v] = static_cast<int>(std::unique(out, out + n) - out);
@@ -257,7 +261,7 @@ void MeshTopology::buildVertexNeighbours(const Wedges& wedges) {
   vv_neighbours_.resize(vv_offsets_.back());
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < num_vertices_; ++v) {
-    const int* in = scratch.data() + 2 * vt_offsets_[v];
+    const int* in = scratch.get() + 2 * vt_offsets_[v];
     std::copy(in, in + row_size[v], vv_neighbours_.begin() + vv_offsets_[v]);
   }
 }
@@ -317,16 +321,16 @@ void MeshTopology::buildEdges(const Wedges& wedges) {
       return vv_edges_[vv_offsets_[v] + at];
     };
     for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
-      const Wedge& wedge = wedges[i];
-      if (wedge.next > v) {
-        const int e = edgeTo(wedge.next);
-        triangle_edges_((wedge.corner + 2) % 3, wedge.triangle) = e;
+      const int t = vt_triangles_[i], k = wedges.corner[i] & 3;
+      if (wedges.next[i] > v) {
+        const int e = edgeTo(wedges.next[i]);
+        triangle_edges_((k + 2) % 3, t) = e;
         ++edge_triangle_count_[e];
         forward_sides[e] = static_cast<std::uint8_t>(std::min(forward_sides[e] + 1, 255));
       }
-      if (wedge.previous > v) {
-        const int e = edgeTo(wedge.previous);
-        triangle_edges_((wedge.corner + 1) % 3, wedge.triangle) = e;
+      if (wedges.previous[i] > v) {
+        const int e = edgeTo(wedges.previous[i]);
+        triangle_edges_((k + 1) % 3, t) = e;
         ++edge_triangle_count_[e];
       }
     }
@@ -391,7 +395,7 @@ void MeshTopology::findBowTieVertices(const Wedges& wedges) {
       int fans = tris.size();
       for (int i = 0; i < tris.size(); ++i) {
         const int wedge = vt_offsets_[v] + i;
-        for (const int w : {wedges[wedge].next, wedges[wedge].previous}) {
+        for (const int w : {wedges.next[wedge], wedges.previous[wedge]}) {
           const int slot =
               static_cast<int>(std::lower_bound(ring.begin(), ring.end(), w) - ring.begin());
           int& first = first_triangle_at_neighbour[slot];

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace pcl_ddg {
@@ -124,16 +125,16 @@ class MeshTopology {
   }
   void build(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
   void triangulate(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
-  /** One incidence of a vertex in a triangle (rows parallel to vt_triangles_): the triangle, its
-   *  next and previous corners after the vertex, the vertex's corner index, and whether the
-   *  triangle is a whole input polygon (a plain triangle). Built once, so that every later
-   *  per-vertex pass reads its own contiguous row instead of triangles all over memory. */
-  struct Wedge {
-    int triangle, next, previous;
-    std::uint8_t corner;
-    bool plain_triangle;
+  /** Per incidence of a vertex in a triangle (parallel to vt_triangles_): the triangle's next and
+   *  previous corners after the vertex, and the vertex's corner index plus kPlainTriangle when the
+   *  triangle is a whole input polygon. Built once, so that every later per-vertex pass reads its
+   *  own contiguous row instead of triangles all over memory. Left uninitialised until the
+   *  parallel scatter writes them, so that their pages are first touched by both threads. */
+  struct Wedges {
+    static constexpr std::uint8_t kPlainTriangle = 4;
+    std::unique_ptr<int[]> next, previous;
+    std::unique_ptr<std::uint8_t[]> corner;
   };
-  using Wedges = std::vector<Wedge>;
   Wedges buildVertexTriangles(const std::vector<pcl::Vertices>& polygons);
   void buildVertexNeighbours(const Wedges& wedges);
   void buildEdges(const Wedges& wedges);
