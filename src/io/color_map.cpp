@@ -30,26 +30,32 @@ double percentile(std::vector<double> sorted_copy, double p) {
 
 }  // namespace
 
-Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorize(const Eigen::VectorXd& values, ColorMap map,
-                                                        const ColorScale& scale) {
-  static const std::array<Rgb, 3> kDiverging = {{{59, 76, 192}, {240, 240, 240}, {180, 4, 38}}};
-  static const std::array<Rgb, 5> kSequential = {
-      {{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
+ColorRange colorRange(const Eigen::VectorXd& values, ColorMap map, const ColorScale& scale) {
   std::vector<double> finite;
   finite.reserve(static_cast<std::size_t>(values.size()));
   for (Eigen::Index i = 0; i < values.size(); ++i) {
     if (std::isfinite(values[i])) finite.push_back(values[i]);
   }
-  double lo = 0.0, hi = 1.0;
+  ColorRange range;
   if (!finite.empty()) {
-    lo = percentile(finite, scale.low_percentile);
-    hi = percentile(finite, scale.high_percentile);
+    range.low = percentile(finite, scale.low_percentile);
+    range.high = percentile(finite, scale.high_percentile);
   }
   if (map == ColorMap::Diverging) {
-    hi = std::max(std::abs(lo), std::abs(hi));
-    lo = -hi;
+    range.high = std::max(std::abs(range.low), std::abs(range.high));
+    range.low = -range.high;
   }
-  const double range = hi > lo ? hi - lo : 1.0;
+  return range;
+}
+
+Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorize(const Eigen::VectorXd& values, ColorMap map,
+                                                        const ColorScale& scale) {
+  static const std::array<Rgb, 3> kDiverging = {{{59, 76, 192}, {240, 240, 240}, {180, 4, 38}}};
+  static const std::array<Rgb, 5> kSequential = {
+      {{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
+  const ColorRange limits = colorRange(values, map, scale);
+  const double lo = limits.low;
+  const double range = limits.high > lo ? limits.high - lo : 1.0;
   Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> rgb(3, values.size());
   for (Eigen::Index i = 0; i < values.size(); ++i) {
     Rgb c = {128, 128, 128};

@@ -17,46 +17,6 @@
 
 namespace pcl_ddg {
 namespace tools {
-namespace {
-
-pcl::PointCloud<pcl::PointXYZ>::Ptr toXYZ(const Eigen::Matrix3Xd& positions) {
-  auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  points->resize(positions.cols());
-  for (Eigen::Index i = 0; i < positions.cols(); ++i)
-    (*points)[i].getVector3fMap() = positions.col(i).cast<float>();
-  points->is_dense = positions.allFinite();
-  return points;
-}
-
-// Mean distance from a point to its nearest other point, over up to 10,000 finite points.
-double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) {
-  pcl::Indices finite;
-  for (std::size_t i = 0; i < points->size(); ++i) {
-    if (pcl::isXYZFinite((*points)[i])) finite.push_back(static_cast<pcl::index_t>(i));
-  }
-  if (finite.size() < 2) return 0.0;
-  pcl::search::KdTree<pcl::PointXYZ> tree;
-  tree.setInputCloud(points, std::make_shared<const pcl::Indices>(finite));
-  const std::size_t step = std::max<std::size_t>(1, finite.size() / 10000);
-  double sum = 0.0;
-  std::size_t counted = 0;
-  pcl::Indices found;
-  std::vector<float> distances;
-  for (std::size_t i = 0; i < finite.size(); i += step) {
-    // Exact duplicates are skipped: the spacing is between distinct samples.
-    if (tree.nearestKSearch((*points)[finite[i]], 8, found, distances) < 2) continue;
-    for (const float d : distances) {
-      if (d > 0.0f) {
-        sum += std::sqrt(d);
-        ++counted;
-        break;
-      }
-    }
-  }
-  return counted > 0 ? sum / counted : 0.0;
-}
-
-}  // namespace
 
 SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name) {
   SurfaceInput input;
@@ -132,14 +92,50 @@ std::optional<Eigen::Vector3d> viewpointArgument(const ToolArguments& args) {
   return v;
 }
 
+}  // namespace
+
+double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) {
+  pcl::Indices finite;
+  for (std::size_t i = 0; i < points->size(); ++i) {
+    if (pcl::isXYZFinite((*points)[i])) finite.push_back(static_cast<pcl::index_t>(i));
+  }
+  if (finite.size() < 2) return 0.0;
+  pcl::search::KdTree<pcl::PointXYZ> tree;
+  tree.setInputCloud(points, std::make_shared<const pcl::Indices>(finite));
+  const std::size_t step = std::max<std::size_t>(1, finite.size() / 10000);
+  double sum = 0.0;
+  std::size_t counted = 0;
+  pcl::Indices found;
+  std::vector<float> distances;
+  for (std::size_t i = 0; i < finite.size(); i += step) {
+    // Exact duplicates are skipped: the spacing is between distinct samples.
+    if (tree.nearestKSearch((*points)[finite[i]], 8, found, distances) < 2) continue;
+    for (const float d : distances) {
+      if (d > 0.0f) {
+        sum += std::sqrt(d);
+        ++counted;
+        break;
+      }
+    }
+  }
+  return counted > 0 ? sum / counted : 0.0;
+}
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr toXYZ(const Eigen::Matrix3Xd& positions) {
+  auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  points->resize(positions.cols());
+  for (Eigen::Index i = 0; i < positions.cols(); ++i)
+    (*points)[i].getVector3fMap() = positions.col(i).cast<float>();
+  points->is_dense = positions.allFinite();
+  return points;
+}
+
 Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals) {
   Eigen::Matrix3Xd n(3, normals.size());
   for (std::size_t i = 0; i < normals.size(); ++i)
     n.col(i) = normals[i].getNormalVector3fMap().cast<double>();
   return n;
 }
-
-}  // namespace
 
 void checkLocalFitArguments(const ToolArguments& args) {
   if (args.has("k") && args.has("radius"))

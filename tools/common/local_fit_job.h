@@ -34,6 +34,16 @@ struct SurfaceInput {
   FieldPrecision coordinate_precision = FieldPrecision::Float;  ///< as the file declares them
 };
 
+/** Mean distance from a point to its nearest other point (exact duplicates skipped), over up to
+ *  10,000 finite points: a cloud's h. */
+double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points);
+
+/** positions as PCL points (float; NaN kept, is_dense when all are finite). */
+pcl::PointCloud<pcl::PointXYZ>::Ptr toXYZ(const Eigen::Matrix3Xd& positions);
+
+/** The normals of a PCL estimator as a 3 x N matrix (NaN kept). */
+Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals);
+
 /** Loads a mesh or a cloud, with the warnings of loadSurfaceMesh for meshes and a count of
  *  non-finite points for clouds. */
 SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name);

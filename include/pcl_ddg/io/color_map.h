@@ -17,7 +17,14 @@ struct ColorScale {
   double high_percentile = 98.0;
 };
 
-/** One RGB colour per value; NaN values are grey. */
+/** The values that the two ends of the colour map stand for: the scale's percentiles of the finite
+ *  values, made symmetric about zero for Diverging ([0, 1] when no value is finite). */
+struct ColorRange {
+  double low = 0.0, high = 1.0;
+};
+ColorRange colorRange(const Eigen::VectorXd& values, ColorMap map, const ColorScale& scale = {});
+
+/** One RGB colour per value, by colorRange; NaN values are grey. */
 Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorize(const Eigen::VectorXd& values, ColorMap map,
                                                         const ColorScale& scale = {});
 

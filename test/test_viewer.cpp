@@ -1,0 +1,309 @@
+// pcl_ddg_viewer under Xvfb (ctest runs this program through xvfb-run): actions and keys reach the
+// same state; pictures are checked by their properties (coverage, colours, glyphs, silhouettes),
+// never pixel by pixel against a stored image; every shared file opens; errors are one line.
+#include <gtest/gtest.h>
+#include <stb/stb_image.h>
+#include <vtkCommand.h>
+#include <vtkRenderWindowInteractor.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "analytic_surfaces.h"
+#include "common/local_fit_job.h"
+#include "pcl_ddg/io/mesh_io.h"
+#include "test_data.h"
+#include "tool_runner.h"
+#include "viewer/viewer_window.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+using viewer::ViewerModel;
+using viewer::ViewerState;
+using viewer::ViewerWindow;
+
+// The viewer's background, (0.12, 0.12, 0.14) in 8 bits.
+bool isBackground(const unsigned char* p) {
+  return std::abs(p[0] - 31) <= 2 && std::abs(p[1] - 31) <= 2 && std::abs(p[2] - 36) <= 2;
+}
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgb;
+  const unsigned char* at(int x, int y) const { return rgb.data() + 3 * (y * width + x); }
+  /** Pixels of the object: not background, and above the overlay text (the bottom 20%) and below
+   *  the colour bar (the top 15%). */
+  template <typename F>
+  void forObject(F f) const {
+    for (int y = height * 15 / 100; y < height * 80 / 100; ++y) {
+      for (int x = 0; x < width; ++x) {
+        if (!isBackground(at(x, y))) f(at(x, y));
+      }
+    }
+  }
+  double objectShare() const {
+    std::int64_t n = 0;
+    forObject([&](const unsigned char*) { ++n; });
+    return static_cast<double>(n) / (width * height * 65 / 100);
+  }
+};
+
+// Whether the object band (forObject's rows) of two pictures is identical: the overlay text below
+// it names the last computation's time, which differs between runs.
+bool sameObject(const Image& a, const Image& b) {
+  if (a.width != b.width || a.height != b.height) return false;
+  const std::size_t begin = 3 * static_cast<std::size_t>(a.width) * (a.height * 15 / 100);
+  const std::size_t end = 3 * static_cast<std::size_t>(a.width) * (a.height * 80 / 100);
+  return std::equal(a.rgb.begin() + begin, a.rgb.begin() + end, b.rgb.begin() + begin);
+}
+
+Image readPng(const std::string& path) {
+  Image image;
+  int channels = 0;
+  unsigned char* data = stbi_load(path.c_str(), &image.width, &image.height, &channels, 3);
+  if (data == nullptr) ADD_FAILURE() << "cannot read " << path;
+  if (data == nullptr) return image;
+  image.rgb.assign(data, data + 3 * image.width * image.height);
+  stbi_image_free(data);
+  return image;
+}
+
+std::int64_t differingPixels(const Image& a, const Image& b) {
+  std::int64_t n = 0;
+  for (std::size_t i = 0; i + 2 < a.rgb.size() && i + 2 < b.rgb.size(); i += 3) {
+    n += a.rgb[i] != b.rgb[i] || a.rgb[i + 1] != b.rgb[i + 1] || a.rgb[i + 2] != b.rgb[i + 2];
+  }
+  return n;
+}
+
+// A sphere with radial noise (5% of the radius): smoothing visibly rounds its silhouette.
+std::string noisySphereFile(const std::string& dir) {
+  SurfaceSample sphere = makeIcosphere(4);
+  std::mt19937 random(3);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  for (Eigen::Index i = 0; i < sphere.points.cols(); ++i)
+    sphere.points.col(i) *= 1.0 + noise(random);
+  std::vector<std::vector<int>> faces;
+  for (Eigen::Index t = 0; t < sphere.triangles.cols(); ++t) {
+    faces.push_back({sphere.triangles(0, t), sphere.triangles(1, t), sphere.triangles(2, t)});
+  }
+  const std::string path = dir + "/noisy_sphere.ply";
+  saveMesh(path, makeMesh(sphere.points, faces));
+  return path;
+}
+
+class Viewer : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = scratchFolder(::testing::UnitTest::GetInstance()->current_test_info()->name());
+  }
+  std::unique_ptr<ViewerModel> open(const std::string& path) {
+    return std::make_unique<ViewerModel>(tools::loadSurfaceInput(path, "test_viewer"), path);
+  }
+  Image screenshot(ViewerWindow& window, const std::string& name) {
+    EXPECT_TRUE(window.runUntilIdle(120.0));
+    const std::string path = dir_ + "/" + name + ".png";
+    window.saveScreenshot(path);
+    return readPng(path);
+  }
+  std::string dir_;
+};
+
+void pressKey(ViewerWindow& window, const std::string& key_sym, char key_code) {
+  vtkRenderWindowInteractor* interactor = window.interactor();
+  interactor->SetKeyEventInformation(0, 0, key_code, 1, key_sym.c_str());
+  interactor->InvokeEvent(vtkCommand::KeyPressEvent);
+  interactor->InvokeEvent(vtkCommand::KeyReleaseEvent);
+}
+
+TEST_F(Viewer, KeysReachTheSameStateAsTheEquivalentDoLine) {
+  auto model = open(sharedData("meshes/bunny.off"));
+  ViewerWindow by_keys(*model, 400, 300);
+  const std::pair<const char*, char> keys[] = {{"m", 'm'},
+                                               {"m", 'm'},
+                                               {"bracketright", ']'},
+                                               {"bracketright", ']'},
+                                               {"bracketleft", '['},
+                                               {"n", 'n'},
+                                               {"v", 'v'},
+                                               {"v", 'v'},
+                                               {"b", 'b'},
+                                               {"semicolon", ';'},
+                                               {"period", '.'},
+                                               {"i", 'i'},
+                                               {"y", 'y'},
+                                               {"d", 'd'},
+                                               {"comma", ','},
+                                               {"t", 't'},
+                                               {"z", 'z'},
+                                               {"i", 'i'}};
+  for (const auto& [sym, code] : keys) pressKey(by_keys, sym, code);
+  ASSERT_TRUE(by_keys.runUntilIdle(120.0));
+
+  ViewerWindow by_actions(*model, 400, 300);
+  for (const std::string& action : viewer::splitActions(
+           "method=mean_curvature k=20 k=25 k=20 neighbours=knn field=gauss normals=on "
+           "shading=flat step=2 smooth=implicit weights=uniform frozen=off step=1 smooth=explicit "
+           "undo smooth=implicit")) {
+    by_actions.enqueue(action);
+  }
+  ASSERT_TRUE(by_actions.runUntilIdle(120.0));
+  EXPECT_TRUE(by_keys.errors().empty());
+  EXPECT_TRUE(by_actions.errors().empty());
+  EXPECT_EQ(by_keys.state(), by_actions.state());
+  EXPECT_EQ(by_keys.state().method, viewer::NormalMethod::MeanCurvature);
+  EXPECT_EQ(by_keys.state().steps.size(), 2u);
+  EXPECT_EQ(*by_keys.frame().positions, *by_actions.frame().positions);
+}
+
+TEST_F(Viewer, PicturesShowTheObjectTheFieldsAndTheGlyphs) {
+  auto model = open(sharedData("meshes/cow.off"));
+  ViewerWindow window(*model, 480, 360);
+  const Image none = screenshot(window, "none");
+  EXPECT_GT(none.objectShare(), 0.05);
+  EXPECT_LT(none.objectShare(), 0.9);
+  // Uncoloured is grey: the lit surface has no hue.
+  int most_saturated = 0;
+  none.forObject([&](const unsigned char* p) {
+    most_saturated = std::max({most_saturated, std::abs(p[0] - p[1]), std::abs(p[1] - p[2])});
+  });
+  EXPECT_LE(most_saturated, 6);
+
+  window.enqueue("field=mean");
+  const Image mean = screenshot(window, "mean");
+  window.enqueue("field=gauss");
+  const Image gauss = screenshot(window, "gauss");
+  EXPECT_GT(differingPixels(none, mean), 1000);
+  EXPECT_GT(differingPixels(mean, gauss), 1000);
+  int colourful = 0;
+  mean.forObject([&](const unsigned char* p) { colourful += std::abs(p[0] - p[2]) > 40; });
+  EXPECT_GT(colourful, 500);
+
+  const auto yellow = [](const Image& image) {
+    int n = 0;
+    image.forObject([&](const unsigned char* p) { n += p[0] > 200 && p[1] > 170 && p[2] < 90; });
+    return n;
+  };
+  window.enqueue("field=none");
+  window.enqueue("normals=on");
+  const Image glyphs = screenshot(window, "glyphs");
+  EXPECT_GT(yellow(glyphs), yellow(none) + 500);
+}
+
+TEST_F(Viewer, SmoothingChangesTheSilhouetteAndUndoRestoresItExactly) {
+  auto model = open(noisySphereFile(dir_));
+  ViewerWindow window(*model, 400, 400);
+  const Image before = screenshot(window, "before");
+  window.enqueue("smooth=implicit:4");
+  const Image smoothed = screenshot(window, "smoothed");
+  std::int64_t silhouette_changed = 0;
+  for (int y = 0; y < before.height; ++y) {
+    for (int x = 0; x < before.width; ++x) {
+      silhouette_changed += isBackground(before.at(x, y)) != isBackground(smoothed.at(x, y));
+    }
+  }
+  EXPECT_GT(silhouette_changed, 200);
+  EXPECT_NE(*window.frame().positions, model->inputPositions());
+
+  window.enqueue("undo");
+  const Image undone = screenshot(window, "undone");
+  EXPECT_TRUE(window.frame().positions->cwiseEqual(model->inputPositions()).all());
+  EXPECT_TRUE(sameObject(undone, before)) << differingPixels(undone, before) << " pixels differ";
+}
+
+TEST_F(Viewer, FiftyKeyPressesDuringAFitAreAllApplied) {
+  auto model = open(sharedData("clouds/milk.pcd"));
+  ViewerWindow window(*model, 400, 300);
+  ASSERT_TRUE(window.runUntilIdle(120.0));
+  window.enqueue("method=quadric");
+  window.runUntilIdle(0.01);  // the quadric fit starts; the presses arrive while it runs
+  ViewerState expected = window.state();
+  viewer::applyAction(expected, model->capabilities(), "method=quadric");
+  for (int i = 0; i < 50; ++i) {  // up and down, ending a few steps above where it began
+    const bool up = i % 2 == 0 || i >= 46;
+    pressKey(window, up ? "bracketright" : "bracketleft", up ? ']' : '[');
+    viewer::applyAction(expected, model->capabilities(), up ? "k+" : "k-");
+    window.runUntilIdle(0.002);
+  }
+  ASSERT_TRUE(window.runUntilIdle(300.0));
+  EXPECT_EQ(window.state(), expected);
+  EXPECT_EQ(window.state().k, expected.k);
+  EXPECT_TRUE(window.errors().empty());
+  EXPECT_EQ(window.frame().normals->cols(), model->capabilities().points);
+}
+
+TEST(ViewerActions, RefuseWhatTheInputCannotDoAndClampK) {
+  viewer::InputCapabilities cloud{false, 100, {"intensity"}};
+  ViewerState state = viewer::initialState(cloud);
+  EXPECT_EQ(state.method, viewer::NormalMethod::PCA);
+  EXPECT_THROW(viewer::applyAction(state, cloud, "method=area"), std::invalid_argument);
+  EXPECT_THROW(viewer::applyAction(state, cloud, "neighbours=bfs"), std::invalid_argument);
+  EXPECT_THROW(viewer::applyAction(state, cloud, "smooth=implicit"), std::invalid_argument);
+  EXPECT_THROW(viewer::applyAction(state, cloud, "field=compare"), std::invalid_argument);
+  EXPECT_THROW(viewer::applyAction(state, cloud, "k=two"), std::invalid_argument);
+  EXPECT_THROW(viewer::applyAction(state, cloud, "colour=red"), std::invalid_argument);
+  EXPECT_NO_THROW(viewer::applyAction(state, cloud, "field=intensity"));
+  EXPECT_FALSE(viewer::applyAction(state, cloud, "k=5000").empty());  // clamped, and said so
+  EXPECT_EQ(state.k, 99);
+  viewer::applyAction(state, cloud, "method+");
+  EXPECT_EQ(state.method, viewer::NormalMethod::Quadric);
+  viewer::applyAction(state, cloud, "method+");  // mesh methods are skipped on a cloud
+  EXPECT_EQ(state.method, viewer::NormalMethod::PCA);
+  EXPECT_EQ(viewer::splitActions("k=3 # comment\n field=none"),
+            (std::vector<std::string>{"k=3", "field=none"}));
+}
+
+TEST_F(Viewer, EverySharedFileOpensAndRenders) {
+  for (const char* name :
+       {"meshes/bumpy.off", "meshes/bun045_rangegrid_tri.ply", "meshes/bun_zipper.ply",
+        "meshes/bun_zipper_res3.ply", "meshes/bun_zipper_res4.ply", "meshes/bunny.off",
+        "meshes/cow.off", "meshes/horse.ply", "meshes/igea.ply", "meshes/rocker-arm.off",
+        "meshes/tum_rabbit.vtk", "clouds/bun0.pcd", "clouds/milk.pcd", "clouds/office1.pcd",
+        "clouds/rs1.pcd", "clouds/table_scene_mug_stereo_textured.pcd",
+        "clouds/terrain_CSite1_red2-utm.pcd", "clouds/tutorials_room_scan1.pcd",
+        "range/bun000.ply"}) {
+    SCOPED_TRACE(name);
+    const std::string png = dir_ + "/" + std::filesystem::path(name).stem().string() + ".png";
+    const ToolRun run = runTool(PCL_DDG_VIEWER_TOOL, "'" + sharedData(name) + "' -screenshot '" +
+                                                         png + "' -size 320x240 -do field=mean");
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const Image image = readPng(png);
+    EXPECT_EQ(image.width, 320);
+    EXPECT_GT(image.objectShare(), 0.01);
+  }
+}
+
+TEST_F(Viewer, ErrorsAreOneLine) {
+  writeText(dir_ + "/broken.ply", "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n");
+  for (const std::string& arguments :
+       {"'" + dir_ + "/broken.ply' -screenshot '" + dir_ + "/x.png'",
+        "'" + sharedData("meshes/cow.off") + "' -do method=nonsense -screenshot '" + dir_ +
+            "/x.png'",
+        "'" + sharedData("clouds/bun0.pcd") + "' -do method=area -screenshot '" + dir_ + "/x.png'",
+        "'" + sharedData("meshes/cow.off") + "' -size 10x10 -screenshot '" + dir_ + "/x.png'"}) {
+    const ToolRun run = runTool(PCL_DDG_VIEWER_TOOL, arguments);
+    EXPECT_NE(run.exit_code, 0) << arguments;
+    // Exactly one error line (a usage error is followed by the syntax, as in every tool).
+    const std::size_t error = run.err.find("pcl_ddg_viewer: error: ");
+    ASSERT_NE(error, std::string::npos) << run.err;
+    EXPECT_EQ(run.err.find("error", error + 23), std::string::npos) << run.err;
+    EXPECT_FALSE(std::filesystem::exists(dir_ + "/x.png"));
+  }
+  const ToolRun headless = runTool("env -u DISPLAY " + std::string(PCL_DDG_VIEWER_TOOL),
+                                   "'" + sharedData("meshes/cow.off") + "'");
+  EXPECT_EQ(headless.exit_code, 1);
+  EXPECT_EQ(headless.err,
+            "pcl_ddg_viewer: error: no display: DISPLAY is not set (run it on a "
+            "desktop, or headless under xvfb-run)\n");
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg

@@ -1,0 +1,83 @@
+#pragma once
+// The viewer's computations, without any window: from a ViewerState to a Frame (positions,
+// normals, colours, overlay text). Results are cached per input version (the smoothing steps
+// applied), method, k and neighbourhood, so that switching back to something already computed,
+// or changing only the colour field, costs no fit. One thread at a time may call compute().
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/local_fit_job.h"
+#include "pcl_ddg/io/color_map.h"
+#include "pcl_ddg/io/vertex_fields.h"
+#include "viewer/viewer_state.h"
+
+namespace pcl_ddg {
+namespace viewer {
+
+struct Frame {
+  ViewerState state;                                  ///< what this frame shows
+  std::shared_ptr<const Eigen::Matrix3Xd> positions;  ///< after state.steps
+  std::shared_ptr<const Eigen::Matrix3Xd> normals;    ///< state.method's (NaN where none)
+  Eigen::VectorXd field;                              ///< empty for "none"
+  std::string field_label;                            ///< e.g. "mean curvature H (1/length)"
+  ColorRange range;                                   ///< of the colour bar
+  ColorMap color_map = ColorMap::Diverging;
+  VertexColors colors;                ///< per vertex (grey for "none" and NaN)
+  double glyph_length = 0.0;          ///< normal glyph length: h
+  std::vector<std::string> warnings;  ///< shown on screen
+  double compute_ms = 0.0;            ///< of this frame
+  bool step_refused = false;          ///< the last smoothing step failed (see warnings)
+};
+
+class ViewerModel {
+ public:
+  /** Takes a loaded input (tools::loadSurfaceInput). */
+  ViewerModel(tools::SurfaceInput input, std::string path);
+
+  const InputCapabilities& capabilities() const { return capabilities_; }
+  const std::string& path() const { return path_; }
+  bool isMesh() const { return static_cast<bool>(input_.topology); }
+  const MeshTopology* topology() const { return input_.topology.get(); }
+  const Eigen::Matrix3Xd& inputPositions() const { return input_.positions; }
+  /** Where the sensor was (a PCD's VIEWPOINT): clouds are first seen from there. */
+  const SensorPose& sensorPose() const { return input_.sensor_pose; }
+  /** Mean edge length (meshes) or mean point spacing (clouds). */
+  double spacing() const { return spacing_; }
+
+  /** Everything the state asks for; throws only on a bug (failures become warnings). */
+  Frame compute(const ViewerState& state);
+
+ private:
+  using Positions = std::shared_ptr<const Eigen::Matrix3Xd>;
+  Positions positionsAfter(const std::vector<SmoothingStep>& steps,
+                           std::vector<std::string>& warnings, bool& refused);
+  /** Normals of a method on the surface after `version` steps (a cache key prefix). */
+  std::shared_ptr<const Eigen::Matrix3Xd> normalsOf(NormalMethod method, const ViewerState& state,
+                                                    const std::string& version,
+                                                    const Positions& positions,
+                                                    std::vector<std::string>& warnings);
+  Eigen::VectorXd fieldOf(const ViewerState& state, const std::string& version,
+                          const Positions& positions, const Eigen::Matrix3Xd& normals,
+                          std::string& label, ColorMap& map, std::vector<std::string>& warnings);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr pointsOf(const std::string& version,
+                                               const Positions& positions);
+
+  tools::SurfaceInput input_;
+  std::string path_;
+  InputCapabilities capabilities_;
+  double spacing_ = 0.0;
+  /** Positions after each prefix of smoothing steps, keyed by the steps' description. */
+  std::map<std::string, Positions> positions_;
+  std::map<std::string, std::shared_ptr<const Eigen::Matrix3Xd>> normals_;
+  std::map<std::string, Eigen::VectorXd> fields_;
+  std::map<std::string, pcl::PointCloud<pcl::PointXYZ>::Ptr> points_;
+};
+
+}  // namespace viewer
+}  // namespace pcl_ddg

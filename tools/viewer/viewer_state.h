@@ -1,0 +1,85 @@
+#pragma once
+// What the viewer shows, as plain data: the normal method, k, the neighbourhood, the colour field,
+// the smoothing steps applied to the input, and how things are drawn. Keys and -do commands both
+// become actions ("method=pca", "k+", "smooth=implicit:2") applied here, so that a key press and
+// the equivalent command reach exactly the same state.
+#include <string>
+#include <vector>
+
+namespace pcl_ddg {
+namespace viewer {
+
+enum class NormalMethod { Uniform, Area, Angle, MeanCurvature, PCA, Quadric };
+enum class Neighbours { MeshRings, KdTree };
+
+struct SmoothingStep {
+  bool implicit = true;
+  double time_step = 1.0;  ///< in h^2 (h: the mean edge length of the input)
+  bool cotan = true;       ///< cotangent weights, else uniform
+  bool frozen = false;     ///< weights of the input kept, else rebuilt at every step
+  bool operator==(const SmoothingStep& o) const {
+    return implicit == o.implicit && time_step == o.time_step && cotan == o.cotan &&
+           frozen == o.frozen;
+  }
+};
+
+struct ViewerState {
+  static constexpr int kDefaultK = 16;
+
+  NormalMethod method = NormalMethod::Area;  ///< PCA on clouds (set by the model)
+  int k = kDefaultK;
+  Neighbours neighbours = Neighbours::MeshRings;
+  /** none, mean, gauss, k1, k2, angle (to the reference method's normals), compare (mesh rings
+   *  vs kd-tree), or the name of a scalar property of the file. */
+  std::string field = "none";
+  std::vector<SmoothingStep> steps;  ///< applied to the input, in order
+  double time_step = 1.0;            ///< of the next step, in h^2
+  bool cotan = true;                 ///< weights of the next step
+  bool frozen = true;                ///< of the next step (the library's default)
+  bool show_normals = false;         ///< glyphs
+  bool smooth_shading = true;
+  int screenshots = 0;  ///< taken so far (the next file's number)
+
+  bool operator==(const ViewerState& o) const;
+  bool operator!=(const ViewerState& o) const { return !(*this == o); }
+};
+
+/** What the input offers, for refusing actions that cannot apply (mesh methods on a cloud). */
+struct InputCapabilities {
+  bool is_mesh = false;
+  int points = 0;
+  std::vector<std::string> properties;  ///< scalar fields of the file (colourable)
+};
+
+/** The initial state for an input: area normals on meshes, PCA through the kd-tree on clouds. */
+ViewerState initialState(const InputCapabilities& input);
+
+/**
+ * Applies one action. The vocabulary (the same for keys and -do):
+ *   method=uniform|area|angle|mean_curvature|pca|quadric   method+ (the next one)
+ *   k=N  k+  k-  k=default          neighbours=bfs|knn  neighbours+ (toggle)
+ *   field=none|mean|gauss|k1|k2|angle|compare|<property>  field+ (the next one)
+ *   smooth=explicit|implicit[:t]  (t: the step in h^2)   undo
+ *   step=t  step*  step/ (double, halve)   weights=uniform|cotan  weights+ (toggle)
+ *   frozen=on|off  normals=on|off  normals+  shading=flat|smooth  shading+  screenshot
+ * Throws std::invalid_argument with a message naming the action when it is unknown, malformed or
+ * impossible for this input (a mesh method or bfs on a cloud, k beyond the point count).
+ * Returns a note for the overlay when the action was adjusted (k clamped), else "".
+ */
+std::string applyAction(ViewerState& state, const InputCapabilities& input,
+                        const std::string& action);
+
+/** Splits a -do line (or a commands file's text) into actions: blank-separated, # comments. */
+std::vector<std::string> splitActions(const std::string& text);
+
+/** The action a key triggers, "" for keys the viewer leaves to PCLVisualizer. */
+std::string actionForKey(const std::string& key_sym);
+
+/** One line per key, for 'h' and -help. */
+std::string keyHelp();
+
+const char* methodName(NormalMethod method);
+bool isMeshMethod(NormalMethod method);
+
+}  // namespace viewer
+}  // namespace pcl_ddg

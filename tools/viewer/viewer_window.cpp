@@ -1,0 +1,386 @@
+#include "viewer/viewer_window.h"
+
+#include <X11/Xlib.h>
+#include <vtkActor.h>
+#include <vtkCellArray.h>
+#include <vtkFloatArray.h>
+#include <vtkLookupTable.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkRendererCollection.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+#include <vtkUnsignedCharArray.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+
+namespace pcl_ddg {
+namespace viewer {
+namespace {
+
+vtkRenderer* rendererOf(pcl::visualization::PCLVisualizer& visualizer) {
+  return visualizer.getRendererCollection()->GetFirstRenderer();
+}
+
+// The colour bar's table: the frame's colour map sampled at 256 values across its range.
+vtkSmartPointer<vtkLookupTable> lookupTable(const Frame& frame) {
+  constexpr int kColors = 256;
+  Eigen::VectorXd ramp(kColors);
+  for (int i = 0; i < kColors; ++i)
+    ramp[i] = frame.range.low + (frame.range.high - frame.range.low) * i / (kColors - 1.0);
+  // colorize() scales by percentiles of its input; a ramp's 2nd..98th percentiles are not its ends,
+  // so the ramp is extended to put them there.
+  ColorScale scale;
+  scale.low_percentile = 0.0;
+  scale.high_percentile = 100.0;
+  const VertexColors colors = colorize(ramp, frame.color_map, scale);
+  auto table = vtkSmartPointer<vtkLookupTable>::New();
+  table->SetNumberOfTableValues(kColors);
+  table->SetRange(frame.range.low, frame.range.high);
+  for (int i = 0; i < kColors; ++i) {
+    table->SetTableValue(i, colors(0, i) / 255.0, colors(1, i) / 255.0, colors(2, i) / 255.0, 1.0);
+  }
+  table->Build();
+  return table;
+}
+
+std::string describe(const ViewerState& s, bool is_mesh) {
+  std::ostringstream out;
+  out << "normals: " << methodName(s.method);
+  if (!isMeshMethod(s.method)) {
+    out << ", k = " << s.k << ", "
+        << (s.neighbours == Neighbours::MeshRings ? "mesh rings" : "kd-tree");
+  }
+  out << "   field: " << s.field;
+  if (is_mesh) {
+    int explicit_steps = 0;
+    for (const SmoothingStep& step : s.steps) explicit_steps += !step.implicit;
+    out << "\nsmoothing: " << s.steps.size() << " steps (" << explicit_steps << " explicit), next "
+        << s.time_step << " h^2, " << (s.cotan ? "cotan" : "uniform") << " weights "
+        << (s.frozen ? "frozen" : "rebuilt");
+  }
+  return out.str();
+}
+
+}  // namespace
+
+std::string displayProblem() {
+  const char* display = std::getenv("DISPLAY");
+  if (display == nullptr || *display == '\0') {
+    return "no display: DISPLAY is not set (run it on a desktop, or headless under xvfb-run)";
+  }
+  Display* connection = XOpenDisplay(nullptr);
+  if (connection == nullptr) {
+    return std::string("cannot open display '") + display + "' (is the X server running?)";
+  }
+  XCloseDisplay(connection);
+  return "";
+}
+
+ViewerWindow::ViewerWindow(ViewerModel& model, int width, int height)
+    : model_(model), pending_(initialState(model.capabilities())) {
+  visualizer_ = std::make_unique<pcl::visualization::PCLVisualizer>("pcl_ddg_viewer");
+  visualizer_->setSize(width, height);
+  visualizer_->setBackgroundColor(0.12, 0.12, 0.14);
+  visualizer_->setShowFPS(false);
+  visualizer_->registerKeyboardCallback(
+      [this](const pcl::visualization::KeyboardEvent& event) { onKey(event); });
+  text_ = vtkSmartPointer<vtkTextActor>::New();
+  text_->GetTextProperty()->SetFontSize(14);
+  text_->GetTextProperty()->SetColor(0.95, 0.95, 0.95);
+  text_->SetDisplayPosition(10, 10);
+  rendererOf(*visualizer_)->AddActor2D(text_);
+}
+
+ViewerWindow::~ViewerWindow() {
+  // Not visualizer_->close(): PCL's X interactor then asks a closed display for an atom (crash).
+  if (computing_.valid()) computing_.wait();
+}
+
+vtkRenderWindowInteractor* ViewerWindow::interactor() {
+  return visualizer_->getRenderWindow()->GetInteractor();
+}
+
+void ViewerWindow::enqueue(const std::string& action) {
+  queue_.push_back(action);
+}
+
+void ViewerWindow::onKey(const pcl::visualization::KeyboardEvent& event) {
+  if (!event.keyDown()) return;
+  if (event.getKeySym() == "h") {
+    std::cout << "pcl_ddg_viewer keys:\n" << keyHelp() << std::flush;
+    return;
+  }
+  const std::string action = actionForKey(event.getKeySym());
+  if (!action.empty()) enqueue(action);
+}
+
+bool ViewerWindow::step() {
+  if (computing_.valid()) {
+    if (computing_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return false;
+    try {
+      Frame frame = computing_.get();
+      // Refused smoothing steps leave the state too, so later actions build on what is shown.
+      if (frame.step_refused) pending_.steps = frame.state.steps;
+      shown_ = std::move(frame);
+      draw(shown_);
+    } catch (const std::exception& e) {
+      if (!drawn_once_) throw;  // nothing to show: the tool's one-line error
+      errors_.push_back(e.what());
+      notes_.push_back(std::string("computation failed: ") + e.what());
+      pending_ = shown_.state;
+      drawOverlay(shown_, "");
+    }
+    notes_.clear();
+  }
+  while (!queue_.empty()) {
+    const std::string action = queue_.front();
+    if (action == "screenshot") {
+      // Of what is queued before it, drawn.
+      if (!drawn_once_ || pending_ != shown_.state) break;
+      applyAction(pending_, model_.capabilities(), action);
+      shown_.state.screenshots = pending_.screenshots;
+      takeScreenshot();
+      queue_.pop_front();
+      continue;
+    }
+    queue_.pop_front();
+    try {
+      const std::string note = applyAction(pending_, model_.capabilities(), action);
+      if (!note.empty()) notes_.push_back(note);
+    } catch (const std::invalid_argument& e) {
+      errors_.push_back(e.what());
+      notes_.push_back(e.what());
+      std::cerr << "pcl_ddg_viewer: " << e.what() << "\n";
+    }
+  }
+  if (drawn_once_ && pending_ == shown_.state) {
+    if (!notes_.empty()) drawOverlay(shown_, "");
+    return queue_.empty();
+  }
+  if (drawn_once_) drawOverlay(shown_, "computing ...");
+  const ViewerState state = pending_;
+  computing_ = std::async(std::launch::async, [this, state] { return model_.compute(state); });
+  return false;
+}
+
+void ViewerWindow::takeScreenshot() {
+  char name[64];
+  std::snprintf(name, sizeof name, "pcl_ddg_viewer_%03d.png", shown_.state.screenshots);
+  saveScreenshot(name);
+  std::cout << "pcl_ddg_viewer: wrote " << name << "\n";
+}
+
+void ViewerWindow::run() {
+  while (!visualizer_->wasStopped()) {
+    visualizer_->spinOnce(15);
+    step();
+  }
+}
+
+bool ViewerWindow::runUntilIdle(double timeout_seconds) {
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_seconds);
+  while (std::chrono::steady_clock::now() < deadline) {
+    visualizer_->spinOnce(5);
+    if (step() && !computing_.valid() && queue_.empty()) return true;
+  }
+  return false;
+}
+
+void ViewerWindow::saveScreenshot(const std::string& path) {
+  visualizer_->spinOnce(1, true);
+  visualizer_->saveScreenshot(path);
+}
+
+void ViewerWindow::draw(const Frame& frame) {
+  drawSurface(frame);
+  drawNormals(frame);
+  vtkRenderer* renderer = rendererOf(*visualizer_);
+  if (color_bar_) renderer->RemoveActor2D(color_bar_);
+  color_bar_ = nullptr;
+  if (!frame.field_label.empty()) {
+    color_bar_ = vtkSmartPointer<vtkScalarBarActor>::New();
+    color_bar_->SetLookupTable(lookupTable(frame));
+    color_bar_->SetTitle(frame.field_label.c_str());
+    color_bar_->SetNumberOfLabels(5);
+    color_bar_->SetOrientationToHorizontal();
+    color_bar_->SetPosition(0.55, 0.88);
+    color_bar_->SetWidth(0.42);
+    color_bar_->SetHeight(0.1);
+    color_bar_->GetTitleTextProperty()->SetFontSize(12);
+    color_bar_->GetLabelTextProperty()->SetFontSize(11);
+    renderer->AddActor2D(color_bar_);
+  }
+  std::ostringstream status;
+  status.precision(3);
+  status << "last computation " << frame.compute_ms << " ms";
+  drawOverlay(frame, status.str());
+  if (!drawn_once_) placeCamera();
+  drawn_once_ = true;
+}
+
+void ViewerWindow::placeCamera() {
+  visualizer_->resetCamera();
+  if (model_.isMesh()) return;
+  // A cloud from its sensor, as pcl_viewer shows a PCD: looking along the sensor's z, y down;
+  // normals face the sensor, so the lit side is the one seen.
+  const SensorPose& pose = model_.sensorPose();
+  const Eigen::Vector3d forward = pose.orientation * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d up = pose.orientation * -Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d focal = pose.origin + forward;
+  visualizer_->setCameraPosition(pose.origin.x(), pose.origin.y(), pose.origin.z(), focal.x(),
+                                 focal.y(), focal.z(), up.x(), up.y(), up.z());
+  rendererOf(*visualizer_)->ResetCamera();
+}
+
+void ViewerWindow::drawSurface(const Frame& frame) {
+  const Eigen::Matrix3Xd& positions = *frame.positions;
+  const Eigen::Index n = positions.cols();
+  if (points_of_ != frame.positions.get()) {
+    points_ = vtkSmartPointer<vtkPoints>::New();
+    points_->SetDataTypeToFloat();
+    points_->SetNumberOfPoints(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Vector3d p = positions.col(i).allFinite() ? Eigen::Vector3d(positions.col(i))
+                                                             : Eigen::Vector3d::Zero();
+      points_->SetPoint(i, p.data());
+    }
+    points_of_ = frame.positions.get();
+    points_owner_ = frame.positions;
+  }
+  if (!cells_) {
+    cells_ = vtkSmartPointer<vtkCellArray>::New();
+    if (const MeshTopology* topology = model_.topology()) {
+      for (int t = 0; t < topology->numTriangles(); ++t) {
+        const vtkIdType corners[3] = {topology->triangles()(0, t), topology->triangles()(1, t),
+                                      topology->triangles()(2, t)};
+        cells_->InsertNextCell(3, corners);
+      }
+    } else {
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (!positions.col(i).allFinite()) continue;
+        const vtkIdType id = i;
+        cells_->InsertNextCell(1, &id);
+      }
+    }
+  }
+  auto colors = vtkSmartPointer<vtkUnsignedCharArray>::New();
+  colors->SetNumberOfComponents(3);
+  colors->SetName("colors");
+  colors->SetNumberOfTuples(n);
+  auto normals = vtkSmartPointer<vtkFloatArray>::New();
+  normals->SetNumberOfComponents(3);
+  normals->SetName("normals");
+  normals->SetNumberOfTuples(n);
+  // Points are drawn unlit (VTK lights them one-sided and from the camera); uncoloured, they are
+  // shaded grey by how squarely their normal faces the sensor, so that the shape shows.
+  const bool shade_points = !model_.isMesh() && frame.field_label.empty();
+  const Eigen::Vector3d sensor_axis = model_.sensorPose().orientation * Eigen::Vector3d::UnitZ();
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (shade_points) {
+      const double facing = frame.normals->col(i).allFinite()
+                                ? std::abs(frame.normals->col(i).dot(sensor_axis))
+                                : 0.5;
+      const auto grey = static_cast<unsigned char>(60.0 + 180.0 * facing);
+      const unsigned char rgb[3] = {grey, grey, grey};
+      colors->SetTypedTuple(i, rgb);
+    } else {
+      colors->SetTypedTuple(i, frame.colors.col(i).data());
+    }
+    const Eigen::Vector3f normal = frame.normals->col(i).allFinite()
+                                       ? Eigen::Vector3f(frame.normals->col(i).cast<float>())
+                                       : Eigen::Vector3f::Zero();
+    normals->SetTypedTuple(i, normal.data());
+  }
+  auto data = vtkSmartPointer<vtkPolyData>::New();
+  data->SetPoints(points_);
+  if (model_.isMesh()) {
+    data->SetPolys(cells_);
+  } else {
+    data->SetVerts(cells_);
+  }
+  data->GetPointData()->SetScalars(colors);
+  data->GetPointData()->SetNormals(normals);
+
+  auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+  mapper->SetInputData(data);
+  mapper->SetColorModeToDirectScalars();
+  mapper->ScalarVisibilityOn();
+  vtkRenderer* renderer = rendererOf(*visualizer_);
+  if (!surface_) {
+    surface_ = vtkSmartPointer<vtkActor>::New();
+    renderer->AddActor(surface_);
+  }
+  surface_->SetMapper(mapper);
+  vtkProperty* property = surface_->GetProperty();
+  if (frame.state.smooth_shading) {
+    property->SetInterpolationToGouraud();
+  } else {
+    property->SetInterpolationToFlat();
+  }
+  property->SetPointSize(model_.isMesh() ? 1.0f : 2.0f);
+  property->SetLighting(model_.isMesh());
+}
+
+void ViewerWindow::drawNormals(const Frame& frame) {
+  vtkRenderer* renderer = rendererOf(*visualizer_);
+  if (glyphs_) renderer->RemoveActor(glyphs_);
+  glyphs_ = nullptr;
+  if (!frame.state.show_normals) return;
+  const Eigen::Matrix3Xd& positions = *frame.positions;
+  const Eigen::Matrix3Xd& normals = *frame.normals;
+  // About 20,000 glyphs whatever the size: every n-th vertex.
+  const Eigen::Index every = std::max<Eigen::Index>(1, positions.cols() / 20000);
+  auto points = vtkSmartPointer<vtkPoints>::New();
+  auto lines = vtkSmartPointer<vtkCellArray>::New();
+  for (Eigen::Index i = 0; i < positions.cols(); i += every) {
+    if (!positions.col(i).allFinite() || !normals.col(i).allFinite()) continue;
+    const Eigen::Vector3d tip = positions.col(i) + frame.glyph_length * normals.col(i);
+    const vtkIdType ends[2] = {points->InsertNextPoint(positions.col(i).data()),
+                               points->InsertNextPoint(tip.data())};
+    lines->InsertNextCell(2, ends);
+  }
+  auto data = vtkSmartPointer<vtkPolyData>::New();
+  data->SetPoints(points);
+  data->SetLines(lines);
+  auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+  mapper->SetInputData(data);
+  glyphs_ = vtkSmartPointer<vtkActor>::New();
+  glyphs_->SetMapper(mapper);
+  glyphs_->GetProperty()->SetColor(1.0, 0.85, 0.2);
+  glyphs_->GetProperty()->SetLighting(false);
+  renderer->AddActor(glyphs_);
+}
+
+void ViewerWindow::drawOverlay(const Frame& frame, const std::string& status) {
+  std::ostringstream text;
+  const std::string& path = model_.path();
+  text << path.substr(path.find_last_of('/') + 1) << ": " << model_.capabilities().points
+       << (model_.isMesh()
+               ? " vertices, " + std::to_string(model_.topology()->numTriangles()) + " triangles"
+               : " points")
+       << "\n"
+       << describe(frame.state, model_.isMesh()) << "\n"
+       << status;
+  for (const std::string& warning : frame.warnings) text << "\n! " << warning;
+  for (const std::string& note : notes_) text << "\n! " << note;
+  text_->SetInput(text.str().c_str());
+  visualizer_->getRenderWindow()->Render();
+}
+
+}  // namespace viewer
+}  // namespace pcl_ddg

@@ -1,0 +1,83 @@
+#pragma once
+// The viewer's window, on pcl::visualization::PCLVisualizer: draws a Frame (surface or points
+// coloured by the field, normal glyphs, overlay text, colour bar) and turns key presses into
+// actions. Actions wait in a queue; whenever no computation runs, all queued actions are applied
+// to the state at once (50 presses of ']' become one fit for the final k) and the frame is
+// computed on a worker thread, so the window keeps drawing and no press is lost.
+#include <pcl/visualization/pcl_visualizer.h>
+#include <vtkSmartPointer.h>
+
+#include <deque>
+#include <future>
+#include <memory>
+#include <string>
+
+#include "viewer/viewer_model.h"
+
+class vtkActor;
+class vtkCellArray;
+class vtkPoints;
+class vtkScalarBarActor;
+class vtkTextActor;
+class vtkRenderWindowInteractor;
+
+namespace pcl_ddg {
+namespace viewer {
+
+class ViewerWindow {
+ public:
+  /** Opens the window (the caller has checked that a display exists). */
+  ViewerWindow(ViewerModel& model, int width, int height);
+  ~ViewerWindow();
+
+  /** Queues an action, as a key press does. */
+  void enqueue(const std::string& action);
+  /** The interactive loop, until the window is closed. */
+  void run();
+  /** Spins until every queued action is computed and drawn; false on timeout. */
+  bool runUntilIdle(double timeout_seconds);
+  void saveScreenshot(const std::string& path);
+
+  /** The state of the frame on screen. */
+  const ViewerState& state() const { return shown_.state; }
+  const Frame& frame() const { return shown_; }
+  /** Messages of refused actions, in order. */
+  const std::vector<std::string>& errors() const { return errors_; }
+  vtkRenderWindowInteractor* interactor();
+  pcl::visualization::PCLVisualizer& visualizer() { return *visualizer_; }
+
+ private:
+  void onKey(const pcl::visualization::KeyboardEvent& event);
+  /** Collects a finished computation and starts the next one; true when idle afterwards. */
+  bool step();
+  void draw(const Frame& frame);
+  void placeCamera();
+  void drawSurface(const Frame& frame);
+  void drawNormals(const Frame& frame);
+  void drawOverlay(const Frame& frame, const std::string& status);
+  void takeScreenshot();
+
+  ViewerModel& model_;
+  std::unique_ptr<pcl::visualization::PCLVisualizer> visualizer_;
+  ViewerState pending_;  ///< the state after every action queued so far
+  std::deque<std::string> queue_;
+  std::future<Frame> computing_;
+  Frame shown_;
+  bool drawn_once_ = false;
+  std::vector<std::string> errors_;
+  std::vector<std::string> notes_;  ///< of actions since the last frame (k clamped, refusals)
+  vtkSmartPointer<vtkActor> surface_, glyphs_;
+  vtkSmartPointer<vtkTextActor> text_;
+  vtkSmartPointer<vtkScalarBarActor> color_bar_;
+  vtkSmartPointer<vtkCellArray> cells_;  ///< triangles or vertices: the same in every frame
+  vtkSmartPointer<vtkPoints> points_;    ///< of points_of_
+  const Eigen::Matrix3Xd* points_of_ = nullptr;
+  std::shared_ptr<const Eigen::Matrix3Xd> points_owner_;  ///< keeps points_of_ alive
+};
+
+/** One line saying why no window can open (no DISPLAY, or an X server that does not answer), or
+ *  "" when a display is there. */
+std::string displayProblem();
+
+}  // namespace viewer
+}  // namespace pcl_ddg
