@@ -171,10 +171,25 @@ bool ViewerWindow::step() {
     if (!notes_.empty()) drawOverlay(shown_, "");
     return queue_.empty();
   }
-  if (drawn_once_) drawOverlay(shown_, "computing ...");
   const ViewerState state = pending_;
   computing_ = std::async(std::launch::async, [this, state] { return model_.compute(state); });
+  computing_since_ = std::chrono::steady_clock::now();
+  computing_shown_ = false;
   return false;
+}
+
+void ViewerWindow::renderIfChanged() {
+  // "computing ..." only for work that takes a while: with software OpenGL a redraw of a large
+  // mesh costs as much as the computation.
+  constexpr auto kShowComputingAfter = std::chrono::milliseconds(300);
+  if (computing_.valid() && !computing_shown_ && drawn_once_ &&
+      std::chrono::steady_clock::now() - computing_since_ > kShowComputingAfter) {
+    drawOverlay(shown_, "computing ...");
+    computing_shown_ = true;
+  }
+  if (!needs_render_) return;
+  visualizer_->getRenderWindow()->Render();
+  needs_render_ = false;
 }
 
 void ViewerWindow::takeScreenshot() {
@@ -188,6 +203,7 @@ void ViewerWindow::run() {
   while (!visualizer_->wasStopped()) {
     visualizer_->spinOnce(15);
     step();
+    renderIfChanged();
   }
 }
 
@@ -196,13 +212,15 @@ bool ViewerWindow::runUntilIdle(double timeout_seconds) {
       std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_seconds);
   while (std::chrono::steady_clock::now() < deadline) {
     visualizer_->spinOnce(5);
-    if (step() && !computing_.valid() && queue_.empty()) return true;
+    const bool idle = step() && !computing_.valid() && queue_.empty();
+    renderIfChanged();
+    if (idle) return true;
   }
   return false;
 }
 
 void ViewerWindow::saveScreenshot(const std::string& path) {
-  visualizer_->spinOnce(1, true);
+  renderIfChanged();
   visualizer_->saveScreenshot(path);
 }
 
@@ -379,7 +397,7 @@ void ViewerWindow::drawOverlay(const Frame& frame, const std::string& status) {
   for (const std::string& warning : frame.warnings) text << "\n! " << warning;
   for (const std::string& note : notes_) text << "\n! " << note;
   text_->SetInput(text.str().c_str());
-  visualizer_->getRenderWindow()->Render();
+  needs_render_ = true;
 }
 
 }  // namespace viewer

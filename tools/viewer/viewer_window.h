@@ -7,6 +7,7 @@
 #include <pcl/visualization/pcl_visualizer.h>
 #include <vtkSmartPointer.h>
 
+#include <chrono>
 #include <deque>
 #include <future>
 #include <memory>
@@ -52,6 +53,8 @@ class ViewerWindow {
   bool step();
   void draw(const Frame& frame);
   void placeCamera();
+  /** One render when something changed since the last (the only place that renders). */
+  void renderIfChanged();
   void drawSurface(const Frame& frame);
   void drawNormals(const Frame& frame);
   void drawOverlay(const Frame& frame, const std::string& status);
@@ -62,6 +65,9 @@ class ViewerWindow {
   ViewerState pending_;  ///< the state after every action queued so far
   std::deque<std::string> queue_;
   std::future<Frame> computing_;
+  std::chrono::steady_clock::time_point computing_since_;
+  bool computing_shown_ = false;
+  bool needs_render_ = false;
   Frame shown_;
   bool drawn_once_ = false;
   std::vector<std::string> errors_;
