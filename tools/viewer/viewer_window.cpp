@@ -324,26 +324,26 @@ void ViewerWindow::drawSurface(const Frame& frame) {
                                        : Eigen::Vector3f::Zero();
     normals->SetTypedTuple(i, normal.data());
   }
-  auto data = vtkSmartPointer<vtkPolyData>::New();
-  data->SetPoints(points_);
-  if (model_.isMesh()) {
-    data->SetPolys(cells_);
-  } else {
-    data->SetVerts(cells_);
-  }
-  data->GetPointData()->SetScalars(colors);
-  data->GetPointData()->SetNormals(normals);
-
-  auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-  mapper->SetInputData(data);
-  mapper->SetColorModeToDirectScalars();
-  mapper->ScalarVisibilityOn();
-  vtkRenderer* renderer = rendererOf(*visualizer_);
+  // One polydata and mapper for the window's life: a new frame replaces arrays, so the mapper
+  // keeps its shaders and the triangle index buffer.
   if (!surface_) {
+    surface_data_ = vtkSmartPointer<vtkPolyData>::New();
+    if (model_.isMesh()) {
+      surface_data_->SetPolys(cells_);
+    } else {
+      surface_data_->SetVerts(cells_);
+    }
+    auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
+    mapper->SetInputData(surface_data_);
+    mapper->SetColorModeToDirectScalars();
+    mapper->ScalarVisibilityOn();
     surface_ = vtkSmartPointer<vtkActor>::New();
-    renderer->AddActor(surface_);
+    surface_->SetMapper(mapper);
+    rendererOf(*visualizer_)->AddActor(surface_);
   }
-  surface_->SetMapper(mapper);
+  if (surface_data_->GetPoints() != points_) surface_data_->SetPoints(points_);
+  surface_data_->GetPointData()->SetScalars(colors);
+  surface_data_->GetPointData()->SetNormals(normals);
   vtkProperty* property = surface_->GetProperty();
   if (frame.state.smooth_shading) {
     property->SetInterpolationToGouraud();

@@ -18,6 +18,7 @@
 class vtkActor;
 class vtkCellArray;
 class vtkPoints;
+class vtkPolyData;
 class vtkScalarBarActor;
 class vtkTextActor;
 class vtkRenderWindowInteractor;
@@ -73,6 +74,7 @@ class ViewerWindow {
   std::vector<std::string> errors_;
   std::vector<std::string> notes_;  ///< of actions since the last frame (k clamped, refusals)
   vtkSmartPointer<vtkActor> surface_, glyphs_;
+  vtkSmartPointer<vtkPolyData> surface_data_;
   vtkSmartPointer<vtkTextActor> text_;
   vtkSmartPointer<vtkScalarBarActor> color_bar_;
   vtkSmartPointer<vtkCellArray> cells_;  ///< triangles or vertices: the same in every frame
