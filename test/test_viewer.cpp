@@ -250,6 +250,11 @@ TEST(ViewerActions, RefuseWhatTheInputCannotDoAndClampK) {
   EXPECT_THROW(viewer::applyAction(state, cloud, "k=two"), std::invalid_argument);
   EXPECT_THROW(viewer::applyAction(state, cloud, "colour=red"), std::invalid_argument);
   EXPECT_NO_THROW(viewer::applyAction(state, cloud, "field=intensity"));
+  EXPECT_THROW(viewer::applyAction(state, cloud, "reference=area"), std::invalid_argument);
+  viewer::applyAction(state, cloud, "reference=quadric");
+  EXPECT_EQ(state.reference, viewer::NormalMethod::Quadric);
+  viewer::applyAction(state, cloud, "reference=auto");
+  EXPECT_FALSE(state.reference.has_value());
   EXPECT_FALSE(viewer::applyAction(state, cloud, "k=5000").empty());  // clamped, and said so
   EXPECT_EQ(state.k, 99);
   viewer::applyAction(state, cloud, "method+");
@@ -258,6 +263,20 @@ TEST(ViewerActions, RefuseWhatTheInputCannotDoAndClampK) {
   EXPECT_EQ(state.method, viewer::NormalMethod::PCA);
   EXPECT_EQ(viewer::splitActions("k=3 # comment\n field=none"),
             (std::vector<std::string>{"k=3", "field=none"}));
+}
+
+TEST_F(Viewer, TheAngleFieldComparesWithTheChosenReference) {
+  auto model = open(sharedData("meshes/cow.off"));
+  ViewerState state = viewer::initialState(model->capabilities());  // area normals
+  viewer::applyAction(state, model->capabilities(), "field=angle");
+  viewer::applyAction(state, model->capabilities(), "reference=area");
+  const viewer::Frame same = model->compute(state);
+  EXPECT_NE(same.field_label.find("area"), std::string::npos);
+  EXPECT_LT(same.field.maxCoeff(), 1e-5);  // area against area: nothing (acos rounding only)
+  viewer::applyAction(state, model->capabilities(), "reference=uniform");
+  const viewer::Frame other = model->compute(state);
+  EXPECT_NE(other.field_label.find("uniform"), std::string::npos);
+  EXPECT_GT(other.field.mean(), 0.5);  // degrees: uniform and area weights differ on the cow
 }
 
 TEST_F(Viewer, EverySharedFileOpensAndRenders) {

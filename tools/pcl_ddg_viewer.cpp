@@ -24,6 +24,7 @@ std::string syntax() {
          "Actions (also what the keys send):\n"
          "  method=uniform|area|angle|mean_curvature|pca|quadric  k=N  neighbours=bfs|knn\n"
          "  field=none|mean|gauss|k1|k2|angle|compare|<property of the file>\n"
+         "  reference=auto|<method> (what field=angle compares with)\n"
          "  smooth=explicit|implicit[:t] (t: step in h^2)  step=t  weights=uniform|cotan\n"
          "  frozen=on|off  undo  normals=on|off  shading=flat|smooth  screenshot\n"
          "Keys:\n" +

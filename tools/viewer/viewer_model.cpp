@@ -232,6 +232,7 @@ Eigen::VectorXd ViewerModel::fieldOf(const ViewerState& state, const std::string
     NormalMethod reference = isMesh() ? NormalMethod::Area : NormalMethod::PCA;
     if (state.method == reference)
       reference = isMesh() ? NormalMethod::MeanCurvature : NormalMethod::Quadric;
+    if (state.reference) reference = *state.reference;
     label = std::string("angle to ") + methodName(reference) + " normals (degrees)";
     map = ColorMap::Sequential;
     const auto other = normalsOf(reference, state, version, positions, warnings);

@@ -60,9 +60,9 @@ void setMethod(ViewerState& state, const InputCapabilities& input, NormalMethod 
 
 bool ViewerState::operator==(const ViewerState& o) const {
   return method == o.method && k == o.k && neighbours == o.neighbours && field == o.field &&
-         steps == o.steps && time_step == o.time_step && cotan == o.cotan && frozen == o.frozen &&
-         show_normals == o.show_normals && smooth_shading == o.smooth_shading &&
-         screenshots == o.screenshots;
+         reference == o.reference && steps == o.steps && time_step == o.time_step &&
+         cotan == o.cotan && frozen == o.frozen && show_normals == o.show_normals &&
+         smooth_shading == o.smooth_shading && screenshots == o.screenshots;
 }
 
 const char* methodName(NormalMethod method) {
@@ -147,6 +147,19 @@ std::string applyAction(ViewerState& state, const InputCapabilities& input,
         refuse(action, "no such field (" + known + ")");
       }
       state.field = value;
+    }
+  } else if (name == "reference") {
+    needValue();
+    if (value == "auto") {
+      state.reference.reset();
+    } else {
+      const auto it = std::find_if(kMethods.begin(), kMethods.end(),
+                                   [&](const auto& m) { return value == m.second; });
+      if (it == kMethods.end()) refuse(action, "unknown method");
+      if (isMeshMethod(it->first) && !input.is_mesh) {
+        refuse(action, std::string(it->second) + " normals need a mesh; this is a cloud");
+      }
+      state.reference = it->first;
     }
   } else if (name == "smooth") {
     needValue();

@@ -3,6 +3,7 @@
 // the smoothing steps applied to the input, and how things are drawn. Keys and -do commands both
 // become actions ("method=pca", "k+", "smooth=implicit:2") applied here, so that a key press and
 // the equivalent command reach exactly the same state.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,9 @@ struct ViewerState {
   /** none, mean, gauss, k1, k2, angle (to the reference method's normals), compare (mesh rings
    *  vs kd-tree), or the name of a scalar property of the file. */
   std::string field = "none";
+  /** The normals field=angle compares with; unset: area on meshes, PCA on clouds (and, when that
+   *  is the method shown, mean_curvature or quadric). */
+  std::optional<NormalMethod> reference;
   std::vector<SmoothingStep> steps;  ///< applied to the input, in order
   double time_step = 1.0;            ///< of the next step, in h^2
   bool cotan = true;                 ///< weights of the next step
@@ -59,6 +63,7 @@ ViewerState initialState(const InputCapabilities& input);
  *   method=uniform|area|angle|mean_curvature|pca|quadric   method+ (the next one)
  *   k=N  k+  k-  k=default          neighbours=bfs|knn  neighbours+ (toggle)
  *   field=none|mean|gauss|k1|k2|angle|compare|<property>  field+ (the next one)
+ *   reference=auto|<method>  (what field=angle compares with)
  *   smooth=explicit|implicit[:t]  (t: the step in h^2)   undo
  *   step=t  step*  step/ (double, halve)   weights=uniform|cotan  weights+ (toggle)
  *   frozen=on|off  normals=on|off  normals+  shading=flat|smooth  shading+  screenshot
