@@ -1,7 +1,7 @@
 // PCD (PCL's own format), read here rather than by pcl::PCDReader: PCL's reader trusts the header
 // (negative or huge COUNT, WIDTH x HEIGHT != POINTS, lying compressed sizes) and crashes on it.
 // Every size is checked against the bytes the file really holds before anything is allocated.
-#include <pcl/io/lzf.h>
+#include <lzf.h>
 
 #include <pcl/common/io.h>
 
@@ -194,7 +194,7 @@ void readCompressed(ByteCursor& cursor, const PcdHeader& header, pcl::PCLPointCl
   if (compressed == 0) cursor.fail("PCD compressed data is empty");
   std::vector<char> unpacked(uncompressed);
   if (uncompressed > 0 &&
-      pcl::lzfDecompress(packed, compressed, unpacked.data(), uncompressed) != uncompressed) {
+      lzf_decompress(packed, compressed, unpacked.data(), uncompressed) != uncompressed) {
     cursor.fail("PCD compressed data is corrupt");
   }
   const char* src = unpacked.data();
@@ -367,8 +367,8 @@ std::string encodePCD(const pcl::PCLPointCloud2& cloud, const SensorPose& sensor
   std::string packed(planar.size() + planar.size() / 2 + 64, '\0');
   const unsigned int packed_size =
       planar.empty() ? 0
-                     : pcl::lzfCompress(planar.data(), static_cast<unsigned int>(planar.size()),
-                                        packed.data(), static_cast<unsigned int>(packed.size()));
+                     : lzf_compress(planar.data(), static_cast<unsigned int>(planar.size()),
+                                    packed.data(), static_cast<unsigned int>(packed.size()));
   if (packed_size == 0 && !planar.empty()) throw FileFormatException("LZF compression failed");
   const auto sizes = [](std::uint32_t compressed, std::uint32_t uncompressed) {
     std::string bytes(8, '\0');
