@@ -97,7 +97,12 @@ MeshFile readMeshFile(const std::string& path) {
              f.datatype == pcl::PCLPointField::FLOAT64;
     });
     if (typed && stored_double) file.coordinate_precision = FieldPrecision::Double;
-    setVertexCoordinates(cloud, file.positions, FieldPrecision::Float);
+    // Float coordinates are PCL's already (and the positions their exact values).
+    const bool all_float = std::all_of(cloud.fields.begin(), cloud.fields.end(), [](auto& f) {
+      return !(f.name == "x" || f.name == "y" || f.name == "z") ||
+             (f.datatype == pcl::PCLPointField::FLOAT32 && f.count == 1);
+    });
+    if (!all_float) setVertexCoordinates(cloud, file.positions, FieldPrecision::Float);
     return file;
   } catch (const pcl::PCLException& e) {
     throw FileFormatException(path + ": " + errorDescription(e));

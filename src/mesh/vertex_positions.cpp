@@ -118,10 +118,22 @@ Eigen::VectorXd vertexScalarField(const pcl::PCLPointCloud2& cloud, const std::s
 
 Eigen::Matrix3Xd vertexPositions(const pcl::PCLPointCloud2& cloud, NonFinitePolicy policy) {
   if (cloud.width * cloud.height == 0) throw InvalidMeshException("mesh has no vertices");
-  Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(cloud.width) * cloud.height);
-  positions.row(0) = vertexScalarField(cloud, "x").transpose();
-  positions.row(1) = vertexScalarField(cloud, "y").transpose();
-  positions.row(2) = vertexScalarField(cloud, "z").transpose();
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  if (cloud.data.size() < n * cloud.point_step) {
+    throw InvalidMeshException("vertex data is shorter than width x height x point_step");
+  }
+  const pcl::PCLPointField* fields[3] = {&namedField(cloud, "x"), &namedField(cloud, "y"),
+                                         &namedField(cloud, "z")};
+  // One pass, serial: loaders run in forked children (tests, services), where an OpenMP team
+  // inherited from the parent would hang.
+  Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(n));
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
+    for (int axis = 0; axis < 3; ++axis) {
+      positions(axis, static_cast<Eigen::Index>(i)) =
+          readScalar(point + fields[axis]->offset, fields[axis]->datatype);
+    }
+  }
   if (policy == NonFinitePolicy::Throw) requireFinite(positions);
   return positions;
 }
