@@ -41,8 +41,8 @@ vtkSmartPointer<vtkLookupTable> lookupTable(const Frame& frame) {
   Eigen::VectorXd ramp(kColors);
   for (int i = 0; i < kColors; ++i)
     ramp[i] = frame.range.low + (frame.range.high - frame.range.low) * i / (kColors - 1.0);
-  // colorize() scales by percentiles of its input; a ramp's 2nd..98th percentiles are not its ends,
-  // so the ramp is extended to put them there.
+  // The ramp already spans the frame's range: colorize() must take its ends (0th and 100th
+  // percentiles), not its default 2nd and 98th.
   ColorScale scale;
   scale.low_percentile = 0.0;
   scale.high_percentile = 100.0;
