@@ -115,6 +115,18 @@ ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingSt
   }
 }
 
+LocalFitResult ViewerModel::fit(LocalFitMethod method, const ViewerState& state,
+                                const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) const {
+  LocalFitOptions options;
+  options.method = method;
+  options.neighbourhood = state.neighbours == Neighbours::MeshRings ? NeighbourhoodKind::MeshRings
+                                                                    : NeighbourhoodKind::KdTree;
+  options.k = state.k;
+  options.viewpoint = input_.sensor_pose.origin;
+  const tools::QuietPCLWarnings quiet;
+  return fitLocalSurfaces(points, input_.topology, options);
+}
+
 pcl::PointCloud<pcl::PointXYZ>::Ptr ViewerModel::pointsOf(const std::string& version,
                                                           const Positions& positions) {
   auto& points = points_[version];
@@ -148,15 +160,9 @@ std::shared_ptr<const Eigen::Matrix3Xd> ViewerModel::normalsOf(NormalMethod meth
     if (method == NormalMethod::MeanCurvature) fallback = result.fallback_vertices;
     normals = std::make_shared<const Eigen::Matrix3Xd>(std::move(result.normals));
   } else {
-    LocalFitOptions options;
-    options.method = method == NormalMethod::PCA ? LocalFitMethod::PCA : LocalFitMethod::Quadric;
-    options.neighbourhood = state.neighbours == Neighbours::MeshRings ? NeighbourhoodKind::MeshRings
-                                                                      : NeighbourhoodKind::KdTree;
-    options.k = state.k;
-    options.viewpoint = input_.sensor_pose.origin;
-    const tools::QuietPCLWarnings quiet;
     const LocalFitResult result =
-        fitLocalSurfaces(pointsOf(version, positions), input_.topology, options);
+        fit(method == NormalMethod::PCA ? LocalFitMethod::PCA : LocalFitMethod::Quadric, state,
+            pointsOf(version, positions));
     invalid = result.failed_points;
     fallback = result.fallback_points;
     normals = std::make_shared<const Eigen::Matrix3Xd>(tools::normalsOf(result.normals));
@@ -201,20 +207,12 @@ Eigen::VectorXd ViewerModel::fieldOf(const ViewerState& state, const std::string
       if (c.invalid_vertices > 0)
         warnings.push_back(count(c.invalid_vertices, "vertices without curvature (NaN)"));
     } else {
-      LocalFitOptions options;
-      options.method = LocalFitMethod::Quadric;
-      options.neighbourhood = state.neighbours == Neighbours::MeshRings
-                                  ? NeighbourhoodKind::MeshRings
-                                  : NeighbourhoodKind::KdTree;
-      options.k = state.k;
-      options.viewpoint = input_.sensor_pose.origin;
-      const tools::QuietPCLWarnings quiet;
-      const LocalFitResult fit =
-          fitLocalSurfaces(pointsOf(version, positions), input_.topology, options);
-      const Eigen::Index n = static_cast<Eigen::Index>(fit.curvatures.size());
+      const LocalFitResult quadric =
+          fit(LocalFitMethod::Quadric, state, pointsOf(version, positions));
+      const Eigen::Index n = static_cast<Eigen::Index>(quadric.curvatures.size());
       for (auto& v : values) v.resize(n);
       for (Eigen::Index i = 0; i < n; ++i) {
-        const double k1 = fit.curvatures[i].pc1, k2 = fit.curvatures[i].pc2;
+        const double k1 = quadric.curvatures[i].pc1, k2 = quadric.curvatures[i].pc2;
         values[0][i] = 0.5 * (k1 + k2);
         values[1][i] = k1 * k2;
         values[2][i] = k1;

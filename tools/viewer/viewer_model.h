@@ -65,6 +65,9 @@ class ViewerModel {
   Eigen::VectorXd fieldOf(const ViewerState& state, const std::string& version,
                           const Positions& positions, const Eigen::Matrix3Xd& normals,
                           std::string& label, ColorMap& map, std::vector<std::string>& warnings);
+  /** A pca or quadric fit with the state's k and neighbourhood, oriented as the tools do. */
+  LocalFitResult fit(LocalFitMethod method, const ViewerState& state,
+                     const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) const;
   pcl::PointCloud<pcl::PointXYZ>::Ptr pointsOf(const std::string& version,
                                                const Positions& positions);
 

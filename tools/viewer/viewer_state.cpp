@@ -35,10 +35,14 @@ double positiveNumber(const std::string& action, const std::string& text) {
   return value;
 }
 
-bool onOff(const std::string& action, const std::string& value) {
-  if (value == "on") return true;
-  if (value == "off") return false;
-  refuse(action, "expected on or off");
+// A two-way setting: "name+" toggles it, "name=on_value|off_value" sets it.
+bool twoWay(bool current, bool toggle, const std::string& action, const std::string& value,
+            const char* on_value, const char* off_value) {
+  if (toggle) return !current;
+  if (value != on_value && value != off_value) {
+    refuse(action, std::string("expected ") + on_value + " or " + off_value);
+  }
+  return value == on_value;
 }
 
 std::vector<std::string> fieldsOf(const InputCapabilities& input) {
@@ -48,12 +52,16 @@ std::vector<std::string> fieldsOf(const InputCapabilities& input) {
   return fields;
 }
 
-void setMethod(ViewerState& state, const InputCapabilities& input, NormalMethod method,
-               const std::string& action) {
-  if (isMeshMethod(method) && !input.is_mesh) {
-    refuse(action, std::string(methodName(method)) + " normals need a mesh; this is a cloud");
+// The method of that name, refused when unknown or when it needs a mesh the input is not.
+NormalMethod usableMethod(const InputCapabilities& input, const std::string& action,
+                          const std::string& value) {
+  const auto it = std::find_if(kMethods.begin(), kMethods.end(),
+                               [&](const auto& m) { return value == m.second; });
+  if (it == kMethods.end()) refuse(action, "unknown method");
+  if (isMeshMethod(it->first) && !input.is_mesh) {
+    refuse(action, std::string(it->second) + " normals need a mesh; this is a cloud");
   }
-  state.method = method;
+  return it->first;
 }
 
 }  // namespace
@@ -103,11 +111,7 @@ std::string applyAction(ViewerState& state, const InputCapabilities& input,
     } while (isMeshMethod(it->first) && !input.is_mesh);
     state.method = it->first;
   } else if (name == "method") {
-    needValue();
-    const auto it = std::find_if(kMethods.begin(), kMethods.end(),
-                                 [&](const auto& m) { return value == m.second; });
-    if (it == kMethods.end()) refuse(action, "unknown method");
-    setMethod(state, input, it->first, action);
+    state.method = usableMethod(input, action, value);
   } else if (action == "k+" || action == "k-" || name == "k") {
     int k = state.k;
     if (action == "k+" || action == "k-") {
@@ -153,13 +157,7 @@ std::string applyAction(ViewerState& state, const InputCapabilities& input,
     if (value == "auto") {
       state.reference.reset();
     } else {
-      const auto it = std::find_if(kMethods.begin(), kMethods.end(),
-                                   [&](const auto& m) { return value == m.second; });
-      if (it == kMethods.end()) refuse(action, "unknown method");
-      if (isMeshMethod(it->first) && !input.is_mesh) {
-        refuse(action, std::string(it->second) + " normals need a mesh; this is a cloud");
-      }
-      state.reference = it->first;
+      state.reference = usableMethod(input, action, value);
     }
   } else if (name == "smooth") {
     needValue();
@@ -182,25 +180,15 @@ std::string applyAction(ViewerState& state, const InputCapabilities& input,
       state.time_step = positiveNumber(action, value);
     }
   } else if (action == "weights+" || name == "weights") {
-    if (action == "weights+") {
-      state.cotan = !state.cotan;
-    } else {
-      needValue();
-      if (value != "uniform" && value != "cotan") refuse(action, "expected uniform or cotan");
-      state.cotan = value == "cotan";
-    }
-  } else if (name == "frozen" || action == "frozen+") {
-    state.frozen = action == "frozen+" ? !state.frozen : onOff(action, value);
-  } else if (name == "normals" || action == "normals+") {
-    state.show_normals = action == "normals+" ? !state.show_normals : onOff(action, value);
-  } else if (name == "shading" || action == "shading+") {
-    if (action == "shading+") {
-      state.smooth_shading = !state.smooth_shading;
-    } else {
-      needValue();
-      if (value != "flat" && value != "smooth") refuse(action, "expected flat or smooth");
-      state.smooth_shading = value == "smooth";
-    }
+    state.cotan = twoWay(state.cotan, action == "weights+", action, value, "cotan", "uniform");
+  } else if (action == "frozen+" || name == "frozen") {
+    state.frozen = twoWay(state.frozen, action == "frozen+", action, value, "on", "off");
+  } else if (action == "normals+" || name == "normals") {
+    state.show_normals =
+        twoWay(state.show_normals, action == "normals+", action, value, "on", "off");
+  } else if (action == "shading+" || name == "shading") {
+    state.smooth_shading =
+        twoWay(state.smooth_shading, action == "shading+", action, value, "smooth", "flat");
   } else if (action == "screenshot") {
     ++state.screenshots;
   } else {
