@@ -7,11 +7,36 @@
 
 #ifdef PCL_DDG_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>
+#endif
 
-#include "cholmod_huge_pages.h"
+#ifdef _OPENMP
+#include <omp.h>
 #endif
 
 namespace pcl_ddg {
+namespace {
+
+/// While alive, OpenMP parallel regions opened by this thread run on this thread alone.
+/// CHOLMOD 3 opens a team of a compiled-in four threads for every descendant update with more
+/// than 64 rows, only to build a relative row map: on a 1.15M-vertex mesh that is ~120,000 team
+/// wake-ups, which cost more than the maps (factorisation 4.0 s -> 2.8 s on two cores). The dense
+/// BLAS calls, where the flops are, keep their own threads.
+class SerialOpenMpRegions {
+ public:
+#ifdef _OPENMP
+  SerialOpenMpRegions() : saved_levels_(omp_get_max_active_levels()) {
+    omp_set_max_active_levels(0);
+  }
+  ~SerialOpenMpRegions() {
+    omp_set_max_active_levels(saved_levels_);
+  }
+
+ private:
+  int saved_levels_;
+#endif
+};
+
+}  // namespace
 
 using SparseMatrix = Eigen::SparseMatrix<double>;
 
@@ -52,26 +77,22 @@ SparseCholesky::SparseCholesky(CholeskyBackend backend)
         "pcl_ddg was built without CHOLMOD (install libsuitesparse-dev)");
   }
 #ifdef PCL_DDG_HAVE_CHOLMOD
-  detail::adviseHugePagesForCholmod();
   // A matrix that is not positive definite is reported by exception, not printed by CHOLMOD.
   cholmod_common& common = impl_->cholmod.cholmod();
   common.print = 0;
-  // AMD alone. CHOLMOD would follow it with METIS whenever AMD's factor looks expensive: nested
-  // dissection leaves less fill (2.3x fewer flops on a scanned head), but ordering 1.15M vertices
-  // takes 6 s against AMD's 0.4 s, and with the supernodes below a smoothing step is no faster
-  // for it (4.6 s either way, bench_smoothing on two cores).
+  // AMD alone. CHOLMOD would follow it with METIS whenever AMD's factor looks expensive. Nested
+  // dissection leaves fewer flops (4.6e10 against 7.5e10 on the 1.15M-vertex bench torus; Scotch's
+  // fast strategy 5.4e10), but ordering takes 5.5 s with METIS and 1.4 s with Scotch against AMD's
+  // 0.5 s, and the factorisation is no faster for it (2.4-2.6 s each, two cores).
   common.nmethods = 1;
   common.method[0].ordering = CHOLMOD_AMD;
-  // Coarser supernodes than CHOLMOD's defaults ({4, 16, 48} columns, {0.8, 0.1, 0.05} explicit
-  // zeros): a mesh's elimination tree is mostly small separators, where a few stored zeros buy
-  // larger dense BLAS blocks. Refactorising the 1.15M-vertex system takes 3.4 s instead of 6.6 s;
-  // a 100k-vertex one 0.21 s instead of 0.41 s.
-  common.nrelax[0] = 16;
-  common.nrelax[1] = 64;
-  common.nrelax[2] = 128;
-  common.zrelax[0] = 0.8;
-  common.zrelax[1] = 0.2;
-  common.zrelax[2] = 0.1;
+  // Coarser supernodes than CHOLMOD's defaults ({4, 16, 48} columns), with its default share of
+  // stored zeros: a mesh's elimination tree is mostly small separators, and larger dense BLAS
+  // blocks pay there. More stored zeros ({0.8, 0.2, 0.1}) also made refactorisations faster, but
+  // the larger factor costs more in page faults than it saves on the first one (bench_smoothing).
+  common.nrelax[0] = 8;
+  common.nrelax[1] = 32;
+  common.nrelax[2] = 96;
 #endif
 }
 
@@ -95,6 +116,7 @@ void SparseCholesky::factorize(const SparseMatrix& matrix) {
   Eigen::ComputationInfo info;
 #ifdef PCL_DDG_HAVE_CHOLMOD
   if (backend_ == CholeskyBackend::Cholmod) {
+    const SerialOpenMpRegions serial;
     impl_->cholmod.factorize(matrix);
     info = impl_->cholmod.info();
   } else
@@ -131,6 +153,7 @@ void SparseCholesky::solve(const Eigen::MatrixXd& rhs, Eigen::MatrixXd& solution
   }
 #ifdef PCL_DDG_HAVE_CHOLMOD
   if (backend_ == CholeskyBackend::Cholmod) {
+    const SerialOpenMpRegions serial;
     solution = impl_->cholmod.solve(rhs);
     return;
   }
