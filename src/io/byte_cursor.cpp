@@ -1,14 +1,12 @@
 #include "byte_cursor.h"
 
 #include <pcl/PCLPointField.h>
-#include <sys/stat.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 
 namespace pcl_ddg {
@@ -20,24 +18,6 @@ bool isSpace(char c) {
 }
 
 }  // namespace
-
-std::string readWholeFile(const std::string& path) {
-  // Only regular files: a directory has no data, and a device or pipe (/dev/zero) may never end.
-  struct stat status {};
-  if (stat(path.c_str(), &status) != 0) throw FileFormatException(std::strerror(errno));
-  if (S_ISDIR(status.st_mode)) throw FileFormatException("is a directory, not a file");
-  if (!S_ISREG(status.st_mode)) {
-    throw FileFormatException("not a regular file (a device, pipe or socket cannot be read)");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw FileFormatException(std::string("cannot open: ") + std::strerror(errno));
-  std::string data(static_cast<std::size_t>(status.st_size), '\0');
-  in.read(data.data(), static_cast<std::streamsize>(data.size()));
-  if (static_cast<std::size_t>(in.gcount()) != data.size()) {
-    throw FileFormatException("cannot read the whole file (it changed while being read?)");
-  }
-  return data;
-}
 
 std::string_view ByteCursor::token() {
   while (pos_ < data_.size() && isSpace(data_[pos_])) ++pos_;

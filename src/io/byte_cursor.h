@@ -16,9 +16,6 @@ namespace detail {
 
 enum class ByteOrder { Little, Big };
 
-/** Reads a whole file; throws FileFormatException if it cannot be opened. */
-std::string readWholeFile(const std::string& path);
-
 class ByteCursor {
  public:
   explicit ByteCursor(std::string_view data) : data_(data) {}

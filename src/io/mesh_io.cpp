@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "byte_cursor.h"
+#include "file_bytes.h"
 #include "formats.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
@@ -71,7 +72,8 @@ std::string fileExtension(const std::string& path) {
 MeshFile readMeshFile(const std::string& path) {
   const std::string ext = fileExtension(path);
   try {
-    const std::string data = detail::readWholeFile(path);  // first: a missing file says so
+    const detail::FileBytes bytes(path);  // first: a missing file says so
+    const std::string_view data = bytes.view();
     using Parser = pcl::PolygonMesh (*)(std::string_view);
     Parser parse = nullptr;
     if (ext == "ply") parse = detail::parsePLY;
