@@ -5,16 +5,20 @@
 namespace pcl_ddg {
 
 PlaneFit fitPlane(const Eigen::Matrix3Xd& points, int count) {
-  PlaneFit fit;
-  if (count < 3) return fit;
+  if (count < 3) return PlaneFit{};
   const auto neighbourhood = points.leftCols(count);
-  fit.centroid = neighbourhood.rowwise().mean();
+  const Eigen::Vector3d centroid = neighbourhood.rowwise().mean();
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   for (int i = 0; i < count; ++i) {
-    const Eigen::Vector3d d = neighbourhood.col(i) - fit.centroid;
+    const Eigen::Vector3d d = neighbourhood.col(i) - centroid;
     covariance.noalias() += d * d.transpose();
   }
-  covariance /= count;
+  return fitPlane(centroid, covariance / count);
+}
+
+PlaneFit fitPlane(const Eigen::Vector3d& centroid, const Eigen::Matrix3d& covariance) {
+  PlaneFit fit;
+  fit.centroid = centroid;
   // Closed form for symmetric 3x3 (Eigen scales and trace-shifts the matrix first, and takes the
   // eigenvectors from the best-conditioned cross products of rows of A - lambda I).
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;

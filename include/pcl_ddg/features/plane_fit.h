@@ -21,4 +21,8 @@ struct PlaneFit {
  *  nearby origin (e.g. the query point) when they come from float coordinates. */
 PlaneFit fitPlane(const Eigen::Matrix3Xd& points, int count);
 
+/** The plane of a neighbourhood given by its centroid and covariance (about the centroid, divided
+ *  by the number of points): how windowed sums (integral images) are turned into a plane. */
+PlaneFit fitPlane(const Eigen::Vector3d& centroid, const Eigen::Matrix3d& covariance);
+
 }  // namespace pcl_ddg
