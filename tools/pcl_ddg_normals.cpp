@@ -15,7 +15,10 @@ constexpr const char* kDescription =
     "Estimates normals of a mesh or a point cloud: from the mesh faces (uniform, area, angle,\n"
     "mean_curvature) or by fitting a plane (pca) or a quadric to each point's neighbours, found "
     "on\n"
-    "the mesh (bfs rings) or in space (knn, kd-tree). Writes nx ny nz (.ply) or normal_x normal_y\n"
+    "the mesh (bfs rings), on an organized cloud's pixel grid (grid: never across a depth jump;\n"
+    "pca there averages the smallest square window of k pixels from integral images) or in space\n"
+    "(knn, kd-tree). An organized cloud stays organized. Writes nx ny nz (.ply) or normal_x "
+    "normal_y\n"
     "normal_z curvature (.pcd; for mesh methods the curvature is PCL's surface variation over\n"
     "the vertex's 1-ring).";
 constexpr const char* kSyntax =
@@ -23,8 +26,12 @@ constexpr const char* kSyntax =
     "         [-method uniform|area|angle|mean_curvature|pca|quadric (default: area on meshes, pca "
     "on clouds)]\n"
     "         [-epsilon e (mean_curvature: |M^-1 L x| below e counts as flat; default 0.02/h)]\n"
-    "         [-neighbours bfs|knn (pca, quadric; bfs needs a mesh)] [-k N (default 16, quadric "
-    "20)]\n"
+    "         [-neighbours bfs|grid|knn (pca, quadric; default bfs on meshes, grid on organized "
+    "clouds)]\n"
+    "         [-k N (default 16, quadric 20)]\n"
+    "         [-max_depth_jump f (grid: a range change above f times the range per pixel cuts the "
+    "grid;\n"
+    "                  default 0.02)]\n"
     "         [-radius r (a length, or a multiple of the mean spacing like 2.5h; instead of -k)]\n"
     "         [-max_nn N (with -radius: at most the N nearest; default 64)]\n"
     "         [-viewpoint x,y,z (clouds: orient normals towards it; default the PCD's VIEWPOINT)]\n"
@@ -44,16 +51,18 @@ int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(argc, argv,
                                   {"method", "epsilon", "neighbours", "k", "radius", "max_nn",
-                                   "viewpoint", "precision", "memory"},
+                                   "viewpoint", "precision", "memory", "max_depth_jump"},
                                   {});
   const FieldPrecision precision = tools::precisionArgument(args);
   const std::vector<std::string> methods = {"uniform",        "area", "angle",
                                             "mean_curvature", "pca",  "quadric"};
   const std::string requested = args.has("method") ? args.choice("method", methods, "area") : "";
   const bool fitted = requested == "pca" || requested == "quadric";
-  const bool neighbour_options = args.has("neighbours") || args.has("k") || args.has("radius");
+  const bool neighbour_options =
+      args.has("neighbours") || args.has("k") || args.has("radius") || args.has("max_depth_jump");
   if (!requested.empty() && !fitted && neighbour_options) {
-    throw tools::UsageError("-neighbours, -k and -radius apply to pca and quadric");
+    throw tools::UsageError(
+        "-neighbours, -k, -radius and -max_depth_jump apply to pca and quadric");
   }
   if (args.has("epsilon") && requested != "mean_curvature") {
     throw tools::UsageError("-epsilon applies to -method mean_curvature only");
@@ -113,13 +122,8 @@ int run(int argc, char** argv) {
         } else {
           const LocalFitOptions options = tools::localFitArguments(
               args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
-          tools::Timer timer(
-              "Computing " + method + " normals (" +
-              (options.neighbourhood == NeighbourhoodKind::MeshRings ? "mesh rings" : "kd-tree") +
-              ", " +
-              (options.radius > 0.0 ? "radius " + std::to_string(options.radius)
-                                    : "k = " + std::to_string(options.k)) +
-              ")");
+          tools::Timer timer("Computing " + method + " normals (" +
+                             tools::describeNeighbourhood(options) + ")");
           const LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
             return fitLocalSurfaces(in.points, in.topology, options);

@@ -2,10 +2,12 @@
 
 #include <pcl/exceptions.h>
 
+#include "pcl_ddg/features/organized_normals.h"
 #include "pcl_ddg/features/pca_normal_estimation.h"
 #include "pcl_ddg/features/quadric_normal_estimation.h"
 #include "pcl_ddg/search/kd_tree_search.h"
 #include "pcl_ddg/search/mesh_ring_search.h"
+#include "pcl_ddg/search/organized_grid_search.h"
 
 namespace pcl_ddg {
 namespace {
@@ -18,6 +20,9 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
   if (indices) estimator.setIndices(indices);
   if (options.neighbourhood == NeighbourhoodKind::MeshRings) {
     estimator.setSearchMethod(std::make_shared<MeshRingSearch<pcl::PointXYZ>>(topology));
+  } else if (options.neighbourhood == NeighbourhoodKind::Grid) {
+    estimator.setSearchMethod(
+        std::make_shared<OrganizedGridSearch<pcl::PointXYZ>>(options.max_depth_jump));
   } else {
     estimator.setSearchMethod(std::make_shared<KdTreeSearch<pcl::PointXYZ>>());
   }
@@ -38,6 +43,12 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
 
 }  // namespace
 
+int gridWindowRadius(int k) {
+  int radius = 1;
+  while ((2 * radius + 1) * (2 * radius + 1) < k) ++radius;
+  return radius;
+}
+
 LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
                                 const std::shared_ptr<const MeshTopology>& topology,
                                 const LocalFitOptions& options) {
@@ -55,6 +66,18 @@ LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
   }
   if (!cloud || cloud->empty()) throw pcl::BadArgumentException("the cloud is empty");
   LocalFitResult result;
+  if (options.method == LocalFitMethod::PCA && options.neighbourhood == NeighbourhoodKind::Grid &&
+      options.radius == 0.0 && !indices) {
+    OrganizedNormalOptions grid;
+    grid.window_radius = gridWindowRadius(options.k);
+    grid.max_depth_jump = options.max_depth_jump;
+    grid.threads = options.threads;
+    grid.viewpoint = options.viewpoint;
+    OrganizedNormalResult normals = computeOrganizedPCANormals(cloud, grid);
+    result.normals = std::move(normals.normals);
+    result.failed_points = normals.failed_points;
+    return result;
+  }
   if (options.method == LocalFitMethod::PCA) {
     PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
     configure(estimator, cloud, topology, options, indices);

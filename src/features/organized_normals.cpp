@@ -37,15 +37,20 @@ std::vector<int> blockingPixelTable(const pcl::PointCloud<pcl::PointXYZ>& cloud,
     int row = 0;
     for (int x = 0; x < image.width; ++x) {
       const int pixel = image.index(x, y);
-      bool blocking = !pcl::isXYZFinite(cloud[pixel]);
-      for (int dy = -1; dy <= 1 && !blocking; ++dy) {
-        for (int dx = -1; dx <= 1 && !blocking; ++dx) {
+      // Blocking: no point, or a step to an adjacent point that the graph does not allow.
+      std::uint8_t adjacent_points = 0;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
           const int u = x + dx, v = y + dy;
-          if (u < 0 || v < 0 || u >= image.width || v >= image.height) continue;
-          const int other = image.index(u, v);
-          blocking = pcl::isXYZFinite(cloud[other]) && !search.isJumpFree(pixel, other);
+          if ((dx == 0 && dy == 0) || u < 0 || v < 0 || u >= image.width || v >= image.height)
+            continue;
+          if (pcl::isXYZFinite(cloud[image.index(u, v)]))
+            adjacent_points |= static_cast<std::uint8_t>(
+                1u << OrganizedGridSearch<pcl::PointXYZ>::stepBit(dx, dy));
         }
       }
+      const bool blocking =
+          !pcl::isXYZFinite(cloud[pixel]) || search.allowedSteps(pixel) != adjacent_points;
       row += blocking;
       table[static_cast<std::size_t>(y + 1) * (image.width + 1) + x + 1] =
           table[static_cast<std::size_t>(y) * (image.width + 1) + x + 1] + row;
@@ -156,12 +161,9 @@ OrganizedNormalResult computeOrganizedPCANormals(
           for (int k = 0; k < kChannels; ++k) s[k] = d[k] - b[k] - c[k] + a[k];
           // The window's sums hold exactly the query's neighbours when nothing in the window can
           // cut it (the common case), or when the search reaches every point of the window.
-          bool whole_window = blockingIn(wx0, wy0, wx1, wy1) == 0;
-          int count = 0;
-          if (!whole_window) {
-            count = search->windowSearch(pixel, w, neighbours, distances);
-            whole_window = count == static_cast<int>(std::lround(s[0]));
-          }
+          const bool whole_window =
+              blockingIn(wx0, wy0, wx1, wy1) == 0 ||
+              search->windowReach(pixel, w) == static_cast<int>(std::lround(s[0]));
           PlaneFit fit;
           if (whole_window) {
             ++window_points;
@@ -174,6 +176,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
             }
           } else {
             ++jump_points;
+            const int count = search->windowSearch(pixel, w, neighbours, distances);
             const Eigen::Vector3d query = (*cloud)[pixel].getVector3fMap().cast<double>();
             for (int i = 0; i < count; ++i) {
               points.col(i) = (*cloud)[neighbours[i]].getVector3fMap().cast<double>() - query;

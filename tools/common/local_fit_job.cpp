@@ -45,6 +45,13 @@ SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name) {
   if (bad.count > 0)
     warn(tool_name, std::to_string(bad.count) + " non-finite points (NaN output there)");
   input.points = toXYZ(positions);
+  // An organized cloud (a frame, a range image) keeps its pixel grid and its sensor.
+  if (input.mesh.cloud.height > 1) {
+    input.points->width = input.mesh.cloud.width;
+    input.points->height = input.mesh.cloud.height;
+  }
+  input.points->sensor_origin_.head<3>() = input.sensor_pose.origin.cast<float>();
+  input.points->sensor_orientation_ = input.sensor_pose.orientation.cast<float>();
   return input;  // the spacing of a cloud costs a kd-tree: measured only when asked for
                  // (-radius 2.5h)
 }
@@ -137,6 +144,21 @@ Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals) {
   return n;
 }
 
+std::string describeNeighbourhood(const LocalFitOptions& options) {
+  if (options.neighbourhood == NeighbourhoodKind::Grid && options.method == LocalFitMethod::PCA &&
+      options.radius == 0.0) {
+    const int side = 2 * gridWindowRadius(options.k) + 1;
+    return "pixel grid, " + std::to_string(side) + " x " + std::to_string(side) +
+           " window, integral images";
+  }
+  const char* kind = options.neighbourhood == NeighbourhoodKind::MeshRings ? "mesh rings"
+                     : options.neighbourhood == NeighbourhoodKind::Grid    ? "pixel grid"
+                                                                           : "kd-tree";
+  return std::string(kind) + ", " +
+         (options.radius > 0.0 ? "radius " + std::to_string(options.radius)
+                               : "k = " + std::to_string(options.k));
+}
+
 void checkLocalFitArguments(const ToolArguments& args) {
   if (args.has("k") && args.has("radius"))
     throw UsageError("-k and -radius exclude each other (use -radius r -max_nn N for both)");
@@ -146,7 +168,9 @@ void checkLocalFitArguments(const ToolArguments& args) {
     throw UsageError("-max_nn must be at least 3");
   radiusArgument(args);
   viewpointArgument(args);
-  args.choice("neighbours", {"bfs", "knn"}, "knn");
+  args.choice("neighbours", {"bfs", "knn", "grid"}, "knn");
+  if (args.has("max_depth_jump") && !(args.number("max_depth_jump", 0.0) > 0.0))
+    throw UsageError("-max_depth_jump must be > 0 (a relative range change per pixel)");
 }
 
 LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput& input,
@@ -154,13 +178,23 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
   checkLocalFitArguments(args);
   LocalFitOptions options;
   options.method = method;
-  const std::string neighbours =
-      args.choice("neighbours", {"bfs", "knn"}, input.topology ? "bfs" : "knn");
+  const bool organized = !input.topology && input.points->height > 1;
+  const std::string neighbours = args.choice("neighbours", {"bfs", "knn", "grid"},
+                                             input.topology ? "bfs"
+                                             : organized    ? "grid"
+                                                            : "knn");
   if (neighbours == "bfs" && !input.topology) {
     throw UsageError("-neighbours bfs needs a mesh; this input is a point cloud (use knn)");
   }
-  options.neighbourhood =
-      neighbours == "bfs" ? NeighbourhoodKind::MeshRings : NeighbourhoodKind::KdTree;
+  if (neighbours == "grid" && !organized) {
+    throw UsageError("-neighbours grid needs an organized cloud (width x height pixels)");
+  }
+  if (args.has("max_depth_jump") && neighbours != "grid")
+    throw UsageError("-max_depth_jump applies to -neighbours grid");
+  options.neighbourhood = neighbours == "bfs"    ? NeighbourhoodKind::MeshRings
+                          : neighbours == "grid" ? NeighbourhoodKind::Grid
+                                                 : NeighbourhoodKind::KdTree;
+  options.max_depth_jump = args.number("max_depth_jump", options.max_depth_jump);
   options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20 : 16);
   const auto points = static_cast<int>(input.positions.cols());
   if (!args.has("radius") && options.k > points) {
@@ -186,7 +220,7 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
 
 LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod method) {
   checkLocalFitArguments(args);
-  if (args.choice("neighbours", {"bfs", "knn"}, "knn") == "bfs")
+  if (args.choice("neighbours", {"bfs", "knn", "grid"}, "knn") != "knn")
     throw UsageError("-memory fits clouds with kd-tree neighbourhoods (-neighbours knn)");
   LocalFitOptions options;
   options.method = method;

@@ -48,6 +48,9 @@ Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals);
  *  non-finite points for clouds. */
 SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name);
 
+/** "mesh rings, k = 16", "pixel grid, 5 x 5 window", "kd-tree, radius 0.01", ... */
+std::string describeNeighbourhood(const LocalFitOptions& options);
+
 /** The syntax of -neighbours, -k, -radius, -max_nn and -viewpoint, checked before any file is
  *  read (UsageError): -k and -radius exclude each other, -max_nn needs -radius. */
 void checkLocalFitArguments(const ToolArguments& args);

@@ -19,7 +19,8 @@ enum class LocalFitMethod { PCA, Quadric };
 
 enum class NeighbourhoodKind {
   MeshRings,  ///< MeshRingSearch over the mesh's edges (needs a topology)
-  KdTree      ///< Euclidean: KdTreeSearch (FLANN)
+  KdTree,     ///< Euclidean: KdTreeSearch (FLANN)
+  Grid        ///< an organized cloud's pixel grid: OrganizedGridSearch
 };
 
 struct LocalFitOptions {
@@ -29,6 +30,8 @@ struct LocalFitOptions {
   double radius = 0.0;              ///< > 0: a radius search instead of k nearest
   unsigned int max_neighbours = 0;  ///< with radius: keep at most this many, the nearest (0: all)
   unsigned int threads = 0;         ///< 0: all cores
+  /** Grid: the relative range change per pixel that cuts the grid (OrganizedGridSearch). */
+  double max_depth_jump = 0.02;
   /** Clouds: normals are turned towards this point (a PCD's VIEWPOINT); unset: the origin, as
    *  PCL does. Meshes are oriented like their faces. */
   std::optional<Eigen::Vector3d> viewpoint;
@@ -43,14 +46,19 @@ struct LocalFitResult {
 };
 
 /**
- * Runs PCANormalEstimation or QuadricNormalEstimation on cloud. With a topology (one vertex per
- * point) normals are oriented like its faces, whichever neighbourhood is used, so that the two
- * neighbourhoods can be compared point by point; without one, towards the origin as PCL does.
- * Throws pcl::BadArgumentException for MeshRings without a topology or a bad k / radius.
+ * Runs PCANormalEstimation or QuadricNormalEstimation on cloud. PCA on the grid of a whole
+ * organized cloud takes the integral-image path (computeOrganizedPCANormals) over the smallest
+ * square window of at least k pixels, and keeps the cloud's width x height. With a topology (one
+ * vertex per point) normals are oriented like its faces, whichever neighbourhood is used, so that
+ * the two neighbourhoods can be compared point by point; without one, towards the origin as PCL
+ * does. Throws pcl::BadArgumentException for MeshRings without a topology or a bad k / radius.
  */
 LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
                                 const std::shared_ptr<const MeshTopology>& topology,
                                 const LocalFitOptions& options);
+
+/** The half-width of the smallest square pixel window of at least k pixels (at least 1). */
+int gridWindowRadius(int k);
 
 /** The same for the points `indices` only (one output per index, in their order), their
  *  neighbours taken from the whole cloud: how a tile with a halo is processed. */

@@ -28,6 +28,7 @@
 // point returns nothing. Thread-safe, and a query allocates nothing once its buffers have grown.
 #include <pcl/search/search.h>
 
+#include <cstdint>
 #include <memory>
 #include <vector>
 
@@ -61,9 +62,19 @@ class OrganizedGridSearch : public pcl::search::Search<PointT> {
    *  them; adjacency is not checked. */
   bool isJumpFree(pcl::index_t a, pcl::index_t b) const;
 
+  /** The 8 steps from pixel index that the graph allows, one bit each: bit stepBit(dx, dy) for
+   *  the step to (x + dx, y + dy). */
+  std::uint8_t allowedSteps(pcl::index_t index) const { return steps_[index]; }
+  static constexpr int stepBit(int dx, int dy) {
+    return (dy + 1) * 3 + (dx + 1) - ((dy + 1) * 3 + (dx + 1) > 4 ? 1 : 0);
+  }
+
   /** The pixels reached from index within its (2 window_radius + 1)^2 window, query first. */
   int windowSearch(pcl::index_t index, int window_radius, pcl::Indices& k_indices,
                    std::vector<float>& k_sqr_distances) const;
+
+  /** How many pixels windowSearch would return. */
+  int windowReach(pcl::index_t index, int window_radius) const;
 
   using pcl::search::Search<PointT>::nearestKSearch;
   using pcl::search::Search<PointT>::radiusSearch;
@@ -92,6 +103,9 @@ class OrganizedGridSearch : public pcl::search::Search<PointT> {
   /** Breadth-first search from start over jump-free steps, level by level, at most max_steps
    *  levels: accept(pixel) says whether a reached pixel belongs (and is searched on from);
    *  level_done(steps) is called after each level and returns false to stop. */
+  /** Breadth-first search within the window; visit(pixel) for each pixel reached. */
+  template <typename Visit>
+  int walkWindow(pcl::index_t index, int window_radius, Visit&& visit) const;
   template <typename Accept, typename LevelDone>
   void breadthFirst(pcl::index_t start, int max_steps, Accept&& accept,
                     LevelDone&& level_done) const;
@@ -99,7 +113,8 @@ class OrganizedGridSearch : public pcl::search::Search<PointT> {
   double max_depth_jump_;
   int max_window_radius_;
   int width_ = 0, height_ = 0;
-  std::vector<float> range_;  ///< per pixel; NaN where the point is not finite
+  std::vector<float> range_;         ///< per pixel; NaN where the point is not finite
+  std::vector<std::uint8_t> steps_;  ///< per pixel: allowedSteps()
 };
 
 }  // namespace pcl_ddg

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <utility>
@@ -47,6 +48,23 @@ void OrganizedGridSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud,
     const PointT& p = (*cloud)[i];
     range_[i] = pcl::isXYZFinite(p) ? (p.getVector3fMap() - origin).norm()
                                     : std::numeric_limits<float>::quiet_NaN();
+  }
+  // Every query walks these steps: their depth tests are made once, here.
+  steps_.assign(range_.size(), 0);
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x) {
+      const pcl::index_t from = static_cast<pcl::index_t>(y) * width_ + x;
+      std::uint8_t bits = 0;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int u = x + dx, v = y + dy;
+          if ((dx == 0 && dy == 0) || u < 0 || v < 0 || u >= width_ || v >= height_) continue;
+          if (isJumpFree(from, static_cast<pcl::index_t>(v) * width_ + u))
+            bits |= static_cast<std::uint8_t>(1u << stepBit(dx, dy));
+        }
+      }
+      steps_[from] = bits;
+    }
   }
 }
 
@@ -97,14 +115,12 @@ void OrganizedGridSearch<PointT>::breadthFirst(pcl::index_t start, int max_steps
   for (int steps = 1; steps <= max_steps && !level.empty(); ++steps) {
     next.clear();
     for (const pcl::index_t from : level) {
-      const int u = from % width_, v = from / width_;
+      const std::uint8_t steps = steps_[from];
       for (int dv = -1; dv <= 1; ++dv) {
         for (int du = -1; du <= 1; ++du) {
-          const int x = u + du, y = v + dv;
-          if ((du == 0 && dv == 0) || x < 0 || y < 0 || x >= width_ || y >= height_) continue;
-          const pcl::index_t to = static_cast<pcl::index_t>(y) * width_ + x;
-          if (!isJumpFree(from, to) || !visited.visit(to)) continue;
-          if (accept(to)) next.push_back(to);
+          if ((du == 0 && dv == 0) || !(steps & (1u << stepBit(du, dv)))) continue;
+          const pcl::index_t to = from + static_cast<pcl::index_t>(dv) * width_ + du;
+          if (visited.visit(to) && accept(to)) next.push_back(to);
         }
       }
     }
@@ -114,25 +130,56 @@ void OrganizedGridSearch<PointT>::breadthFirst(pcl::index_t start, int max_steps
 }
 
 template <typename PointT>
+template <typename Visit>
+int OrganizedGridSearch<PointT>::walkWindow(pcl::index_t index, int window_radius,
+                                            Visit&& visit) const {
+  // Breadth-first within the window, with marks and a queue local to the window: at most
+  // (2w+1)^2 pixels.
+  const int u = index % width_, v = index / width_;
+  const int x0 = std::max(0, u - window_radius), x1 = std::min(width_ - 1, u + window_radius);
+  const int y0 = std::max(0, v - window_radius), y1 = std::min(height_ - 1, v + window_radius);
+  const int side = x1 - x0 + 1;
+  thread_local std::vector<std::uint8_t> seen;
+  thread_local std::vector<pcl::index_t> queue;
+  seen.assign(static_cast<std::size_t>(side) * (y1 - y0 + 1), 0);
+  seen[static_cast<std::size_t>(v - y0) * side + (u - x0)] = 1;
+  queue.assign(1, index);
+  for (std::size_t next = 0; next < queue.size(); ++next) {
+    const pcl::index_t from = queue[next];
+    visit(from);
+    const int fu = from % width_, fv = from / width_;
+    const std::uint8_t steps = steps_[from];
+    for (int y = std::max(y0, fv - 1); y <= std::min(y1, fv + 1); ++y) {
+      for (int x = std::max(x0, fu - 1); x <= std::min(x1, fu + 1); ++x) {
+        if ((x == fu && y == fv) || !(steps & (1u << stepBit(x - fu, y - fv)))) continue;
+        std::uint8_t& mark = seen[static_cast<std::size_t>(y - y0) * side + (x - x0)];
+        if (mark) continue;
+        mark = 1;
+        queue.push_back(static_cast<pcl::index_t>(y) * width_ + x);
+      }
+    }
+  }
+  return static_cast<int>(queue.size());
+}
+
+template <typename PointT>
 int OrganizedGridSearch<PointT>::windowSearch(pcl::index_t index, int window_radius,
                                               pcl::Indices& k_indices,
                                               std::vector<float>& k_sqr_distances) const {
   k_indices.clear();
   k_sqr_distances.clear();
   if (!isSearchable(index) || window_radius < 0) return 0;
-  const int u = index % width_, v = index / width_;
-  breadthFirst(
-      index, (2 * window_radius + 1) * (2 * window_radius + 1),
-      [&](pcl::index_t pixel) {
-        if (std::abs(pixel % width_ - u) > window_radius ||
-            std::abs(pixel / width_ - v) > window_radius)
-          return false;
-        k_indices.push_back(pixel);
-        k_sqr_distances.push_back(squaredDistance(index, pixel));
-        return true;
-      },
-      [](int) { return true; });
+  walkWindow(index, window_radius, [&](pcl::index_t pixel) {
+    k_indices.push_back(pixel);
+    k_sqr_distances.push_back(squaredDistance(index, pixel));
+  });
   return static_cast<int>(k_indices.size());
+}
+
+template <typename PointT>
+int OrganizedGridSearch<PointT>::windowReach(pcl::index_t index, int window_radius) const {
+  if (!isSearchable(index) || window_radius < 0) return 0;
+  return walkWindow(index, window_radius, [](pcl::index_t) {});
 }
 
 template <typename PointT>
