@@ -1,0 +1,215 @@
+#include "pcl_ddg/features/consistent_orientation.h"
+
+#include <pcl/common/point_tests.h>
+#include <pcl/exceptions.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <vector>
+
+#include "../mesh/disjoint_sets.h"
+#include "pcl_ddg/search/point_kd_tree.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+namespace pcl_ddg {
+namespace {
+
+struct GraphEdge {
+  int a, b;  ///< point indices
+};
+
+/** Points with a finite coordinate and normal. */
+std::vector<char> orientablePoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                   const pcl::PointCloud<pcl::Normal>& normals) {
+  if (normals.size() != cloud.size()) {
+    throw pcl::BadArgumentException("orientNormalsConsistently: " + std::to_string(normals.size()) +
+                                    " normals for " + std::to_string(cloud.size()) + " points");
+  }
+  std::vector<char> usable(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    usable[i] = pcl::isXYZFinite(cloud[i]) && pcl::isNormalFinite(normals[i]);
+  }
+  return usable;
+}
+
+/**
+ * The minimum spanning forest of the graph (Kruskal; weights 1 - |n_a . n_b| bucketed to 16
+ * bits by a stable counting sort, so that the order, and the result, do not depend on threads),
+ * then each tree walked from its highest point.
+ */
+ConsistentOrientationReport orientAlongSpanningForest(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                                      pcl::PointCloud<pcl::Normal>& normals,
+                                                      const std::vector<char>& usable,
+                                                      const std::vector<GraphEdge>& edges,
+                                                      const ConsistentOrientationOptions& options) {
+  const int n = static_cast<int>(cloud.size());
+  constexpr int kBuckets = 1 << 16;
+  std::vector<std::uint16_t> key(edges.size());
+  std::vector<std::int64_t> start(kBuckets + 1, 0);
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const Eigen::Vector3f na = normals[edges[e].a].getNormalVector3fMap().normalized();
+    const Eigen::Vector3f nb = normals[edges[e].b].getNormalVector3fMap().normalized();
+    const Eigen::Vector3f along =
+        (cloud[edges[e].b].getVector3fMap() - cloud[edges[e].a].getVector3fMap()).normalized();
+    // Hoppe's 1 - |na . nb|, which also finds antiparallel normals cheap: across the two sheets
+    // of a thin part (an ear, a leg) the step runs along the normals, so it is charged for that.
+    float weight = 1.0f - std::abs(na.dot(nb));
+    if (along.allFinite()) weight += 0.5f * (std::abs(na.dot(along)) + std::abs(nb.dot(along)));
+    key[e] = static_cast<std::uint16_t>(std::clamp(0.5f * weight, 0.0f, 1.0f) * (kBuckets - 1) +
+                                        0.5f);
+    ++start[key[e] + 1];
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::int64_t> order(edges.size());
+  for (std::size_t e = 0; e < edges.size(); ++e)
+    order[start[key[e]]++] = static_cast<std::int64_t>(e);
+
+  detail::DisjointSets sets(n);
+  std::vector<int> degree(n + 1, 0);
+  std::vector<GraphEdge> tree;
+  tree.reserve(static_cast<std::size_t>(n));
+  for (const std::int64_t e : order) {
+    if (!sets.unite(edges[e].a, edges[e].b)) continue;
+    tree.push_back(edges[e]);
+    ++degree[edges[e].a + 1];
+    ++degree[edges[e].b + 1];
+  }
+  std::partial_sum(degree.begin(), degree.end(), degree.begin());
+  std::vector<int> adjacent(2 * tree.size()), fill(degree.begin(), degree.end() - 1);
+  for (const GraphEdge& e : tree) {
+    adjacent[fill[e.a]++] = e.b;
+    adjacent[fill[e.b]++] = e.a;
+  }
+
+  // Seeds: points from the highest down; the first point of a tree met is its highest.
+  std::vector<int> by_height;
+  by_height.reserve(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i)
+    if (usable[i]) by_height.push_back(i);
+  std::stable_sort(by_height.begin(), by_height.end(),
+                   [&](int a, int b) { return cloud[a].z > cloud[b].z; });
+
+  ConsistentOrientationReport report;
+  report.oriented_points = static_cast<std::int64_t>(by_height.size());
+  std::vector<char> reached(static_cast<std::size_t>(n), 0);
+  std::vector<int> queue;
+  const auto flip = [&](int i) {
+    normals[i].normal_x = -normals[i].normal_x;
+    normals[i].normal_y = -normals[i].normal_y;
+    normals[i].normal_z = -normals[i].normal_z;
+    ++report.flipped_points;
+  };
+  for (const int seed : by_height) {
+    if (reached[seed]) continue;
+    ++report.components;
+    const Eigen::Vector3f n0 = normals[seed].getNormalVector3fMap();
+    const float facing =
+        options.viewpoint ? n0.dot(options.viewpoint->cast<float>() - cloud[seed].getVector3fMap())
+                          : n0.z();
+    if (facing < 0.0f) flip(seed);
+    reached[seed] = 1;
+    queue.assign(1, seed);
+    for (std::size_t next = 0; next < queue.size(); ++next) {
+      const int from = queue[next];
+      const Eigen::Vector3f parent = normals[from].getNormalVector3fMap();
+      for (int k = degree[from]; k < degree[from + 1]; ++k) {
+        const int to = adjacent[k];
+        if (reached[to]) continue;
+        reached[to] = 1;
+        if (normals[to].getNormalVector3fMap().dot(parent) < 0.0f) flip(to);
+        queue.push_back(to);
+      }
+    }
+  }
+  return report;
+}
+
+}  // namespace
+
+ConsistentOrientationReport orientNormalsConsistently(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                                      pcl::PointCloud<pcl::Normal>& normals,
+                                                      const ConsistentOrientationOptions& options) {
+  if (options.k < 1) throw pcl::BadArgumentException("orientNormalsConsistently: k must be >= 1");
+  const std::vector<char> usable = orientablePoints(cloud, normals);
+  std::vector<float> xyz;
+  std::vector<pcl::index_t> ids;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (!usable[i]) continue;
+    xyz.insert(xyz.end(), {cloud[i].x, cloud[i].y, cloud[i].z});
+    ids.push_back(static_cast<pcl::index_t>(i));
+  }
+  const std::vector<pcl::index_t> points = ids;
+  const detail::PointKdTree tree(std::move(xyz), std::move(ids));
+  // Each point's k nearest others fill its own k slots: the edge list does not depend on threads.
+  const int k = options.k;
+  std::vector<GraphEdge> slots(points.size() * static_cast<std::size_t>(k), GraphEdge{-1, -1});
+#ifdef _OPENMP
+  const int threads =
+      options.threads > 0 ? static_cast<int>(options.threads) : omp_get_max_threads();
+#endif
+#pragma omp parallel num_threads(threads)
+  {
+    pcl::Indices found;
+    std::vector<float> distances;
+#pragma omp for schedule(dynamic, 1024)
+    for (std::int64_t p = 0; p < static_cast<std::int64_t>(points.size()); ++p) {
+      const int i = points[p];
+      tree.nearestK(cloud[i].data, k + 1, found, distances);
+      int slot = 0;
+      for (const pcl::index_t j : found) {
+        if (j == i || slot == k) continue;
+        slots[p * k + slot++] = GraphEdge{std::min<int>(i, j), std::max<int>(i, j)};
+      }
+    }
+  }
+  slots.erase(
+      std::remove_if(slots.begin(), slots.end(), [](const GraphEdge& e) { return e.a < 0; }),
+      slots.end());
+  return orientAlongSpanningForest(cloud, normals, usable, slots, options);
+}
+
+ConsistentOrientationReport orientNormalsConsistently(const MeshTopology& topology,
+                                                      const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                                      pcl::PointCloud<pcl::Normal>& normals,
+                                                      const ConsistentOrientationOptions& options) {
+  if (cloud.size() != static_cast<std::size_t>(topology.numVertices())) {
+    throw pcl::BadArgumentException("orientNormalsConsistently: the cloud has " +
+                                    std::to_string(cloud.size()) + " points for a mesh of " +
+                                    std::to_string(topology.numVertices()) + " vertices");
+  }
+  const std::vector<char> usable = orientablePoints(cloud, normals);
+  std::vector<GraphEdge> edges;
+  edges.reserve(static_cast<std::size_t>(topology.numEdges()));
+  for (int e = 0; e < topology.numEdges(); ++e) {
+    const int a = topology.edgeVertices()(0, e), b = topology.edgeVertices()(1, e);
+    if (usable[a] && usable[b]) edges.push_back({a, b});
+  }
+  return orientAlongSpanningForest(cloud, normals, usable, edges, options);
+}
+
+ConsistentOrientationReport orientNormalsConsistently(
+    const OrganizedGridSearch<pcl::PointXYZ>& grid, pcl::PointCloud<pcl::Normal>& normals,
+    const ConsistentOrientationOptions& options) {
+  const auto cloud = grid.getInputCloud();
+  if (!cloud) throw pcl::BadArgumentException("orientNormalsConsistently: the grid has no cloud");
+  const std::vector<char> usable = orientablePoints(*cloud, normals);
+  const int width = static_cast<int>(cloud->width);
+  std::vector<GraphEdge> edges;
+  // Each step once: to the right, and to the three pixels of the row below.
+  const int steps[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+  for (int i = 0; i < static_cast<int>(cloud->size()); ++i) {
+    if (!usable[i]) continue;
+    for (const auto& step : steps) {
+      if (!(grid.allowedSteps(i) & (1u << grid.stepBit(step[0], step[1])))) continue;
+      const int j = i + step[1] * width + step[0];
+      if (usable[j]) edges.push_back({i, j});
+    }
+  }
+  return orientAlongSpanningForest(*cloud, normals, usable, edges, options);
+}
+
+}  // namespace pcl_ddg
