@@ -162,11 +162,12 @@ TEST(ConsistentOrientation, GridGraphOfARangeImage) {
 }
 
 TEST(ConsistentOrientation, AgreesWithTheFacesOfTheSharedScans) {
-  // Smooth, well-sampled scans agree to 99 %. On the coarse cow (2,762 vertices) and the 1,889-
-  // vertex bunny with holes, a thin part (an ear, a leg) is a few points across: its PCA normals
-  // and the tree's steps across it are unreliable, and one wrong step turns a whole branch.
-  const std::pair<const char*, double> scans[] = {{"meshes/bunny.off", 0.99},
-                                                  {"meshes/horse.ply", 0.99},
+  // The horse (48k vertices) agrees to 99.9 %, the decimated bunny to 99 %. On the coarse cow
+  // (2,762 vertices) and the 1,889- vertex bunny with holes, a thin part (an ear, a leg) is a few
+  // points across: its PCA normals and the tree's steps across it are unreliable, and one wrong
+  // step turns a whole branch.
+  const std::pair<const char*, double> scans[] = {{"meshes/bunny.off", 0.985},
+                                                  {"meshes/horse.ply", 0.999},
                                                   {"meshes/cow.off", 0.9},
                                                   {"meshes/bun_zipper_res3.ply", 0.95}};
   for (const auto& [name, expected] : scans) {
