@@ -1,10 +1,14 @@
 // pcl_ddg_normals, pcl_ddg_curvature and pcl_ddg_render as a user runs them: every shared mesh,
 // every option, and bad input (one error line, non-zero exit, no output file).
 #include <gtest/gtest.h>
+#include <pcl/conversions.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
 
 #include <algorithm>
 #include <filesystem>
 
+#include <cmath>
 #include <cstdio>
 
 #include "analytic_surfaces.h"
@@ -157,6 +161,67 @@ TEST_F(MeshTools, FaceMethodsOnACloudOrBFSWithoutAMeshAreUsageErrors) {
               2)
         << options;
   }
+}
+
+TEST_F(MeshTools, OrganizedFramesUseTheGridAndStayOrganized) {
+  const std::string frame = sharedData("clouds/office1.pcd");
+  for (const char* options : {"", " -method quadric", " -orient mst", " -max_depth_jump 0.05"}) {
+    const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, frame + " " + path("out.pcd") + options);
+    ASSERT_EQ(run.exit_code, 0) << options << run.err;
+    EXPECT_NE(run.err.find("pixel grid"), std::string::npos) << run.err;
+    pcl::PCLPointCloud2 in, out;
+    ASSERT_EQ(pcl::io::loadPCDFile(frame, in), 0);
+    ASSERT_EQ(pcl::io::loadPCDFile(path("out.pcd"), out), 0);
+    EXPECT_EQ(out.width, 640u) << options;
+    EXPECT_EQ(out.height, 480u) << options;
+    pcl::PointCloud<pcl::PointNormal> points;
+    pcl::fromPCLPointCloud2(out, points);
+    int holes = 0;
+    for (const auto& p : points) {
+      if (std::isfinite(p.x)) continue;
+      ++holes;
+      EXPECT_FALSE(std::isfinite(p.normal_x)) << "a hole was filled";
+    }
+    EXPECT_GT(holes, 50000);
+  }
+  std::filesystem::remove(path("out.pcd"));
+  // The grid needs an organized cloud; -max_depth_jump is for the grid; -orient mesh for meshes.
+  for (const std::string& options :
+       {sharedData("clouds/bun0.pcd") + " " + path("out.pcd") + " -neighbours grid",
+        frame + " " + path("out.pcd") + " -neighbours knn -max_depth_jump 0.1",
+        frame + " " + path("out.pcd") + " -max_depth_jump 0",
+        frame + " " + path("out.pcd") + " -orient mesh",
+        sharedData("meshes/cow.off") + " " + path("out.ply") + " -method area -orient mst"}) {
+    const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, options);
+    EXPECT_EQ(run.exit_code, 2) << options;
+    EXPECT_FALSE(std::filesystem::exists(path("out.pcd"))) << options;
+    EXPECT_FALSE(std::filesystem::exists(path("out.ply"))) << options;
+    std::filesystem::remove(path("out.pcd"));
+  }
+}
+
+TEST_F(MeshTools, SpanningTreeOrientationReportsItsFlips) {
+  // horse.ply's faces are wound inwards: PCA normals oriented like them point in; the tree,
+  // seeded up at the highest point, turns (nearly) all of them out.
+  const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, sharedData("meshes/horse.ply") + " " +
+                                                        path("out.ply") + " -orient mst");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("in 1 components"), std::string::npos) << run.err;
+  const MeshFile in = readMeshFile(sharedData("meshes/horse.ply"));
+  const MeshFile out = readMeshFile(path("out.ply"));
+  Eigen::Matrix3Xd normals(3, out.positions.cols());
+  normals.row(0) = vertexScalarField(out.mesh.cloud, "nx").transpose();
+  normals.row(1) = vertexScalarField(out.mesh.cloud, "ny").transpose();
+  normals.row(2) = vertexScalarField(out.mesh.cloud, "nz").transpose();
+  const Eigen::Vector3d centre = in.positions.rowwise().mean();
+  // The highest point's normal points up, and most normals point away from the centre.
+  Eigen::Index top = 0;
+  in.positions.row(2).maxCoeff(&top);
+  EXPECT_GT(normals(2, top), 0.5);
+  int outward = 0;
+  for (Eigen::Index v = 0; v < normals.cols(); ++v)
+    outward += normals.col(v).dot(in.positions.col(v) - centre) > 0.0;
+  EXPECT_GT(outward, 0.8 * normals.cols());
 }
 
 TEST_F(MeshTools, NormalMethodsAndPcdOutput) {
@@ -346,8 +411,8 @@ TEST_F(MeshTools, RenderMakesAPicture) {
                               sharedData("meshes/cow.off") + " " + path("cow.png") + " -size 64");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_GT(std::filesystem::file_size(path("cow.png")), 100u);
-  const ToolRun missing = runTool(
-      PCL_DDG_RENDER_TOOL, sharedData("meshes/cow.off") + " " + path("cow.png") + " -field nothing");
+  const ToolRun missing = runTool(PCL_DDG_RENDER_TOOL, sharedData("meshes/cow.off") + " " +
+                                                           path("cow.png") + " -field nothing");
   EXPECT_EQ(missing.exit_code, 1);
   // The error names what there is to choose from.
   EXPECT_NE(missing.err.find("no 'nothing' field (it has: x y z)"), std::string::npos)

@@ -3,6 +3,7 @@
 #include "common/local_fit_job.h"
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
+#include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/ring_surface_variation.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/surface/mesh_normals.h"
@@ -35,6 +36,12 @@ constexpr const char* kSyntax =
     "         [-radius r (a length, or a multiple of the mean spacing like 2.5h; instead of -k)]\n"
     "         [-max_nn N (with -radius: at most the N nearest; default 64)]\n"
     "         [-viewpoint x,y,z (clouds: orient normals towards it; default the PCD's VIEWPOINT)]\n"
+    "         [-orient viewpoint|mst|mesh (pca, quadric: towards the viewpoint (clouds' default),\n"
+    "                  along a minimum spanning tree of the mesh, pixel grid or 10 nearest "
+    "(merged\n"
+    "                  scans; each tree seeded facing -viewpoint, an organized frame's sensor, or "
+    "up),\n"
+    "                  or like the faces (meshes' default))]\n"
     "         [-precision float|double]\n"
     "         [-memory SIZE (clouds larger than memory: fitted tile by tile within SIZE, like 2G;\n"
     "                  input binary PCD or PLY, output binary; the same values as in memory)]";
@@ -47,22 +54,53 @@ pcl_ddg::NormalWeighting weightingOf(const std::string& method) {
                                       : NormalWeighting::Area;
 }
 
+/** Turns the normals consistently along a minimum spanning tree of the mesh, the pixel grid or
+ *  the 10 nearest neighbours, each tree seeded facing the -viewpoint or else up at its highest
+ *  point, and says how many it turned. */
+void orientBySpanningTree(const pcl_ddg::tools::SurfaceInput& in,
+                          const pcl_ddg::LocalFitOptions& options, bool seed_facing_viewpoint,
+                          pcl::PointCloud<pcl::Normal>& normals) {
+  using namespace pcl_ddg;
+  ConsistentOrientationOptions tree;
+  if (seed_facing_viewpoint) tree.viewpoint = options.viewpoint;
+  tree.threads = options.threads;
+  const char* graph = in.topology             ? "mesh edges"
+                      : in.points->height > 1 ? "pixel grid"
+                                              : "10 nearest";
+  tools::Timer timer(std::string("Orienting along a spanning tree (") + graph + ")");
+  ConsistentOrientationReport report;
+  if (in.topology) {
+    report = orientNormalsConsistently(*in.topology, *in.points, normals, tree);
+  } else if (in.points->height > 1) {
+    OrganizedGridSearch<pcl::PointXYZ> grid(options.max_depth_jump);
+    grid.setInputCloud(in.points);
+    report = orientNormalsConsistently(grid, normals, tree);
+  } else {
+    report = orientNormalsConsistently(*in.points, normals, tree);
+  }
+  timer.done(in.points->size());
+  char share[32];
+  std::snprintf(share, sizeof share, "%.1f %%", 100.0 * report.flippedShare());
+  std::cerr << kName << ": turned " << report.flipped_points << " of " << report.oriented_points
+            << " normals (" << share << ") in " << report.components << " components\n";
+}
+
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(argc, argv,
                                   {"method", "epsilon", "neighbours", "k", "radius", "max_nn",
-                                   "viewpoint", "precision", "memory", "max_depth_jump"},
+                                   "viewpoint", "precision", "memory", "max_depth_jump", "orient"},
                                   {});
   const FieldPrecision precision = tools::precisionArgument(args);
   const std::vector<std::string> methods = {"uniform",        "area", "angle",
                                             "mean_curvature", "pca",  "quadric"};
   const std::string requested = args.has("method") ? args.choice("method", methods, "area") : "";
   const bool fitted = requested == "pca" || requested == "quadric";
-  const bool neighbour_options =
-      args.has("neighbours") || args.has("k") || args.has("radius") || args.has("max_depth_jump");
+  const bool neighbour_options = args.has("neighbours") || args.has("k") || args.has("radius") ||
+                                 args.has("max_depth_jump") || args.has("orient");
   if (!requested.empty() && !fitted && neighbour_options) {
     throw tools::UsageError(
-        "-neighbours, -k, -radius and -max_depth_jump apply to pca and quadric");
+        "-neighbours, -k, -radius, -max_depth_jump and -orient apply to pca and quadric");
   }
   if (args.has("epsilon") && requested != "mean_curvature") {
     throw tools::UsageError("-epsilon applies to -method mean_curvature only");
@@ -82,9 +120,13 @@ int run(int argc, char** argv) {
           tools::setNormalFields(piece, output, fit.normals, precision);
         });
   }
+  const std::string orient =
+      args.has("orient") ? args.choice("orient", {"viewpoint", "mst", "mesh"}, "mesh") : "";
   return tools::forEachInput(
       args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
         tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
+        if (orient == "mesh" && !in.topology)
+          throw tools::UsageError("-orient mesh needs a mesh; this input is a point cloud");
         const std::string method =
             !requested.empty() ? requested : (in.topology && !neighbour_options ? "area" : "pca");
         if (method != "pca" && method != "quadric") {
@@ -120,16 +162,21 @@ int run(int argc, char** argv) {
                            ringSurfaceVariation(*in.topology, positions), precision);
           }
         } else {
-          const LocalFitOptions options = tools::localFitArguments(
+          LocalFitOptions options = tools::localFitArguments(
               args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
+          options.orient_like_faces = orient != "viewpoint";
           tools::Timer timer("Computing " + method + " normals (" +
                              tools::describeNeighbourhood(options) + ")");
-          const LocalFitResult result = [&] {
+          LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
             return fitLocalSurfaces(in.points, in.topology, options);
           }();
           timer.done(in.points->size());
           tools::warnAboutLocalFit(kName, result);
+          // An organized frame has one sensor: its trees are seeded facing it.
+          if (orient == "mst")
+            orientBySpanningTree(in, options, args.has("viewpoint") || in.points->height > 1,
+                                 result.normals);
           tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
         }
         tools::saveResult(kName, output, in.mesh, in.positions,

@@ -32,7 +32,7 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
   } else {
     estimator.setKSearch(options.k);
   }
-  if (topology) {
+  if (topology && options.orient_like_faces) {
     estimator.setOrientationMesh(topology);
   } else if (options.viewpoint) {
     const Eigen::Vector3f v = options.viewpoint->cast<float>();

@@ -35,6 +35,8 @@ struct LocalFitOptions {
   /** Clouds: normals are turned towards this point (a PCD's VIEWPOINT); unset: the origin, as
    *  PCL does. Meshes are oriented like their faces. */
   std::optional<Eigen::Vector3d> viewpoint;
+  /** With a topology: oriented like its faces; false: towards the viewpoint as clouds are. */
+  bool orient_like_faces = true;
 };
 
 struct LocalFitResult {
