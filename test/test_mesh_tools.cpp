@@ -185,12 +185,26 @@ TEST_F(MeshTools, OrganizedFramesUseTheGridAndStayOrganized) {
     EXPECT_GT(holes, 50000);
   }
   std::filesystem::remove(path("out.pcd"));
+  // The normals as an image of the frame.
+  ASSERT_EQ(runTool(PCL_DDG_NORMALS_TOOL,
+                    frame + " " + path("out.pcd") + " -normal_map " + path("normals.png"))
+                .exit_code,
+            0);
+  std::FILE* png = std::fopen(path("normals.png").c_str(), "rb");
+  ASSERT_NE(png, nullptr);
+  unsigned char header[24] = {};
+  ASSERT_EQ(std::fread(header, 1, sizeof header, png), sizeof header);
+  std::fclose(png);
+  EXPECT_EQ((header[16] << 24 | header[17] << 16 | header[18] << 8 | header[19]), 640);
+  EXPECT_EQ((header[20] << 24 | header[21] << 16 | header[22] << 8 | header[23]), 480);
+  std::filesystem::remove(path("out.pcd"));
   // The grid needs an organized cloud; -max_depth_jump is for the grid; -orient mesh for meshes.
   for (const std::string& options :
        {sharedData("clouds/bun0.pcd") + " " + path("out.pcd") + " -neighbours grid",
         frame + " " + path("out.pcd") + " -neighbours knn -max_depth_jump 0.1",
         frame + " " + path("out.pcd") + " -max_depth_jump 0",
         frame + " " + path("out.pcd") + " -orient mesh",
+        sharedData("clouds/bun0.pcd") + " " + path("out.pcd") + " -normal_map " + path("n.png"),
         sharedData("meshes/cow.off") + " " + path("out.ply") + " -method area -orient mst"}) {
     const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, options);
     EXPECT_EQ(run.exit_code, 2) << options;

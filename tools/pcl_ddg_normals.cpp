@@ -6,6 +6,7 @@
 #include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/ring_surface_variation.h"
 #include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/io/mesh_render.h"
 #include "pcl_ddg/surface/mesh_normals.h"
 #include "pcl_ddg/tiling/out_of_core_fit.h"
 
@@ -42,6 +43,8 @@ constexpr const char* kSyntax =
     "                  scans; each tree seeded facing -viewpoint, an organized frame's sensor, or "
     "up),\n"
     "                  or like the faces (meshes' default))]\n"
+    "         [-normal_map out.png (organized clouds: the normals as an image, (n + 1) / 2 as "
+    "RGB)]\n"
     "         [-precision float|double]\n"
     "         [-memory SIZE (clouds larger than memory: fitted tile by tile within SIZE, like 2G;\n"
     "                  input binary PCD or PLY, output binary; the same values as in memory)]";
@@ -85,12 +88,33 @@ void orientBySpanningTree(const pcl_ddg::tools::SurfaceInput& in,
             << " normals (" << share << ") in " << report.components << " components\n";
 }
 
+/** An organized cloud's normals as an image: (n + 1) / 2 as red, green, blue; black where none. */
+void saveNormalMap(const std::string& path, const pcl::PointCloud<pcl::Normal>& normals) {
+  if (normals.height < 2) {
+    throw pcl_ddg::tools::UsageError("-normal_map needs an organized cloud (width x height)");
+  }
+  pcl_ddg::Image image;
+  image.width = static_cast<int>(normals.width);
+  image.height = static_cast<int>(normals.height);
+  image.rgb.assign(normals.size() * 3, 0);
+  for (std::size_t i = 0; i < normals.size(); ++i) {
+    const Eigen::Vector3f n = normals[i].getNormalVector3fMap();
+    if (!n.allFinite()) continue;
+    for (int c = 0; c < 3; ++c)
+      image.rgb[3 * i + c] = static_cast<std::uint8_t>(std::lround(127.5f * (n[c] + 1.0f)));
+  }
+  pcl_ddg::tools::Timer timer("Saving " + path);
+  pcl_ddg::savePNG(path, image);
+  timer.done(normals.size());
+}
+
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
-  const tools::ToolArguments args(argc, argv,
-                                  {"method", "epsilon", "neighbours", "k", "radius", "max_nn",
-                                   "viewpoint", "precision", "memory", "max_depth_jump", "orient"},
-                                  {});
+  const tools::ToolArguments args(
+      argc, argv,
+      {"method", "epsilon", "neighbours", "k", "radius", "max_nn", "viewpoint", "precision",
+       "memory", "max_depth_jump", "orient", "normal_map"},
+      {});
   const FieldPrecision precision = tools::precisionArgument(args);
   const std::vector<std::string> methods = {"uniform",        "area", "angle",
                                             "mean_curvature", "pca",  "quadric"};
@@ -177,6 +201,7 @@ int run(int argc, char** argv) {
           if (orient == "mst")
             orientBySpanningTree(in, options, args.has("viewpoint") || in.points->height > 1,
                                  result.normals);
+          if (args.has("normal_map")) saveNormalMap(*args.value("normal_map"), result.normals);
           tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
         }
         tools::saveResult(kName, output, in.mesh, in.positions,
