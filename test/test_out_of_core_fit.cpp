@@ -50,7 +50,9 @@ class OutOfCore : public ::testing::Test {
   void expectSameOutput(const std::string& input, const std::string& options,
                         const std::string& memory, const char* tool = PCL_DDG_NORMALS_TOOL) {
     SCOPED_TRACE(input + options);
-    const ToolRun whole = runTool(tool, input + " " + path("whole.ply") + " " + options);
+    // Out of core is the kd-tree's path; in memory an organized cloud would take the grid.
+    const ToolRun whole =
+        runTool(tool, input + " " + path("whole.ply") + " " + options + " -neighbours knn");
     ASSERT_EQ(whole.exit_code, 0) << whole.err;
     const ToolRun tiled =
         runTool(tool, input + " " + path("tiled.ply") + " " + options + " -memory " + memory);
@@ -91,7 +93,9 @@ TEST_F(OutOfCore, APcdOutputHoldsTheSameValuesAndStaysOrganized) {
   pcl::PCLPointCloud2 cloud;
   ASSERT_EQ(pcl::io::loadPCDFile(sharedData("clouds/office1.pcd"), cloud), 0);
   ASSERT_EQ(pcl::PCDWriter().writeBinary(path("office.pcd"), cloud), 0);
-  ASSERT_EQ(runTool(PCL_DDG_NORMALS_TOOL, path("office.pcd") + " " + path("whole.pcd")).exit_code,
+  ASSERT_EQ(runTool(PCL_DDG_NORMALS_TOOL,
+                    path("office.pcd") + " " + path("whole.pcd") + " -neighbours knn")
+                .exit_code,
             0);
   ASSERT_EQ(
       runTool(PCL_DDG_NORMALS_TOOL, path("office.pcd") + " " + path("tiled.pcd") + " -memory 4M")
