@@ -214,6 +214,24 @@ TEST_F(MeshTools, OrganizedFramesUseTheGridAndStayOrganized) {
   }
 }
 
+TEST_F(MeshTools, CompareNeighbourhoodsOnAnOrganizedFrame) {
+  // Pixel grid against kd-tree; the output stays organized and carries both fields.
+  const ToolRun run = runTool(PCL_DDG_COMPARE_TOOL,
+                              sharedData("clouds/office1.pcd") + " " + path("out.pcd") + " -k 49");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("pixel grid"), std::string::npos) << run.err;
+  pcl::PCLPointCloud2 out;
+  ASSERT_EQ(pcl::io::loadPCDFile(path("out.pcd"), out), 0);
+  EXPECT_EQ(out.width, 640u);
+  EXPECT_EQ(out.height, 480u);
+  EXPECT_TRUE(vertexScalarField(out, "angle_difference").size() == 307200);
+  EXPECT_TRUE(vertexScalarField(out, "overlap").size() == 307200);
+  // An unorganized cloud has no topology to compare.
+  EXPECT_EQ(runTool(PCL_DDG_COMPARE_TOOL, sharedData("clouds/bun0.pcd") + " " + path("bun.pcd"))
+                .exit_code,
+            1);
+}
+
 TEST_F(MeshTools, SpanningTreeOrientationReportsItsFlips) {
   // horse.ply's faces are wound inwards: PCA normals oriented like them point in; the tree,
   // seeded up at the highest point, turns (nearly) all of them out.

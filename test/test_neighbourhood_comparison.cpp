@@ -1,12 +1,16 @@
 // Topological versus Euclidean neighbourhoods: where a surface passes close to another sheet of
 // itself, kd-tree neighbourhoods mix the sheets and the normals go wrong; mesh rings do not.
 #include <gtest/gtest.h>
+#include <pcl/exceptions.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "analytic_surfaces.h"
 #include "estimator_support.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
+#include "range_images.h"
 
 namespace pcl_ddg {
 namespace test {
@@ -24,7 +28,7 @@ TEST(NeighbourhoodComparison, ThinTwoSheetSurfaceBFSRightKdTreeWrong) {
     const NeighbourhoodComparison c =
         compareNeighbourhoods(toCloud(s.points), topologyPtrOf(s), options);
     const AngleErrors bfs =
-        angleErrors(normalsOf(c.mesh_rings.normals), s.normals, SignMode::Signed);
+        angleErrors(normalsOf(c.topological.normals), s.normals, SignMode::Signed);
     const AngleErrors kd = angleErrors(normalsOf(c.kd_tree.normals), s.normals, SignMode::Unsigned);
     std::printf(
         "%s, sheets %.2fh apart: BFS error mean %.3g max %.3g deg; kd-tree error mean %.3g max "
@@ -59,6 +63,35 @@ TEST(NeighbourhoodComparison, NeedsAMesh) {
   const SurfaceSample torus = makeTorus({16, 0.0, 1});
   EXPECT_THROW(compareNeighbourhoods(toCloud(torus.points), nullptr, {}),
                pcl::BadArgumentException);
+}
+
+TEST(NeighbourhoodComparison, PixelGridAgainstKdTreeAtADepthStep) {
+  // A box 15 cm before a wall, seen by a pinhole camera: on the planes both neighbourhoods give
+  // the exact normal; 2-4 pixels from the step the kd-tree reaches across it, the grid does not.
+  const auto image = renderRangeImage(RangeScene::BoxOnWall, PinholeCamera{});
+  LocalFitOptions options;
+  options.k = 100;
+  const NeighbourhoodComparison c = compareNeighbourhoods(image.cloud, nullptr, options);
+  double far_worst = 0.0, near_mean = 0.0;
+  int near = 0;
+  for (std::size_t i = 0; i < image.normals.size(); ++i) {
+    const double d = c.angle_difference[static_cast<Eigen::Index>(i)];
+    if (!std::isfinite(d)) continue;
+    if (image.pixels_from_step[i] > 8) far_worst = std::max(far_worst, d);
+    if (image.pixels_from_step[i] >= 2 && image.pixels_from_step[i] <= 4) {
+      near_mean += d;
+      ++near;
+    }
+  }
+  near_mean /= near;
+  EXPECT_LT(far_worst, 0.01);
+  EXPECT_GT(near_mean, 1.0);
+  EXPECT_GT(c.summary.compared, 15000);
+  // Without a mesh or a pixel grid there is nothing topological to compare.
+  pcl::PointCloud<pcl::PointXYZ>::Ptr flat(new pcl::PointCloud<pcl::PointXYZ>(*image.cloud));
+  flat->width = static_cast<std::uint32_t>(flat->size());
+  flat->height = 1;
+  EXPECT_THROW(compareNeighbourhoods(flat, nullptr, options), pcl::BadArgumentException);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
-// pcl_ddg_compare_neighbourhoods: one estimator, run with topological (mesh rings) and Euclidean
-// (kd-tree) neighbourhoods; how much the normals and the neighbour sets differ, per vertex.
+// pcl_ddg_compare_neighbourhoods: one estimator, run with topological (mesh rings, or an organized
+// cloud's pixel grid) and Euclidean (kd-tree) neighbourhoods; how much the normals and the
+// neighbour sets differ, per point.
 #include <cstdio>
 
 #include "common/local_fit_job.h"
@@ -13,20 +14,23 @@ namespace {
 
 constexpr const char* kName = "pcl_ddg_compare_neighbourhoods";
 constexpr const char* kDescription =
-    "Runs a normal estimator on a mesh with mesh-ring (BFS) and with kd-tree neighbourhoods, "
-    "prints\n"
+    "Runs a normal estimator on a mesh with mesh-ring (BFS), or on an organized cloud with "
+    "pixel-grid,\n"
+    "and with kd-tree neighbourhoods, prints\n"
     "how far the normals differ and how much the neighbour sets overlap, and writes per-vertex\n"
     "angle_difference (degrees) and overlap (Jaccard, 0..1), coloured by the angle difference\n"
     "(by default unless the input has colours of its own; -color none keeps them as they are).";
 constexpr const char* kSyntax =
-    "input.{ply,obj,off,stl,vtk} output.{ply,pcd} [-method pca|quadric] [-k N (default 16)]\n"
+    "input.{ply,obj,off,stl,vtk,pcd} output.{ply,pcd} [-method pca|quadric] [-k N (default 16)]\n"
     "         [-radius r or 2.5h (instead of -k)] [-max_nn N (with -radius; default 64)]\n"
+    "         [-max_depth_jump f (organized clouds; default 0.02)]\n"
     "         [-viewpoint x,y,z] [-color angle_difference|overlap|none] [-precision float|double]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(
-      argc, argv, {"method", "k", "radius", "max_nn", "viewpoint", "precision", "color"}, {});
+      argc, argv,
+      {"method", "k", "radius", "max_nn", "viewpoint", "precision", "color", "max_depth_jump"}, {});
   const std::string method = args.choice("method", {"pca", "quadric"}, "pca");
   args.choice("color", {"angle_difference", "overlap", "none"}, "none");
   const FieldPrecision precision = tools::precisionArgument(args);
@@ -34,19 +38,23 @@ int run(int argc, char** argv) {
   return tools::forEachInput(
       args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
         tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
-        if (!in.topology)
-          throw std::runtime_error(input + " has no faces: there are no mesh rings to compare");
+        const bool organized = !in.topology && in.points->height > 1;
+        if (!in.topology && !organized)
+          throw std::runtime_error(input +
+                                   " has no faces and no pixel grid: no topological "
+                                   "neighbourhoods to compare");
         LocalFitOptions options = tools::localFitArguments(
             args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
         if (!args.has("k")) options.k = 16;
 
-        tools::Timer timer("Comparing " + method + " normals from mesh rings and from a kd-tree");
+        tools::Timer timer("Comparing " + method + " normals from " +
+                           (organized ? "the pixel grid" : "mesh rings") + " and from a kd-tree");
         const NeighbourhoodComparison c = [&] {
           const tools::QuietPCLWarnings quiet;
           return compareNeighbourhoods(in.points, in.topology, options);
         }();
         timer.done(in.points->size());
-        tools::warnAboutLocalFit(kName, c.mesh_rings);
+        tools::warnAboutLocalFit(kName, c.topological);
         tools::warnAboutLocalFit(kName, c.kd_tree);
         const NeighbourhoodComparison::Summary& s = c.summary;
         std::printf(

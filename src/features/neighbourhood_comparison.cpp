@@ -10,6 +10,7 @@
 
 #include "pcl_ddg/search/kd_tree_search.h"
 #include "pcl_ddg/search/mesh_ring_search.h"
+#include "pcl_ddg/search/organized_grid_search.h"
 
 namespace pcl_ddg {
 namespace {
@@ -19,8 +20,19 @@ constexpr double kDegrees = 180.0 / 3.14159265358979323846;
 Eigen::VectorXd jaccardOverlaps(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
                                 const std::shared_ptr<const MeshTopology>& topology,
                                 const LocalFitOptions& options) {
-  MeshRingSearch<pcl::PointXYZ> rings(topology);
-  rings.setInputCloud(cloud);
+  std::shared_ptr<MeshRingSearch<pcl::PointXYZ>> rings;
+  std::shared_ptr<OrganizedGridSearch<pcl::PointXYZ>> grid;
+  if (topology) {
+    rings = std::make_shared<MeshRingSearch<pcl::PointXYZ>>(topology);
+    rings->setInputCloud(cloud);
+  } else {
+    grid = std::make_shared<OrganizedGridSearch<pcl::PointXYZ>>(options.max_depth_jump);
+    grid->setInputCloud(cloud);
+  }
+  // The neighbours the topological fit used: the grid's PCA averages a window.
+  const bool grid_window = grid && options.method == LocalFitMethod::PCA && options.radius == 0.0;
+  const pcl::search::Search<pcl::PointXYZ>& topological =
+      rings ? static_cast<const pcl::search::Search<pcl::PointXYZ>&>(*rings) : *grid;
   KdTreeSearch<pcl::PointXYZ> tree;
   tree.setInputCloud(cloud);
   const auto n = static_cast<Eigen::Index>(cloud->size());
@@ -32,11 +44,14 @@ Eigen::VectorXd jaccardOverlaps(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
 #pragma omp for schedule(dynamic, 256)
     for (Eigen::Index i = 0; i < n; ++i) {
       const auto index = static_cast<pcl::index_t>(i);
-      if (options.radius > 0.0) {
-        rings.radiusSearch(index, options.radius, a, distances);
+      if (grid_window) {
+        grid->windowSearch(index, gridWindowRadius(options.k), a, distances);
+        tree.nearestKSearch(index, options.k, b, distances);
+      } else if (options.radius > 0.0) {
+        topological.radiusSearch(index, options.radius, a, distances);
         tree.radiusSearch(index, options.radius, b, distances);
       } else {
-        rings.nearestKSearch(index, options.k, a, distances);
+        topological.nearestKSearch(index, options.k, a, distances);
         tree.nearestKSearch(index, options.k, b, distances);
       }
       std::sort(a.begin(), a.end());
@@ -56,10 +71,13 @@ Eigen::VectorXd jaccardOverlaps(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
 NeighbourhoodComparison compareNeighbourhoods(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
                                               const std::shared_ptr<const MeshTopology>& topology,
                                               LocalFitOptions options) {
-  if (!topology) throw pcl::BadArgumentException("comparing neighbourhoods needs a mesh (faces)");
+  if (!topology && !(cloud && cloud->height > 1)) {
+    throw pcl::BadArgumentException(
+        "comparing neighbourhoods needs a mesh (faces) or an organized cloud (a pixel grid)");
+  }
   NeighbourhoodComparison c;
-  options.neighbourhood = NeighbourhoodKind::MeshRings;
-  c.mesh_rings = fitLocalSurfaces(cloud, topology, options);
+  options.neighbourhood = topology ? NeighbourhoodKind::MeshRings : NeighbourhoodKind::Grid;
+  c.topological = fitLocalSurfaces(cloud, topology, options);
   options.neighbourhood = NeighbourhoodKind::KdTree;
   c.kd_tree = fitLocalSurfaces(cloud, topology, options);
 
@@ -68,7 +86,7 @@ NeighbourhoodComparison compareNeighbourhoods(const pcl::PointCloud<pcl::PointXY
   std::vector<double> compared;
   compared.reserve(n);
   for (Eigen::Index i = 0; i < n; ++i) {
-    const Eigen::Vector3d a = c.mesh_rings.normals[i].getNormalVector3fMap().cast<double>();
+    const Eigen::Vector3d a = c.topological.normals[i].getNormalVector3fMap().cast<double>();
     const Eigen::Vector3d b = c.kd_tree.normals[i].getNormalVector3fMap().cast<double>();
     if (!a.allFinite() || !b.allFinite()) {
       c.angle_difference[i] = std::numeric_limits<double>::quiet_NaN();

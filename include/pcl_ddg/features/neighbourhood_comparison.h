@@ -1,7 +1,8 @@
 #pragma once
-// The same estimator run with topological (mesh-ring) and Euclidean (kd-tree) neighbourhoods,
-// and how much the two differ at every vertex: where a scan's surface passes close to another
-// part of itself (thin walls, folds, fingers), Euclidean neighbourhoods mix both sheets.
+// The same estimator run with topological neighbourhoods (mesh rings, or an organized cloud's
+// pixel grid) and Euclidean ones (kd-tree), and how much the two differ at every point: where a
+// scan's surface passes close to another part of itself (thin walls, folds, fingers), or a frame
+// has a depth jump, Euclidean neighbourhoods mix both sides.
 #include <Eigen/Core>
 #include <cstdint>
 
@@ -23,11 +24,13 @@ struct NeighbourhoodComparison {
     double mean_overlap = 0.0;                       ///< over all vertices
   } summary;
 
-  LocalFitResult mesh_rings, kd_tree;
+  LocalFitResult topological, kd_tree;
 };
 
 /** Runs options.method (k or radius of options) with both neighbourhoods; options.neighbourhood
- *  is ignored. topology is required (one vertex per point). */
+ *  is ignored. The topological one is the mesh's rings with a topology (one vertex per point),
+ *  else the pixel grid of an organized cloud (PCA over its window, as fitLocalSurfaces does;
+ *  the overlap is then of that window's pixels); throws pcl::BadArgumentException for neither. */
 NeighbourhoodComparison compareNeighbourhoods(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
                                               const std::shared_ptr<const MeshTopology>& topology,
                                               LocalFitOptions options);
