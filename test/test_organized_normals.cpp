@@ -204,6 +204,33 @@ TEST(OrganizedNormals, AtLeastAsAccurateAsIntegralImageNormalEstimation) {
       << "ours " << ours / kDegree << " deg, theirs " << sum / count / kDegree << " deg";
 }
 
+TEST(OrganizedNormals, QuadricOnTheGridGivesTheSpheresCurvature) {
+  // The quadric estimator with OrganizedGridSearch: second-order normals and kappa = 1/R (the
+  // sphere's radius is 1; normals towards the camera, so it bends away from them: +1).
+  const auto image = renderRangeImage(RangeScene::Sphere, PinholeCamera{}.scaled(2.0));
+  LocalFitOptions options;
+  options.method = LocalFitMethod::Quadric;
+  options.neighbourhood = NeighbourhoodKind::Grid;
+  options.k = 25;
+  options.viewpoint = Eigen::Vector3d::Zero();
+  const LocalFitResult fit = fitLocalSurfaces(image.cloud, nullptr, options);
+  EXPECT_EQ(fit.normals.width, image.cloud->width);
+  double normal_error = 0.0, curvature_error = 0.0;
+  int count = 0;
+  for (std::size_t i = 0; i < image.normals.size(); ++i) {
+    if (!std::isfinite(fit.curvatures[i].pc1)) continue;
+    const Eigen::Vector3d ray = (*image.cloud)[i].getVector3fMap().cast<double>().normalized();
+    if (std::abs(ray.dot(image.normals[i])) < 0.5) continue;  // head-on part, as above
+    normal_error += angleTo(fit.normals[i], image.normals[i]);
+    curvature_error +=
+        std::abs(fit.curvatures[i].pc1 - 1.0) + std::abs(fit.curvatures[i].pc2 - 1.0);
+    ++count;
+  }
+  ASSERT_GT(count, 10000);
+  EXPECT_LT(normal_error / count, 0.01 * kDegree);
+  EXPECT_LT(curvature_error / (2 * count), 0.02);
+}
+
 /** Pixels whose (2 reach + 1)^2 surroundings are all finite with no step between 4-neighbours
  *  above 2 % of the range: where PCL's depth-change distance map lets it use its whole window. */
 std::vector<char> farFromEdges(const pcl::PointCloud<pcl::PointXYZ>& cloud, int reach) {
