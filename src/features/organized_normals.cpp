@@ -27,36 +27,86 @@ struct Image {
   int index(int x, int y) const { return y * width + x; }
 };
 
-/** Summed-area table of the pixels that could make a window's neighbourhood differ from the
- *  whole window: pixels without a point, and pixels with a depth jump to an adjacent pixel. */
-std::vector<int> blockingPixelTable(const pcl::PointCloud<pcl::PointXYZ>& cloud,
-                                    const OrganizedGridSearch<pcl::PointXYZ>& search,
-                                    const Image& image) {
-  std::vector<int> table(static_cast<std::size_t>(image.width + 1) * (image.height + 1), 0);
+/** Summed-area tables over the pixels: of those without a point, and of those with a depth jump
+ *  to an adjacent point. A window free of both is whole; one with holes but no jump is whole
+ *  unless its holes cut it. */
+struct BlockingTables {
+  std::vector<int> holes, jumps;
+  int width;
+  int count(const std::vector<int>& table, int x0, int y0, int x1, int y1) const {
+    const auto at = [&](int x, int y) {
+      return table[static_cast<std::size_t>(y) * (width + 1) + x];
+    };
+    return at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0);  // [x0, x1) x [y0, y1)
+  }
+};
+
+BlockingTables blockingTables(const OrganizedGridSearch<pcl::PointXYZ>& search, const Image& image,
+                              const std::vector<std::uint8_t>& finite) {
+  BlockingTables t;
+  t.width = image.width;
+  t.holes.assign(static_cast<std::size_t>(image.width + 1) * (image.height + 1), 0);
+  t.jumps = t.holes;
   for (int y = 0; y < image.height; ++y) {
-    int row = 0;
+    int holes = 0, jumps = 0;
     for (int x = 0; x < image.width; ++x) {
       const int pixel = image.index(x, y);
-      // Blocking: no point, or a step to an adjacent point that the graph does not allow.
       std::uint8_t adjacent_points = 0;
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
           const int u = x + dx, v = y + dy;
           if ((dx == 0 && dy == 0) || u < 0 || v < 0 || u >= image.width || v >= image.height)
             continue;
-          if (pcl::isXYZFinite(cloud[image.index(u, v)]))
+          if (finite[image.index(u, v)])
             adjacent_points |= static_cast<std::uint8_t>(
                 1u << OrganizedGridSearch<pcl::PointXYZ>::stepBit(dx, dy));
         }
       }
-      const bool blocking =
-          !pcl::isXYZFinite(cloud[pixel]) || search.allowedSteps(pixel) != adjacent_points;
-      row += blocking;
-      table[static_cast<std::size_t>(y + 1) * (image.width + 1) + x + 1] =
-          table[static_cast<std::size_t>(y) * (image.width + 1) + x + 1] + row;
+      holes += !finite[pixel];
+      jumps += finite[pixel] && search.allowedSteps(pixel) != adjacent_points;
+      const std::size_t cell = static_cast<std::size_t>(y + 1) * (image.width + 1) + x + 1;
+      t.holes[cell] = t.holes[cell - image.width - 1] + holes;
+      t.jumps[cell] = t.jumps[cell - image.width - 1] + jumps;
     }
   }
-  return table;
+  return t;
+}
+
+/** Whether every point of the window [x0, x1) x [y0, y1) (at most 7 x 7) is reached from its
+ *  pixel (x, y) by the grid's steps inside the window: windowSearch's answer, by a flood fill on
+ *  bit masks, 8 bits a row, so that the eighth column (never a pixel) absorbs the shifts'
+ *  wrap-around. Steps are symmetric, so each of the four forward directions serves both ways. */
+bool windowConnected(const OrganizedGridSearch<pcl::PointXYZ>& search,
+                     const std::vector<std::uint8_t>& finite, const Image& image, int x, int y,
+                     int x0, int y0, int x1, int y1) {
+  using Search = OrganizedGridSearch<pcl::PointXYZ>;
+  // Forward steps and their shifts: right, down-left, down, down-right.
+  constexpr int kShift[4] = {1, 7, 8, 9};
+  const int bit[4] = {Search::stepBit(1, 0), Search::stepBit(-1, 1), Search::stepBit(0, 1),
+                      Search::stepBit(1, 1)};
+  std::uint64_t points = 0, step[4] = {0, 0, 0, 0};
+  for (int v = y0; v < y1; ++v) {
+    for (int u = x0; u < x1; ++u) {
+      const int pixel = image.index(u, v);
+      if (!finite[pixel]) continue;
+      const std::uint64_t here = std::uint64_t{1} << ((v - y0) * 8 + (u - x0));
+      points |= here;
+      const std::uint8_t allowed = search.allowedSteps(pixel);
+      for (int d = 0; d < 4; ++d)
+        if (allowed & (1u << bit[d])) step[d] |= here;
+    }
+  }
+  std::uint64_t reached = std::uint64_t{1} << ((y - y0) * 8 + (x - x0));
+  for (;;) {
+    std::uint64_t grown = reached;
+    for (int d = 0; d < 4; ++d) {
+      grown |= (reached & step[d]) << kShift[d];
+      grown |= (reached & (step[d] << kShift[d])) >> kShift[d];
+    }
+    grown &= points;
+    if (grown == reached) return reached == points;
+    reached = grown;
+  }
 }
 
 void setNaN(pcl::Normal& n) {
@@ -79,13 +129,9 @@ OrganizedNormalResult computeOrganizedPCANormals(
   const Eigen::Vector3d origin = cloud->sensor_origin_.head<3>().cast<double>();
   const Eigen::Vector3d viewpoint = options.viewpoint.value_or(origin);
 
-  const std::vector<int> blocking = blockingPixelTable(*cloud, *search, image);
-  const auto blockingIn = [&](int x0, int y0, int x1, int y1) {  // [x0, x1) x [y0, y1)
-    const auto at = [&](int x, int y) {
-      return blocking[static_cast<std::size_t>(y) * (image.width + 1) + x];
-    };
-    return at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0);
-  };
+  std::vector<std::uint8_t> finite(cloud->size());
+  for (std::size_t i = 0; i < cloud->size(); ++i) finite[i] = pcl::isXYZFinite((*cloud)[i]);
+  const BlockingTables blocking = blockingTables(*search, image, finite);
 
   OrganizedNormalResult result;
   result.normals.resize(cloud->size());
@@ -115,15 +161,15 @@ OrganizedNormalResult computeOrganizedPCANormals(
       const int rx1 = std::min(image.width, x1 + w), ry1 = std::min(image.height, y1 + w);
       const int rw = rx1 - rx0, rh = ry1 - ry0;
       Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-      int finite = 0;
+      int region_points = 0;
       for (int y = ry0; y < ry1; ++y) {
         for (int x = rx0; x < rx1; ++x) {
-          if (!pcl::isXYZFinite((*cloud)[image.index(x, y)])) continue;
+          if (!finite[image.index(x, y)]) continue;
           centre += (*cloud)[image.index(x, y)].getVector3fMap().cast<double>();
-          ++finite;
+          ++region_points;
         }
       }
-      if (finite > 0) centre /= finite;
+      if (region_points > 0) centre /= region_points;
       // table(x, y) = sums over the region's pixels left of x and above y.
       const int stride = rw + 1;
       table.assign(static_cast<std::size_t>(stride) * (rh + 1) * kChannels, 0.0);
@@ -131,7 +177,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
         std::array<double, kChannels> row{};
         for (int x = 0; x < rw; ++x) {
           const int pixel = image.index(rx0 + x, ry0 + y);
-          if (pcl::isXYZFinite((*cloud)[pixel])) {
+          if (finite[pixel]) {
             const Eigen::Vector3d d = (*cloud)[pixel].getVector3fMap().cast<double>() - centre;
             const double values[kChannels] = {
                 1.0,           d.x(),         d.y(),         d.z(),         d.x() * d.x(),
@@ -152,7 +198,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
           const int pixel = image.index(x, y);
           pcl::Normal& out = result.normals[pixel];
           setNaN(out);
-          if (!pcl::isXYZFinite((*cloud)[pixel])) continue;
+          if (!finite[pixel]) continue;
           const int wx0 = std::max(0, x - w), wy0 = std::max(0, y - w);
           const int wx1 = std::min(image.width, x + w + 1);
           const int wy1 = std::min(image.height, y + w + 1);
@@ -160,10 +206,13 @@ OrganizedNormalResult computeOrganizedPCANormals(
           double s[kChannels];
           for (int k = 0; k < kChannels; ++k) s[k] = d[k] - b[k] - c[k] + a[k];
           // The window's sums hold exactly the query's neighbours when nothing in the window can
-          // cut it (the common case), or when the search reaches every point of the window.
+          // cut it (the common case), or when the search reaches every point of the window
+          // (a bit-mask flood fill up to 7 x 7, else the search itself).
           const bool whole_window =
-              blockingIn(wx0, wy0, wx1, wy1) == 0 ||
-              search->windowReach(pixel, w) == static_cast<int>(std::lround(s[0]));
+              (blocking.count(blocking.jumps, wx0, wy0, wx1, wy1) == 0 &&
+               blocking.count(blocking.holes, wx0, wy0, wx1, wy1) == 0) ||
+              (w <= 3 ? windowConnected(*search, finite, image, x, y, wx0, wy0, wx1, wy1)
+                      : search->windowReach(pixel, w) == static_cast<int>(std::lround(s[0])));
           PlaneFit fit;
           if (whole_window) {
             ++window_points;
