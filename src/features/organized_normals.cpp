@@ -120,9 +120,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
   if (options.window_radius < 1) {
     throw pcl::BadArgumentException("the window radius must be >= 1 pixel");
   }
-  auto search = std::make_shared<OrganizedGridSearch<pcl::PointXYZ>>(
-      options.max_depth_jump,
-      std::max(options.window_radius, OrganizedGridSearch<pcl::PointXYZ>::kDefaultMaxWindowRadius));
+  auto search = std::make_shared<OrganizedGridSearch<pcl::PointXYZ>>(options.max_depth_jump);
   search->setInputCloud(cloud);  // throws unless organized
   const Image image{static_cast<int>(cloud->width), static_cast<int>(cloud->height)};
   const int w = options.window_radius;

@@ -13,6 +13,21 @@
 #include "pcl_ddg/search/visit_stamps.h"
 
 namespace pcl_ddg {
+namespace detail {
+
+/** Writes the first count (distance, pixel) pairs of found into the outputs. */
+inline int writeFound(const std::vector<std::pair<float, pcl::index_t>>& found, std::size_t count,
+                      pcl::Indices& k_indices, std::vector<float>& k_sqr_distances) {
+  k_indices.resize(count);
+  k_sqr_distances.resize(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    k_sqr_distances[i] = found[i].first;
+    k_indices[i] = found[i].second;
+  }
+  return static_cast<int>(count);
+}
+
+}  // namespace detail
 
 template <typename PointT>
 OrganizedGridSearch<PointT>::OrganizedGridSearch(double max_depth_jump, int max_window_radius)
@@ -205,13 +220,7 @@ int OrganizedGridSearch<PointT>::nearestKSearch(pcl::index_t index, int k, pcl::
       });
   const std::size_t kept = std::min<std::size_t>(found.size(), static_cast<std::size_t>(k));
   std::partial_sort(found.begin(), found.begin() + static_cast<std::ptrdiff_t>(kept), found.end());
-  k_indices.resize(kept);
-  k_sqr_distances.resize(kept);
-  for (std::size_t i = 0; i < kept; ++i) {
-    k_sqr_distances[i] = found[i].first;
-    k_indices[i] = found[i].second;
-  }
-  return static_cast<int>(kept);
+  return detail::writeFound(found, kept, k_indices, k_sqr_distances);
 }
 
 template <typename PointT>
@@ -263,13 +272,7 @@ int OrganizedGridSearch<PointT>::radiusSearch(pcl::index_t index, double radius,
   } else if (this->sorted_results_) {
     std::sort(found.begin(), found.end());
   }
-  k_indices.resize(kept);
-  k_sqr_distances.resize(kept);
-  for (std::size_t i = 0; i < kept; ++i) {
-    k_sqr_distances[i] = found[i].first;
-    k_indices[i] = found[i].second;
-  }
-  return static_cast<int>(kept);
+  return detail::writeFound(found, kept, k_indices, k_sqr_distances);
 }
 
 template <typename PointT>
