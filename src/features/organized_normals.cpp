@@ -18,7 +18,7 @@
 namespace pcl_ddg {
 namespace {
 
-constexpr int kTile = 32;
+constexpr int kTile = 64;
 // Per cell of a summed-area table: count, x, y, z, xx, xy, xz, yy, yz, zz.
 constexpr int kChannels = 10;
 
@@ -27,30 +27,58 @@ struct Image {
   int index(int x, int y) const { return y * width + x; }
 };
 
-/** Summed-area tables over the pixels: of those without a point, and of those with a depth jump
- *  to an adjacent point. A window free of both is whole; one with holes but no jump is whole
- *  unless its holes cut it. */
-struct BlockingTables {
-  std::vector<int> holes, jumps;
-  int width;
-  int count(const std::vector<int>& table, int x0, int y0, int x1, int y1) const {
-    const auto at = [&](int x, int y) {
-      return table[static_cast<std::size_t>(y) * (width + 1) + x];
-    };
-    return at(x1, y1) - at(x0, y1) - at(x1, y0) + at(x0, y0);  // [x0, x1) x [y0, y1)
+/** One bit per pixel, each row padded with a spare word, so that any run of up to 57 bits of a
+ *  row is read from two words. Rows are written by one thread each (no two share a word). */
+class RowBits {
+ public:
+  RowBits(int width, int height)
+      : words_per_row_(static_cast<std::size_t>(width) / 64 + 2),
+        words_(words_per_row_ * static_cast<std::size_t>(height), 0) {}
+  void set(int x, int y) { row(y)[x >> 6] |= std::uint64_t{1} << (x & 63); }
+  /** Bits x .. x + count - 1 of row y, bit 0 for pixel x. */
+  std::uint64_t read(int x, int y, int count) const {
+    const std::uint64_t* words = &words_[static_cast<std::size_t>(y) * words_per_row_];
+    const int offset = x & 63;
+    std::uint64_t bits = words[x >> 6] >> offset;
+    if (offset != 0) bits |= words[(x >> 6) + 1] << (64 - offset);
+    return bits & ((std::uint64_t{1} << count) - 1);
   }
+
+ private:
+  std::uint64_t* row(int y) { return &words_[static_cast<std::size_t>(y) * words_per_row_]; }
+  std::size_t words_per_row_;
+  std::vector<std::uint64_t> words_;
 };
 
-BlockingTables blockingTables(const OrganizedGridSearch<pcl::PointXYZ>& search, const Image& image,
-                              const std::vector<std::uint8_t>& finite) {
-  BlockingTables t;
-  t.width = image.width;
-  t.holes.assign(static_cast<std::size_t>(image.width + 1) * (image.height + 1), 0);
-  t.jumps = t.holes;
+using Search = OrganizedGridSearch<pcl::PointXYZ>;
+
+/** The grid as bit rows: the pixels with a point; those that can cut a window (no point, or a
+ *  jump to an adjacent point); and per forward step (right, down-left, down, down-right) the
+ *  pixels the search may take it from. Steps are symmetric, so forward steps serve both ways. */
+struct GridBits {
+  static constexpr int kForward = 4;
+  GridBits(int width, int height)
+      : points(width, height), blocking(width, height), steps(kForward, RowBits(width, height)) {}
+  RowBits points, blocking;
+  std::vector<RowBits> steps;
+};
+
+constexpr int kForwardShift[GridBits::kForward] = {1, 7, 8, 9};  // in 8-bit rows of a window mask
+constexpr int kForwardBit[GridBits::kForward] = {Search::stepBit(1, 0), Search::stepBit(-1, 1),
+                                                 Search::stepBit(0, 1), Search::stepBit(1, 1)};
+
+GridBits gridBits(const Search& search, const Image& image, const std::vector<std::uint8_t>& finite,
+                  int threads) {
+  GridBits bits(image.width, image.height);
+#pragma omp parallel for schedule(static) num_threads(threads)
   for (int y = 0; y < image.height; ++y) {
-    int holes = 0, jumps = 0;
     for (int x = 0; x < image.width; ++x) {
       const int pixel = image.index(x, y);
+      if (!finite[pixel]) {
+        bits.blocking.set(x, y);
+        continue;
+      }
+      bits.points.set(x, y);
       std::uint8_t adjacent_points = 0;
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dx = -1; dx <= 1; ++dx) {
@@ -58,54 +86,59 @@ BlockingTables blockingTables(const OrganizedGridSearch<pcl::PointXYZ>& search, 
           if ((dx == 0 && dy == 0) || u < 0 || v < 0 || u >= image.width || v >= image.height)
             continue;
           if (finite[image.index(u, v)])
-            adjacent_points |= static_cast<std::uint8_t>(
-                1u << OrganizedGridSearch<pcl::PointXYZ>::stepBit(dx, dy));
+            adjacent_points |= static_cast<std::uint8_t>(1u << Search::stepBit(dx, dy));
         }
       }
-      holes += !finite[pixel];
-      jumps += finite[pixel] && search.allowedSteps(pixel) != adjacent_points;
-      const std::size_t cell = static_cast<std::size_t>(y + 1) * (image.width + 1) + x + 1;
-      t.holes[cell] = t.holes[cell - image.width - 1] + holes;
-      t.jumps[cell] = t.jumps[cell - image.width - 1] + jumps;
+      const std::uint8_t allowed = search.allowedSteps(pixel);
+      if (allowed != adjacent_points) bits.blocking.set(x, y);
+      for (int d = 0; d < GridBits::kForward; ++d)
+        if (allowed & (1u << kForwardBit[d])) bits.steps[d].set(x, y);
     }
   }
-  return t;
+  return bits;
 }
 
-/** Whether every point of the window [x0, x1) x [y0, y1) (at most 7 x 7) is reached from its
- *  pixel (x, y) by the grid's steps inside the window: windowSearch's answer, by a flood fill on
- *  bit masks, 8 bits a row, so that the eighth column (never a pixel) absorbs the shifts'
- *  wrap-around. Steps are symmetric, so each of the four forward directions serves both ways. */
-bool windowConnected(const OrganizedGridSearch<pcl::PointXYZ>& search,
-                     const std::vector<std::uint8_t>& finite, const Image& image, int x, int y,
-                     int x0, int y0, int x1, int y1) {
-  using Search = OrganizedGridSearch<pcl::PointXYZ>;
-  // Forward steps and their shifts: right, down-left, down, down-right.
-  constexpr int kShift[4] = {1, 7, 8, 9};
-  const int bit[4] = {Search::stepBit(1, 0), Search::stepBit(-1, 1), Search::stepBit(0, 1),
-                      Search::stepBit(1, 1)};
-  std::uint64_t points = 0, step[4] = {0, 0, 0, 0};
-  for (int v = y0; v < y1; ++v) {
-    for (int u = x0; u < x1; ++u) {
-      const int pixel = image.index(u, v);
-      if (!finite[pixel]) continue;
-      const std::uint64_t here = std::uint64_t{1} << ((v - y0) * 8 + (u - x0));
-      points |= here;
-      const std::uint8_t allowed = search.allowedSteps(pixel);
-      for (int d = 0; d < 4; ++d)
-        if (allowed & (1u << bit[d])) step[d] |= here;
-    }
-  }
-  std::uint64_t reached = std::uint64_t{1} << ((y - y0) * 8 + (x - x0));
+/** A window [x0, x1) x [y0, y1) of at most 7 x 7 pixels as a bit mask, bit 8 (v - y0) + (u - x0)
+ *  for pixel (u, v): 8 bits a row, so that the eighth column (never a pixel) absorbs the
+ *  wrap-around of the flood fill's shifts. */
+std::uint64_t windowMask(const RowBits& bits, int x0, int y0, int x1, int y1) {
+  std::uint64_t mask = 0;
+  for (int v = y0; v < y1; ++v) mask |= bits.read(x0, v, x1 - x0) << ((v - y0) * 8);
+  return mask;
+}
+
+/** Whether any pixel of the window [x0, x1) x [y0, y1), of any size, has its bit set. */
+bool anyInWindow(const RowBits& bits, int x0, int y0, int x1, int y1) {
+  constexpr int kRun = 57;  // RowBits::read's longest run
+  for (int v = y0; v < y1; ++v)
+    for (int u = x0; u < x1; u += kRun)
+      if (bits.read(u, v, std::min(kRun, x1 - u)) != 0) return true;
+  return false;
+}
+
+/** The points of the window around (x, y) that the grid's steps inside the window reach from it:
+ *  windowSearch's answer, by a flood fill on the window's masks. */
+struct WindowMasks {
+  std::uint64_t points = 0, reached = 0;
+};
+
+constexpr int kMaskRadius = 3;
+
+WindowMasks floodWindow(const GridBits& bits, int x, int y, int x0, int y0, int x1, int y1) {
+  WindowMasks masks;
+  masks.points = windowMask(bits.points, x0, y0, x1, y1);
+  std::uint64_t step[GridBits::kForward];
+  for (int d = 0; d < GridBits::kForward; ++d) step[d] = windowMask(bits.steps[d], x0, y0, x1, y1);
+  masks.reached = std::uint64_t{1} << ((y - y0) * 8 + (x - x0));
   for (;;) {
-    std::uint64_t grown = reached;
-    for (int d = 0; d < 4; ++d) {
-      grown |= (reached & step[d]) << kShift[d];
-      grown |= (reached & (step[d] << kShift[d])) >> kShift[d];
+    std::uint64_t grown = masks.reached;
+    for (int d = 0; d < GridBits::kForward; ++d) {
+      grown |= (masks.reached & step[d]) << kForwardShift[d];
+      grown |= (masks.reached & (step[d] << kForwardShift[d])) >> kForwardShift[d];
     }
-    grown &= points;
-    if (grown == reached) return reached == points;
-    reached = grown;
+    grown &= masks.points;
+    if (grown == masks.reached) return masks;
+    masks.reached = grown;
   }
 }
 
@@ -127,9 +160,16 @@ OrganizedNormalResult computeOrganizedPCANormals(
   const Eigen::Vector3d origin = cloud->sensor_origin_.head<3>().cast<double>();
   const Eigen::Vector3d viewpoint = options.viewpoint.value_or(origin);
 
+#ifdef _OPENMP
+  const int threads =
+      options.threads > 0 ? static_cast<int>(options.threads) : omp_get_max_threads();
+#else
+  const int threads = 1;
+#endif
   std::vector<std::uint8_t> finite(cloud->size());
+#pragma omp parallel for schedule(static) num_threads(threads)
   for (std::size_t i = 0; i < cloud->size(); ++i) finite[i] = pcl::isXYZFinite((*cloud)[i]);
-  const BlockingTables blocking = blockingTables(*search, image, finite);
+  const GridBits bits = gridBits(*search, image, finite, threads);
 
   OrganizedNormalResult result;
   result.normals.resize(cloud->size());
@@ -140,10 +180,6 @@ OrganizedNormalResult computeOrganizedPCANormals(
   const int tiles_x = (image.width + kTile - 1) / kTile;
   const int tiles_y = (image.height + kTile - 1) / kTile;
   std::int64_t failed = 0, window_points = 0, jump_points = 0;
-#ifdef _OPENMP
-  const int threads =
-      options.threads > 0 ? static_cast<int>(options.threads) : omp_get_max_threads();
-#endif
 #pragma omp parallel reduction(+ : failed, window_points, jump_points) num_threads(threads)
   {
     std::vector<double> table;
@@ -206,12 +242,16 @@ OrganizedNormalResult computeOrganizedPCANormals(
           // The window's sums hold exactly the query's neighbours when nothing in the window can
           // cut it (the common case), or when the search reaches every point of the window
           // (a bit-mask flood fill up to 7 x 7, else the search itself).
-          const bool whole_window =
-              (blocking.count(blocking.jumps, wx0, wy0, wx1, wy1) == 0 &&
-               blocking.count(blocking.holes, wx0, wy0, wx1, wy1) == 0) ||
-              (w <= 3 ? windowConnected(*search, finite, image, x, y, wx0, wy0, wx1, wy1)
-                      : search->windowReach(pixel, w) == static_cast<int>(std::lround(s[0])));
-          PlaneFit fit;
+          bool whole_window = !anyInWindow(bits.blocking, wx0, wy0, wx1, wy1);
+          std::uint64_t reached = 0;
+          if (!whole_window && w <= kMaskRadius) {
+            const WindowMasks masks = floodWindow(bits, x, y, wx0, wy0, wx1, wy1);
+            whole_window = masks.reached == masks.points;
+            reached = masks.reached;
+          } else if (!whole_window) {
+            whole_window = search->windowReach(pixel, w) == static_cast<int>(std::lround(s[0]));
+          }
+          PlaneNormal fit;
           if (whole_window) {
             ++window_points;
             if (s[0] >= 3.0) {
@@ -219,17 +259,26 @@ OrganizedNormalResult computeOrganizedPCANormals(
               Eigen::Matrix3d covariance;
               covariance << s[4], s[5], s[6], s[5], s[7], s[8], s[6], s[8], s[9];
               covariance = covariance / s[0] - mean * mean.transpose();
-              fit = fitPlane(centre + mean, covariance);
+              fit = fitPlaneNormal(covariance);
             }
           } else {
+            // Cut: the plane of the points the query reaches, relative to the query.
             ++jump_points;
-            const int count = search->windowSearch(pixel, w, neighbours, distances);
             const Eigen::Vector3d query = (*cloud)[pixel].getVector3fMap().cast<double>();
-            for (int i = 0; i < count; ++i) {
-              points.col(i) = (*cloud)[neighbours[i]].getVector3fMap().cast<double>() - query;
+            int count = 0;
+            if (w <= kMaskRadius) {
+              for (; reached != 0; reached &= reached - 1) {
+                const int bit = __builtin_ctzll(reached);
+                const int neighbour = image.index(wx0 + bit % 8, wy0 + bit / 8);
+                points.col(count++) = (*cloud)[neighbour].getVector3fMap().cast<double>() - query;
+              }
+            } else {
+              count = search->windowSearch(pixel, w, neighbours, distances);
+              for (int i = 0; i < count; ++i) {
+                points.col(i) = (*cloud)[neighbours[i]].getVector3fMap().cast<double>() - query;
+              }
             }
-            fit = fitPlane(points, count);
-            fit.centroid += query;
+            fit = fitPlaneNormal(points, count);
           }
           if (!fit.valid) {
             ++failed;

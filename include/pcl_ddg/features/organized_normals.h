@@ -5,7 +5,7 @@
 // needs a search.
 //
 // Far from the origin the sums of squares would cancel the covariance away: the tables are built
-// per 32 x 32 tile on coordinates relative to the tile's mean, so that a window's covariance is
+// per 64 x 64 tile on coordinates relative to the tile's mean, so that a window's covariance is
 // as exact as the two-pass PCA of its points (1e-9 relative or better).
 //
 // Across a depth jump a window would mix two surfaces. Where the window holds a point that

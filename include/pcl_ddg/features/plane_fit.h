@@ -25,4 +25,21 @@ PlaneFit fitPlane(const Eigen::Matrix3Xd& points, int count);
  *  by the number of points): how windowed sums (integral images) are turned into a plane. */
 PlaneFit fitPlane(const Eigen::Vector3d& centroid, const Eigen::Matrix3d& covariance);
 
+/** Only the normal and the surface variation of a plane fit, for per-pixel fits at frame rate. */
+struct PlaneNormal {
+  bool valid = false;  ///< as PlaneFit::valid
+  Eigen::Vector3d normal;
+  double surface_variation = 0.0;
+};
+
+/** The smallest eigenpair of a covariance (about the centroid, divided by the number of points):
+ *  the eigenvalues in closed form, then only the smallest one's eigenvector, as the
+ *  best-conditioned cross product of rows of A - lambda0 I. fitPlane's normal and surface
+ *  variation up to rounding, at half the cost (the closed-form solver also finds the other two
+ *  eigenvectors). */
+PlaneNormal fitPlaneNormal(const Eigen::Matrix3d& covariance);
+
+/** fitPlaneNormal of the first count columns of points, their covariance formed as in fitPlane. */
+PlaneNormal fitPlaneNormal(const Eigen::Matrix3Xd& points, int count);
+
 }  // namespace pcl_ddg

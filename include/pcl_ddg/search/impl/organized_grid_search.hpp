@@ -59,13 +59,16 @@ void OrganizedGridSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud,
   height_ = static_cast<int>(cloud->height);
   const Eigen::Vector3f origin = cloud->sensor_origin_.template head<3>();
   range_.resize(cloud->size());
-  for (std::size_t i = 0; i < cloud->size(); ++i) {
+  const std::int64_t size = static_cast<std::int64_t>(cloud->size());
+#pragma omp parallel for schedule(static)
+  for (std::int64_t i = 0; i < size; ++i) {
     const PointT& p = (*cloud)[i];
     range_[i] = pcl::isXYZFinite(p) ? (p.getVector3fMap() - origin).norm()
                                     : std::numeric_limits<float>::quiet_NaN();
   }
   // Every query walks these steps: their depth tests are made once, here.
-  steps_.assign(range_.size(), 0);
+  steps_.resize(range_.size());
+#pragma omp parallel for schedule(static)
   for (int y = 0; y < height_; ++y) {
     for (int x = 0; x < width_; ++x) {
       const pcl::index_t from = static_cast<pcl::index_t>(y) * width_ + x;

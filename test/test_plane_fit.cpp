@@ -1,0 +1,96 @@
+// The plane fits against matrices of known eigen-decomposition: fitPlane (Eigen's closed-form
+// solver) and fitPlaneNormal (the smallest eigenpair only), across flatness, scale and the
+// degenerate cases.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "pcl_ddg/features/plane_fit.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+struct KnownCovariance {
+  Eigen::Matrix3d matrix;
+  Eigen::Vector3d normal;       ///< eigenvector of the smallest eigenvalue
+  Eigen::Vector3d eigenvalues;  ///< ascending
+};
+
+KnownCovariance rotated(const Eigen::Vector3d& eigenvalues, std::mt19937& random) {
+  std::normal_distribution<double> gaussian;
+  const Eigen::Quaterniond rotation =
+      Eigen::Quaterniond(gaussian(random), gaussian(random), gaussian(random), gaussian(random))
+          .normalized();
+  const Eigen::Matrix3d r = rotation.toRotationMatrix();
+  return {r * eigenvalues.asDiagonal() * r.transpose(), r.col(0), eigenvalues};
+}
+
+double angleBetweenLines(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), std::abs(a.dot(b)));
+}
+
+TEST(PlaneFit, SmallestEigenpairOfKnownMatricesFromFlatToNearlyIsotropic) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 20000; ++trial) {
+    // Flatness l0 / l1 from 1e-9 to 0.9, elongation l1 / l2 from 1e-3 to 1, scale from 1e-12 to
+    // 1e12 (squared metres of anything from a micro-scan to a city).
+    const double l2 = std::pow(10.0, -12.0 + 24.0 * unit(random));
+    const double l1 = l2 * std::pow(10.0, -3.0 * unit(random));
+    const double l0 =
+        l1 * (trial % 4 == 0 ? 0.9 * unit(random) : std::pow(10.0, -9.0 * unit(random)));
+    const KnownCovariance known = rotated({l0, l1, l2}, random);
+    const PlaneNormal fast = fitPlaneNormal(known.matrix);
+    const PlaneFit full = fitPlane(Eigen::Vector3d::Zero(), known.matrix);
+    ASSERT_TRUE(fast.valid) << trial;
+    ASSERT_TRUE(full.valid) << trial;
+    // A closed form reads the eigenvalues off cos(3 phi) = r, where acos is ill-conditioned near
+    // r = 1, the double root that l0 and l1 become next to l2: the smallest eigenvalue is good to
+    // rounding * l2 / gap, and its eigenvector, a kernel of A - l0 I, to rounding * (l2 / gap)^2.
+    const double gap = (l1 - l0) / l2;
+    const double tolerance = 1e-15 / (gap * gap);
+    EXPECT_LT(angleBetweenLines(fast.normal, known.normal), tolerance) << trial;
+    EXPECT_LT(angleBetweenLines(full.normal, known.normal), tolerance) << trial;
+    EXPECT_NEAR(fast.normal.norm(), 1.0, 1e-15);
+    const double variation = l0 / (l0 + l1 + l2);
+    EXPECT_NEAR(fast.surface_variation, variation, 1e-15 / gap) << trial;
+    EXPECT_NEAR(full.surface_variation, variation, 1e-15 / gap) << trial;
+  }
+}
+
+TEST(PlaneFit, PointsOnAPlaneHaveItsNormalAndNoVariation) {
+  // A tilted square grid of points, far from the origin as scans are, passed relative to a point.
+  const Eigen::Vector3d normal = Eigen::Vector3d(1, -2, 3).normalized();
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  Eigen::Matrix3Xd points(3, 25);
+  for (int i = 0; i < 25; ++i) points.col(i) = 1e-3 * ((i % 5) * u + (i / 5) * v);
+  const PlaneNormal fit = fitPlaneNormal(points, 25);
+  ASSERT_TRUE(fit.valid);
+  EXPECT_LT(angleBetweenLines(fit.normal, normal), 1e-12);
+  EXPECT_LT(fit.surface_variation, 1e-15);
+}
+
+TEST(PlaneFit, DegenerateNeighbourhoodsHaveNoPlane) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  Eigen::Matrix3Xd line(3, 4);
+  line << 0, 1, 2, 3, 0, 2, 4, 6, 0, 3, 6, 9;
+  EXPECT_FALSE(fitPlaneNormal(line, 4).valid);
+  EXPECT_FALSE(fitPlane(line, 4).valid);
+  EXPECT_FALSE(fitPlaneNormal(line, 2).valid);  // fewer than 3 points
+  EXPECT_FALSE(fitPlaneNormal(Eigen::Matrix3d::Zero()).valid);
+  EXPECT_FALSE(fitPlaneNormal(Eigen::Matrix3d::Identity()).valid);  // isotropic: no direction
+  Eigen::Matrix3d poisoned = Eigen::Matrix3d::Identity();
+  poisoned(2, 2) = 2.0;
+  poisoned(0, 1) = poisoned(1, 0) = nan;
+  EXPECT_FALSE(fitPlaneNormal(poisoned).valid);
+  poisoned(0, 1) = poisoned(1, 0) = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(fitPlaneNormal(poisoned).valid);
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
