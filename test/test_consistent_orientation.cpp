@@ -10,8 +10,11 @@
 #include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/features/normal_orientation.h"
+#include "pcl_ddg/features/pca_normal_estimation.h"
+#include "pcl_ddg/features/quadric_normal_estimation.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/search/kd_tree_search.h"
 #include "range_images.h"
 #include "test_data.h"
 
@@ -201,6 +204,90 @@ TEST(ConsistentOrientation, AgreesWithTheFacesOfTheSharedScans) {
   }
 }
 
+TEST(ConsistentOrientation, AnOrientationModeOfTheEstimators) {
+  // Viewpoint at the torus's centre: per point, the outer half of the PCA normals points in.
+  // As the estimator's orientation mode, over its own kd-tree, they all come out.
+  OrientedCloud ring = torus(200, 80);
+  auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>(ring.points);
+  PCANormalEstimation<pcl::PointXYZ, pcl::Normal> pca;
+  pca.setInputCloud(points);
+  pca.setSearchMethod(std::make_shared<KdTreeSearch<pcl::PointXYZ>>());
+  pca.setKSearch(12);
+  pca.setOrientationSpanningTree();
+  pcl::PointCloud<pcl::Normal> normals;
+  pca.compute(normals);
+  EXPECT_EQ(pca.getOrientation(), NormalOrientation::SpanningTree);
+  EXPECT_EQ(agreement(normals, ring.normals), 1.0);
+  EXPECT_EQ(pca.getOrientationReport().components, 1);
+  EXPECT_GT(pca.getOrientationReport().flippedShare(), 0.3);  // the outer half, turned
+}
+
+TEST(ConsistentOrientation, QuadricCurvaturesTurnWithTheirNormals) {
+  // Seen from its centre a sphere's normals point in and its curvatures are -1/r; along the tree
+  // (seeded up at the top) they point out, and both curvatures become +1/r, with kappa1's
+  // direction still a unit tangent.
+  constexpr double kRadius = 2.0;
+  OrientedCloud sphere;
+  addSphere(sphere, Eigen::Vector3d::Zero(), kRadius, 20000);
+  auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>(sphere.points);
+  QuadricNormalEstimation<pcl::PointXYZ, pcl::Normal> quadric;
+  quadric.setInputCloud(points);
+  quadric.setSearchMethod(std::make_shared<KdTreeSearch<pcl::PointXYZ>>());
+  quadric.setKSearch(20);
+  quadric.setViewPoint(0.0f, 0.0f, 0.0f);
+  quadric.setOrientationSpanningTree(10, false);
+  pcl::PointCloud<pcl::Normal> normals;
+  pcl::PointCloud<pcl::PrincipalCurvatures> curvatures;
+  quadric.computeWithCurvatures(normals, curvatures);
+  EXPECT_EQ(agreement(normals, sphere.normals), 1.0);
+  EXPECT_GT(quadric.getOrientationReport().flippedShare(), 0.99);
+  for (std::size_t i = 0; i < curvatures.size(); ++i) {
+    const pcl::PrincipalCurvatures& c = curvatures[i];
+    ASSERT_NEAR(c.pc1, 1.0 / kRadius, 0.01) << i;
+    ASSERT_NEAR(c.pc2, 1.0 / kRadius, 0.01) << i;
+    ASSERT_GE(c.pc1, c.pc2) << i;
+    const Eigen::Vector3f d(c.principal_curvature_x, c.principal_curvature_y,
+                            c.principal_curvature_z);
+    ASSERT_NEAR(d.norm(), 1.0f, 1e-5f) << i;
+    ASSERT_NEAR(d.dot(normals[i].getNormalVector3fMap()), 0.0f, 1e-5f) << i;
+  }
+}
+
+TEST(ConsistentOrientation, SpanningTreeThroughFitLocalSurfacesOnTheGrid) {
+  // A sphere seen by a camera looking along +z. Seeded facing the sensor, the grid's tree keeps
+  // the normals facing it; seeded up at the highest (farthest) point, it turns them away:
+  // consistent either way, for the pixel-grid fast path and for the quadric's grid search.
+  // Compared where the sphere is seen within 70 degrees of head-on: nearer the limb the windows
+  // hold a scanline or two, whose planes contain the ray, and no orientation is meaningful.
+  const auto image = test::renderRangeImage(test::RangeScene::Sphere, test::PinholeCamera{});
+  pcl::PointCloud<pcl::Normal> truth;
+  std::vector<std::size_t> seen;
+  for (std::size_t i = 0; i < image.normals.size(); ++i) {
+    const Eigen::Vector3d ray = -(*image.cloud)[i].getVector3fMap().cast<double>().normalized();
+    if (!(image.normals[i].dot(ray) > std::cos(70.0 * M_PI / 180.0))) continue;
+    seen.push_back(i);
+    const Eigen::Vector3f n = image.normals[i].cast<float>();
+    truth.push_back(pcl::Normal(n.x(), n.y(), n.z()));
+  }
+  ASSERT_GT(seen.size(), 5000u);
+  for (const LocalFitMethod method : {LocalFitMethod::PCA, LocalFitMethod::Quadric}) {
+    for (const bool facing_sensor : {true, false}) {
+      LocalFitOptions options;
+      options.method = method;
+      options.neighbourhood = NeighbourhoodKind::Grid;
+      options.k = 25;
+      options.orientation = NormalOrientation::SpanningTree;
+      options.seed_facing_viewpoint = facing_sensor;
+      const LocalFitResult fit = fitLocalSurfaces(image.cloud, nullptr, options);
+      pcl::PointCloud<pcl::Normal> estimated;
+      for (const std::size_t i : seen) estimated.push_back(fit.normals[i]);
+      EXPECT_EQ(agreement(estimated, truth), facing_sensor ? 1.0 : 0.0);
+      EXPECT_GT(fit.orientation.flippedShare(), facing_sensor ? 0.0 : 0.95);
+      EXPECT_LT(fit.orientation.flippedShare(), facing_sensor ? 0.05 : 1.0);
+    }
+  }
+}
+
 TEST(ConsistentOrientation, RefusesMismatchedInput) {
   OrientedCloud sphere;
   addSphere(sphere, Eigen::Vector3d::Zero(), 1.0, 100);
@@ -209,6 +296,9 @@ TEST(ConsistentOrientation, RefusesMismatchedInput) {
   ConsistentOrientationOptions options;
   options.k = 0;
   EXPECT_THROW(orientNormalsConsistently(sphere.points, sphere.normals, options),
+               pcl::BadArgumentException);
+  const std::vector<std::pair<int, int>> leaving = {{0, 1}, {99, 100}};
+  EXPECT_THROW(orientNormalsConsistently(sphere.points, sphere.normals, leaving),
                pcl::BadArgumentException);
 }
 

@@ -38,10 +38,9 @@ constexpr const char* kSyntax =
     "         [-max_nn N (with -radius: at most the N nearest; default 64)]\n"
     "         [-viewpoint x,y,z (clouds: orient normals towards it; default the PCD's VIEWPOINT)]\n"
     "         [-orient viewpoint|mst|mesh (pca, quadric: towards the viewpoint (clouds' default),\n"
-    "                  along a minimum spanning tree of the mesh, pixel grid or 10 nearest "
-    "(merged\n"
-    "                  scans; each tree seeded facing -viewpoint, an organized frame's sensor, or "
-    "up),\n"
+    "                  along a minimum spanning tree of the 10 nearest on the mesh, the pixel\n"
+    "                  grid or in space (merged scans; each tree seeded facing -viewpoint, an\n"
+    "                  organized frame's sensor, or up),\n"
     "                  or like the faces (meshes' default))]\n"
     "         [-normal_map out.png (organized clouds: the normals as an image, (n + 1) / 2 as "
     "RGB)]\n"
@@ -57,35 +56,13 @@ pcl_ddg::NormalWeighting weightingOf(const std::string& method) {
                                       : NormalWeighting::Area;
 }
 
-/** Turns the normals consistently along a minimum spanning tree of the mesh, the pixel grid or
- *  the 10 nearest neighbours, each tree seeded facing the -viewpoint or else up at its highest
- *  point, and says how many it turned. */
-void orientBySpanningTree(const pcl_ddg::tools::SurfaceInput& in,
-                          const pcl_ddg::LocalFitOptions& options, bool seed_facing_viewpoint,
-                          pcl::PointCloud<pcl::Normal>& normals) {
-  using namespace pcl_ddg;
-  ConsistentOrientationOptions tree;
-  if (seed_facing_viewpoint) tree.viewpoint = options.viewpoint;
-  tree.threads = options.threads;
-  const char* graph = in.topology             ? "mesh edges"
-                      : in.points->height > 1 ? "pixel grid"
-                                              : "10 nearest";
-  tools::Timer timer(std::string("Orienting along a spanning tree (") + graph + ")");
-  ConsistentOrientationReport report;
-  if (in.topology) {
-    report = orientNormalsConsistently(*in.topology, *in.points, normals, tree);
-  } else if (in.points->height > 1) {
-    OrganizedGridSearch<pcl::PointXYZ> grid(options.max_depth_jump);
-    grid.setInputCloud(in.points);
-    report = orientNormalsConsistently(grid, normals, tree);
-  } else {
-    report = orientNormalsConsistently(*in.points, normals, tree);
-  }
-  timer.done(in.points->size());
+/** Says how many normals the spanning tree turned. */
+void reportSpanningTree(const pcl_ddg::ConsistentOrientationReport& report) {
   char share[32];
   std::snprintf(share, sizeof share, "%.1f %%", 100.0 * report.flippedShare());
-  std::cerr << kName << ": turned " << report.flipped_points << " of " << report.oriented_points
-            << " normals (" << share << ") in " << report.components << " components\n";
+  std::cerr << kName << ": the spanning tree turned " << report.flipped_points << " of "
+            << report.oriented_points << " normals (" << share << ") in " << report.components
+            << " components\n";
 }
 
 /** An organized cloud's normals as an image: (n + 1) / 2 as red, green, blue; black where none. */
@@ -136,6 +113,9 @@ int run(int argc, char** argv) {
     // A cloud larger than memory: fitted tile by tile from the file (pcl_ddg/tiling).
     if (!requested.empty() && !fitted)
       throw tools::UsageError("-memory applies to pca and quadric on clouds");
+    if (args.has("orient") && *args.value("orient") != "viewpoint")
+      throw tools::UsageError("-orient " + *args.value("orient") +
+                              " needs the whole cloud; with -memory normals face the viewpoint");
     const LocalFitOptions options = tools::outOfCoreFitArguments(
         args, requested == "quadric" ? LocalFitMethod::Quadric : LocalFitMethod::PCA);
     return tools::fitEachInputOutOfCore(
@@ -188,19 +168,21 @@ int run(int argc, char** argv) {
         } else {
           LocalFitOptions options = tools::localFitArguments(
               args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
-          options.orient_like_faces = orient != "viewpoint";
+          options.orientation = orient == "viewpoint" ? NormalOrientation::Viewpoint
+                                : orient == "mst"     ? NormalOrientation::SpanningTree
+                                                      : NormalOrientation::MeshFaces;
+          // An organized frame has one sensor: its trees are seeded facing it.
+          options.seed_facing_viewpoint = args.has("viewpoint") || in.points->height > 1;
           tools::Timer timer("Computing " + method + " normals (" +
-                             tools::describeNeighbourhood(options) + ")");
+                             tools::describeNeighbourhood(options) +
+                             (orient == "mst" ? ", oriented along a spanning tree)" : ")"));
           LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
             return fitLocalSurfaces(in.points, in.topology, options);
           }();
           timer.done(in.points->size());
           tools::warnAboutLocalFit(kName, result);
-          // An organized frame has one sensor: its trees are seeded facing it.
-          if (orient == "mst")
-            orientBySpanningTree(in, options, args.has("viewpoint") || in.points->height > 1,
-                                 result.normals);
+          if (orient == "mst") reportSpanningTree(result.orientation);
           if (args.has("normal_map")) saveNormalMap(*args.value("normal_map"), result.normals);
           tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
         }

@@ -18,9 +18,7 @@
 namespace pcl_ddg {
 namespace {
 
-struct GraphEdge {
-  int a, b;  ///< point indices
-};
+using GraphEdge = std::pair<int, int>;  ///< point indices
 
 /** Points with a finite coordinate and normal. */
 std::vector<char> orientablePoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
@@ -51,16 +49,17 @@ ConsistentOrientationReport orientAlongSpanningForest(const pcl::PointCloud<pcl:
   std::vector<std::uint16_t> key(edges.size());
   std::vector<std::int64_t> start(kBuckets + 1, 0);
   for (std::size_t e = 0; e < edges.size(); ++e) {
-    const Eigen::Vector3f na = normals[edges[e].a].getNormalVector3fMap().normalized();
-    const Eigen::Vector3f nb = normals[edges[e].b].getNormalVector3fMap().normalized();
+    const Eigen::Vector3f na = normals[edges[e].first].getNormalVector3fMap().normalized();
+    const Eigen::Vector3f nb = normals[edges[e].second].getNormalVector3fMap().normalized();
     const Eigen::Vector3f along =
-        (cloud[edges[e].b].getVector3fMap() - cloud[edges[e].a].getVector3fMap()).normalized();
+        (cloud[edges[e].second].getVector3fMap() - cloud[edges[e].first].getVector3fMap())
+            .normalized();
     // Hoppe's 1 - |na . nb|, which also finds antiparallel normals cheap: across the two sheets
     // of a thin part (an ear, a leg) the step runs along the normals, so it is charged for that.
     float weight = 1.0f - std::abs(na.dot(nb));
     if (along.allFinite()) weight += 0.5f * (std::abs(na.dot(along)) + std::abs(nb.dot(along)));
-    key[e] = static_cast<std::uint16_t>(std::clamp(0.5f * weight, 0.0f, 1.0f) * (kBuckets - 1) +
-                                        0.5f);
+    key[e] =
+        static_cast<std::uint16_t>(std::clamp(0.5f * weight, 0.0f, 1.0f) * (kBuckets - 1) + 0.5f);
     ++start[key[e] + 1];
   }
   std::partial_sum(start.begin(), start.end(), start.begin());
@@ -73,28 +72,38 @@ ConsistentOrientationReport orientAlongSpanningForest(const pcl::PointCloud<pcl:
   std::vector<GraphEdge> tree;
   tree.reserve(static_cast<std::size_t>(n));
   for (const std::int64_t e : order) {
-    if (!sets.unite(edges[e].a, edges[e].b)) continue;
+    if (!sets.unite(edges[e].first, edges[e].second)) continue;
     tree.push_back(edges[e]);
-    ++degree[edges[e].a + 1];
-    ++degree[edges[e].b + 1];
+    ++degree[edges[e].first + 1];
+    ++degree[edges[e].second + 1];
   }
   std::partial_sum(degree.begin(), degree.end(), degree.begin());
   std::vector<int> adjacent(2 * tree.size()), fill(degree.begin(), degree.end() - 1);
-  for (const GraphEdge& e : tree) {
-    adjacent[fill[e.a]++] = e.b;
-    adjacent[fill[e.b]++] = e.a;
+  for (const auto& [a, b] : tree) {
+    adjacent[fill[a]++] = b;
+    adjacent[fill[b]++] = a;
   }
 
-  // Seeds: points from the highest down; the first point of a tree met is its highest.
-  std::vector<int> by_height;
-  by_height.reserve(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i)
-    if (usable[i]) by_height.push_back(i);
-  std::stable_sort(by_height.begin(), by_height.end(),
-                   [&](int a, int b) { return cloud[a].z > cloud[b].z; });
+  // Seeds: the first point of a tree met in this order. Up: from the highest point down. Facing
+  // a viewpoint: from the point that sees it most squarely, so that no seed is a point seen
+  // edge-on (a sphere's limb), whose sign would be a coin toss.
+  std::vector<float> seed_rank(static_cast<std::size_t>(n), 0.0f);
+  std::vector<int> by_rank;
+  by_rank.reserve(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    if (!usable[i]) continue;
+    by_rank.push_back(i);
+    seed_rank[i] =
+        options.viewpoint
+            ? std::abs(normals[i].getNormalVector3fMap().normalized().dot(
+                  (options.viewpoint->cast<float>() - cloud[i].getVector3fMap()).normalized()))
+            : cloud[i].z;
+  }
+  std::stable_sort(by_rank.begin(), by_rank.end(),
+                   [&](int a, int b) { return seed_rank[a] > seed_rank[b]; });
 
   ConsistentOrientationReport report;
-  report.oriented_points = static_cast<std::int64_t>(by_height.size());
+  report.oriented_points = static_cast<std::int64_t>(by_rank.size());
   std::vector<char> reached(static_cast<std::size_t>(n), 0);
   std::vector<int> queue;
   const auto flip = [&](int i) {
@@ -103,7 +112,7 @@ ConsistentOrientationReport orientAlongSpanningForest(const pcl::PointCloud<pcl:
     normals[i].normal_z = -normals[i].normal_z;
     ++report.flipped_points;
   };
-  for (const int seed : by_height) {
+  for (const int seed : by_rank) {
     if (reached[seed]) continue;
     ++report.components;
     const Eigen::Vector3f n0 = normals[seed].getNormalVector3fMap();
@@ -167,7 +176,7 @@ ConsistentOrientationReport orientNormalsConsistently(const pcl::PointCloud<pcl:
     }
   }
   slots.erase(
-      std::remove_if(slots.begin(), slots.end(), [](const GraphEdge& e) { return e.a < 0; }),
+      std::remove_if(slots.begin(), slots.end(), [](const GraphEdge& e) { return e.first < 0; }),
       slots.end());
   return orientAlongSpanningForest(cloud, normals, usable, slots, options);
 }
@@ -186,9 +195,28 @@ ConsistentOrientationReport orientNormalsConsistently(const MeshTopology& topolo
   edges.reserve(static_cast<std::size_t>(topology.numEdges()));
   for (int e = 0; e < topology.numEdges(); ++e) {
     const int a = topology.edgeVertices()(0, e), b = topology.edgeVertices()(1, e);
-    if (usable[a] && usable[b]) edges.push_back({a, b});
+    if (usable[a] && usable[b]) edges.emplace_back(a, b);
   }
   return orientAlongSpanningForest(cloud, normals, usable, edges, options);
+}
+
+ConsistentOrientationReport orientNormalsConsistently(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                                      pcl::PointCloud<pcl::Normal>& normals,
+                                                      const std::vector<GraphEdge>& edges,
+                                                      const ConsistentOrientationOptions& options) {
+  const std::vector<char> usable = orientablePoints(cloud, normals);
+  const auto outside = [&](int i) { return i < 0 || i >= static_cast<int>(cloud.size()); };
+  std::vector<GraphEdge> usable_edges;
+  usable_edges.reserve(edges.size());
+  for (const auto& [a, b] : edges) {
+    if (outside(a) || outside(b)) {
+      throw pcl::BadArgumentException("orientNormalsConsistently: the edge " + std::to_string(a) +
+                                      "-" + std::to_string(b) + " leaves the cloud of " +
+                                      std::to_string(cloud.size()) + " points");
+    }
+    if (usable[a] && usable[b]) usable_edges.emplace_back(a, b);
+  }
+  return orientAlongSpanningForest(cloud, normals, usable, usable_edges, options);
 }
 
 ConsistentOrientationReport orientNormalsConsistently(
@@ -206,7 +234,7 @@ ConsistentOrientationReport orientNormalsConsistently(
     for (const auto& step : steps) {
       if (!(grid.allowedSteps(i) & (1u << grid.stepBit(step[0], step[1])))) continue;
       const int j = i + step[1] * width + step[0];
-      if (usable[j]) edges.push_back({i, j});
+      if (usable[j]) edges.emplace_back(i, j);
     }
   }
   return orientAlongSpanningForest(*cloud, normals, usable, edges, options);

@@ -12,6 +12,8 @@
 namespace pcl_ddg {
 namespace {
 
+constexpr int kSpanningTreeNeighbours = 10;
+
 template <typename Estimator>
 void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
                const std::shared_ptr<const MeshTopology>& topology, const LocalFitOptions& options,
@@ -32,11 +34,18 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
   } else {
     estimator.setKSearch(options.k);
   }
-  if (topology && options.orient_like_faces) {
-    estimator.setOrientationMesh(topology);
-  } else if (options.viewpoint) {
+  if (options.viewpoint) {
     const Eigen::Vector3f v = options.viewpoint->cast<float>();
     estimator.setViewPoint(v.x(), v.y(), v.z());
+  }
+  if (options.orientation == NormalOrientation::SpanningTree) {
+    // Over the mesh's rings when there is a mesh, else the estimator's own neighbourhoods (the
+    // grid's steps, or the nearest points in space).
+    estimator.setOrientationSpanningTree(
+        kSpanningTreeNeighbours, options.seed_facing_viewpoint,
+        topology ? std::make_shared<MeshRingSearch<pcl::PointXYZ>>(topology) : nullptr);
+  } else if (topology && options.orientation == NormalOrientation::MeshFaces) {
+    estimator.setOrientationMesh(topology);
   }
   estimator.setNumberOfThreads(options.threads);
 }
@@ -76,6 +85,15 @@ LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
     OrganizedNormalResult normals = computeOrganizedPCANormals(cloud, grid);
     result.normals = std::move(normals.normals);
     result.failed_points = normals.failed_points;
+    if (options.orientation == NormalOrientation::SpanningTree) {
+      OrganizedGridSearch<pcl::PointXYZ> steps(options.max_depth_jump);
+      steps.setInputCloud(cloud);
+      ConsistentOrientationOptions tree;
+      if (options.seed_facing_viewpoint)
+        tree.viewpoint = grid.viewpoint.value_or(cloud->sensor_origin_.head<3>().cast<double>());
+      tree.threads = options.threads;
+      result.orientation = orientNormalsConsistently(steps, result.normals, tree);
+    }
     return result;
   }
   if (options.method == LocalFitMethod::PCA) {
@@ -83,12 +101,14 @@ LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
     configure(estimator, cloud, topology, options, indices);
     estimator.compute(result.normals);
     result.failed_points = estimator.getFailedPoints();
+    result.orientation = estimator.getOrientationReport();
   } else {
     QuadricNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
     configure(estimator, cloud, topology, options, indices);
     estimator.computeWithCurvatures(result.normals, result.curvatures);
     result.failed_points = estimator.getFailedPoints();
     result.fallback_points = estimator.getFallbackPoints();
+    result.orientation = estimator.getOrientationReport();
   }
   if (result.normals.size() != (indices ? indices->size() : cloud->size())) {
     throw pcl::ComputeFailedException("normal estimation failed (see the PCL error above)");

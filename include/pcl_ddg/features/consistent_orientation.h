@@ -3,17 +3,20 @@
 // multi-view clouds: a minimum spanning tree over a neighbour graph weighted by 1 - |n_i . n_j|
 // (nearly parallel normals first), and each normal is flipped to agree with its parent in the
 // tree. Each connected component is seeded at its highest point (largest z), whose normal is
-// turned up (+z) or, given a viewpoint, towards it; a component is oriented on its own.
+// turned up (+z), or, given a viewpoint, at the point whose normal faces it most squarely, turned
+// towards it; a component is oriented on its own.
 //
 // The graph is the k nearest neighbours in space, or the mesh's edges, or an organized cloud's
-// jump-free pixel steps (OrganizedGridSearch). Points with a non-finite coordinate or normal take
-// no part and keep their normal.
+// jump-free pixel steps (OrganizedGridSearch), or one the caller gives. Points with a non-finite
+// coordinate or normal take no part and keep their normal.
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <optional>
+#include <utility>
+#include <vector>
 
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/search/organized_grid_search.h"
@@ -46,6 +49,13 @@ ConsistentOrientationReport orientNormalsConsistently(
 ConsistentOrientationReport orientNormalsConsistently(
     const MeshTopology& topology, const pcl::PointCloud<pcl::PointXYZ>& cloud,
     pcl::PointCloud<pcl::Normal>& normals,
+    const ConsistentOrientationOptions& options = ConsistentOrientationOptions());
+
+/** Over the given graph, pairs of point indices (e.g. each point's neighbours from whatever search
+ *  an estimator uses). Throws pcl::BadArgumentException for an index outside the cloud. */
+ConsistentOrientationReport orientNormalsConsistently(
+    const pcl::PointCloud<pcl::PointXYZ>& cloud, pcl::PointCloud<pcl::Normal>& normals,
+    const std::vector<std::pair<int, int>>& edges,
     const ConsistentOrientationOptions& options = ConsistentOrientationOptions());
 
 /** Over the pixel grid of the search's organized cloud (its jump-free steps). */

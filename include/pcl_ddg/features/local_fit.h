@@ -11,6 +11,8 @@
 #include <memory>
 #include <optional>
 
+#include "pcl_ddg/features/consistent_orientation.h"
+#include "pcl_ddg/features/normal_orientation.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 
 namespace pcl_ddg {
@@ -35,8 +37,12 @@ struct LocalFitOptions {
   /** Clouds: normals are turned towards this point (a PCD's VIEWPOINT); unset: the origin, as
    *  PCL does. Meshes are oriented like their faces. */
   std::optional<Eigen::Vector3d> viewpoint;
-  /** With a topology: oriented like its faces; false: towards the viewpoint as clouds are. */
-  bool orient_like_faces = true;
+  /** normal_orientation.h. MeshFaces (the default) orients a mesh like its faces and a cloud
+   *  towards the viewpoint. SpanningTree propagates over the mesh's edges, the pixel grid, or
+   *  the 10 nearest points, as consistent_orientation.h. */
+  NormalOrientation orientation = NormalOrientation::MeshFaces;
+  /** SpanningTree: each tree's seed faces the viewpoint; false: up (+z) at its highest point. */
+  bool seed_facing_viewpoint = false;
 };
 
 struct LocalFitResult {
@@ -44,7 +50,8 @@ struct LocalFitResult {
   /** Quadric only: principal curvatures and directions (see QuadricNormalEstimation). */
   pcl::PointCloud<pcl::PrincipalCurvatures> curvatures;
   std::int64_t failed_points = 0;
-  std::int64_t fallback_points = 0;  ///< quadric: PCA normal used
+  std::int64_t fallback_points = 0;         ///< quadric: PCA normal used
+  ConsistentOrientationReport orientation;  ///< SpanningTree: what the propagation turned
 };
 
 /**
@@ -52,8 +59,9 @@ struct LocalFitResult {
  * organized cloud takes the integral-image path (computeOrganizedPCANormals) over the smallest
  * square window of at least k pixels, and keeps the cloud's width x height. With a topology (one
  * vertex per point) normals are oriented like its faces, whichever neighbourhood is used, so that
- * the two neighbourhoods can be compared point by point; without one, towards the origin as PCL
- * does. Throws pcl::BadArgumentException for MeshRings without a topology or a bad k / radius.
+ * the two neighbourhoods can be compared point by point; without one, towards the viewpoint (the
+ * origin by default) as PCL does; or along a spanning tree (options.orientation). Throws
+ * pcl::BadArgumentException for MeshRings without a topology or a bad k / radius.
  */
 LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
                                 const std::shared_ptr<const MeshTopology>& topology,

@@ -6,7 +6,10 @@
 //
 // Orientation (see normal_orientation.h): by the viewpoint, as PCL does, unless the search method
 // is a MeshRingSearch (or setOrientationMesh was called), in which case by the mesh's faces.
-// setViewPoint chooses the viewpoint explicitly.
+// setViewPoint chooses the viewpoint explicitly. setOrientationSpanningTree makes the normals
+// consistent along a minimum spanning tree of each point's nearest neighbours from the search
+// method (mesh rings, pixel grid or kd-tree: the graph follows the neighbourhood), for clouds
+// without a single viewpoint; the quadric's curvatures change sign with their normals.
 //
 // A point that cannot be estimated (non-finite, or too few finite neighbours) gets NaN output
 // and output.is_dense = false; compute() counts them (getFailedPoints) and warns once.
@@ -16,6 +19,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/normal_orientation.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 
@@ -43,6 +47,22 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
     orientation_ = NormalOrientation::MeshFaces;
     orientation_chosen_ = true;
   }
+  /** Orients normals consistently along a minimum spanning tree over each point's `neighbours`
+   *  nearest (consistent_orientation.h) from `graph` (a search over the same input; null: the
+   *  search method); each tree is seeded facing the viewpoint (setViewPoint before this) if
+   *  seed_facing_viewpoint, else up at its highest point. Only the points being estimated (the
+   *  indices) join the graph. */
+  void setOrientationSpanningTree(int neighbours = 10, bool seed_facing_viewpoint = false,
+                                  typename pcl::search::Search<PointInT>::Ptr graph = nullptr) {
+    spanning_tree_neighbours_ = neighbours;
+    seed_facing_viewpoint_ = seed_facing_viewpoint;
+    spanning_tree_graph_ = std::move(graph);
+    orientation_ = NormalOrientation::SpanningTree;
+    orientation_chosen_ = true;
+  }
+  /** SpanningTree: what the last compute() turned (after the per-point viewpoint sign). */
+  const ConsistentOrientationReport& getOrientationReport() const { return orientation_report_; }
+
   /** The orientation used by the last compute(). */
   NormalOrientation getOrientation() const { return used_orientation_; }
 
@@ -72,8 +92,14 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   template <typename Fit>
   void fitEachNeighbourhood(PointCloudOut& output, Fit&& fit);
 
-  /** Turns n to agree with the reference of query point index (at position p); true if flipped. */
+  /** Turns n to agree with the reference of query point index (at position p); true if flipped.
+   *  SpanningTree: towards the viewpoint, until makeOrientationConsistent. */
   bool orient(Eigen::Vector3d& n, pcl::index_t index, const Eigen::Vector3d& p) const;
+
+  /** SpanningTree only: turns output normals to agree along the tree, calling
+   *  on_turn(output_index) after each normal it turns. */
+  template <typename OnTurn>
+  void makeOrientationConsistent(PointCloudOut& output, OnTurn&& on_turn);
 
   /** Sets every field of a point that cannot be estimated to NaN. */
   virtual void setInvalid(PointOutT& point) const = 0;
@@ -88,6 +114,10 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   NormalOrientation used_orientation_ = NormalOrientation::Viewpoint;
   std::shared_ptr<const MeshTopology> orientation_mesh_;
   Eigen::Matrix3Xd reference_normals_;  ///< MeshFaces: one per input point
+  int spanning_tree_neighbours_ = 10;
+  typename pcl::search::Search<PointInT>::Ptr spanning_tree_graph_;  ///< null: tree_
+  bool seed_facing_viewpoint_ = false;
+  ConsistentOrientationReport orientation_report_;
   unsigned int threads_ = 0;
   std::int64_t failed_points_ = 0;
 };

@@ -1,7 +1,10 @@
 #pragma once
 #include <pcl/common/point_tests.h>
 
+#include <algorithm>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "pcl_ddg/features/local_fit_estimation.h"
 #include "pcl_ddg/features/spatial_order.h"
@@ -37,7 +40,73 @@ bool LocalFitEstimation<PointInT, PointOutT>::initCompute() {
   } else {
     reference_normals_.resize(3, 0);
   }
+  if (used_orientation_ == NormalOrientation::SpanningTree && spanning_tree_neighbours_ < 1) {
+    PCL_ERROR("[pcl_ddg::%s] the spanning tree needs at least 1 neighbour per point, not %d\n",
+              this->getClassName().c_str(), spanning_tree_neighbours_);
+    return false;
+  }
+  if (used_orientation_ == NormalOrientation::SpanningTree && spanning_tree_graph_ &&
+      spanning_tree_graph_->getInputCloud() != this->input_) {
+    spanning_tree_graph_->setInputCloud(this->input_);
+  }
+  orientation_report_ = ConsistentOrientationReport();
   return true;
+}
+
+template <typename PointInT, typename PointOutT>
+template <typename OnTurn>
+void LocalFitEstimation<PointInT, PointOutT>::makeOrientationConsistent(PointCloudOut& output,
+                                                                        OnTurn&& on_turn) {
+  if (used_orientation_ != NormalOrientation::SpanningTree) return;
+  const pcl::Indices& indices = *this->indices_;
+  const int count = static_cast<int>(indices.size());
+  pcl::PointCloud<pcl::PointXYZ> points;
+  pcl::PointCloud<pcl::Normal> normals;
+  points.resize(indices.size());
+  normals.resize(indices.size());
+  std::vector<int> slot(this->input_->size(), -1);  // input index -> output index
+  for (int i = 0; i < count; ++i) {
+    slot[indices[i]] = i;
+    points[i].getVector3fMap() = (*this->input_)[indices[i]].getVector3fMap();
+    normals[i].getNormalVector3fMap() =
+        Eigen::Vector3f(output[i].normal_x, output[i].normal_y, output[i].normal_z);
+  }
+  // Each point's neighbours fill its own slots: the graph does not depend on the threads.
+  const int k = spanning_tree_neighbours_;
+  const pcl::search::Search<PointInT>& graph =
+      spanning_tree_graph_ ? *spanning_tree_graph_ : *this->tree_;
+  std::vector<std::pair<int, int>> edges(static_cast<std::size_t>(count) * k, {-1, -1});
+  int threads = static_cast<int>(threads_);
+#ifdef _OPENMP
+  if (threads == 0) threads = omp_get_num_procs();
+#endif
+#pragma omp parallel num_threads(threads)
+  {
+    pcl::Indices found;
+    std::vector<float> distances;
+#pragma omp for schedule(dynamic, 1024)
+    for (int i = 0; i < count; ++i) {
+      if (!pcl::isNormalFinite(normals[i]) || !pcl::isXYZFinite(points[i])) continue;
+      graph.nearestKSearch(*this->input_, indices[i], k + 1, found, distances);
+      int filled = 0;
+      for (const pcl::index_t j : found) {
+        if (filled == k || slot[j] < 0 || slot[j] == i) continue;
+        edges[static_cast<std::size_t>(i) * k + filled++] = {i, slot[j]};
+      }
+    }
+  }
+  edges.erase(std::remove(edges.begin(), edges.end(), std::pair<int, int>(-1, -1)), edges.end());
+  ConsistentOrientationOptions options;
+  if (seed_facing_viewpoint_) options.viewpoint = viewpoint_;
+  orientation_report_ = orientNormalsConsistently(points, normals, edges, options);
+  for (int i = 0; i < count; ++i) {
+    const Eigen::Vector3f before(output[i].normal_x, output[i].normal_y, output[i].normal_z);
+    if (!(normals[i].getNormalVector3fMap().dot(before) < 0.0f)) continue;
+    output[i].normal_x = normals[i].normal_x;
+    output[i].normal_y = normals[i].normal_y;
+    output[i].normal_z = normals[i].normal_z;
+    on_turn(i);
+  }
 }
 
 template <typename PointInT, typename PointOutT>

@@ -23,6 +23,7 @@ void PCANormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& out
         out.curvature = static_cast<float>(plane.surface_variation);
         return Outcome::Fitted;
       });
+  this->makeOrientationConsistent(output, [](std::size_t) {});
 }
 
 template <typename PointInT, typename PointOutT>

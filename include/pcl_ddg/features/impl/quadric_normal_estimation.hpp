@@ -62,6 +62,22 @@ void QuadricNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut&
         }
         return Outcome::Fitted;
       });
+  // A turned normal turns the shape operator: kappa1, kappa2 become -kappa2, -kappa1, and the
+  // direction of the new kappa1 is the old kappa2's, old normal x old direction1.
+  this->makeOrientationConsistent(output, [&](std::size_t i) {
+    if (!curvatures_) return;
+    pcl::PrincipalCurvatures& c = (*curvatures_)[i];
+    const Eigen::Vector3f old_normal =
+        -Eigen::Vector3f(output[i].normal_x, output[i].normal_y, output[i].normal_z);
+    const Eigen::Vector3f direction2 = old_normal.cross(
+        Eigen::Vector3f(c.principal_curvature_x, c.principal_curvature_y, c.principal_curvature_z));
+    const float pc1 = c.pc1;
+    c.pc1 = -c.pc2;
+    c.pc2 = -pc1;
+    c.principal_curvature_x = direction2.x();
+    c.principal_curvature_y = direction2.y();
+    c.principal_curvature_z = direction2.z();
+  });
 }
 
 template <typename PointInT, typename PointOutT>
