@@ -1,10 +1,13 @@
 // MeshReport: geometric defects (zero area, non-finite) and measures, on hand-made meshes.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
+#include <vector>
 
 #include "analytic_surfaces.h"
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_report.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "test_data.h"
@@ -67,6 +70,28 @@ TEST(MeshReport, MeasuresOfARegularPlaneGrid) {
   EXPECT_EQ(r.bounding_box.min, Eigen::Vector3d(-1, -1, 0));
   EXPECT_EQ(r.bounding_box.max, Eigen::Vector3d(1, 1, 0));
   EXPECT_EQ(r.genus, -1);
+}
+
+TEST(MeshReport, TriangleQualityIsTheSmallestCornerAngle) {
+  // An equilateral triangle (60 degrees), a right isosceles one (45), a thin one whose smallest
+  // corner is 0.5 degrees at the vertex listed last (a sliver), and a zero-area one (skipped).
+  const double thin = std::tan(0.5 * M_PI / 180.0);
+  Eigen::Matrix3Xd p(3, 10);
+  p << 0, 1, 0.5, 2, 3, 2, 4, 5, 4, 6,                //
+      0, 0, std::sqrt(0.75), 0, 0, 1, 0, 0, thin, 0,  //
+      0, 0, 0, 0, 0, 0, 0, 0, 0, 0;
+  const auto quality = [&](const std::vector<std::vector<int>>& faces) {
+    const pcl::PolygonMesh mesh = makeMesh(p, faces);
+    return triangleQuality(MeshTopology(mesh), p);
+  };
+  EXPECT_NEAR(quality({{0, 1, 2}}).min_angle_degrees, 60.0, 1e-12);
+  EXPECT_NEAR(quality({{3, 4, 5}}).min_angle_degrees, 45.0, 1e-12);
+  const TriangleQuality sliver = quality({{0, 1, 2}, {8, 6, 7}});
+  EXPECT_NEAR(sliver.min_angle_degrees, 0.5, 1e-12);
+  EXPECT_EQ(sliver.slivers, 1);
+  const TriangleQuality flat = quality({{3, 4, 5}, {1, 3, 9}});  // 1, 3, 9 on the x axis
+  EXPECT_NEAR(flat.min_angle_degrees, 45.0, 1e-12);
+  EXPECT_EQ(flat.slivers, 0);
 }
 
 TEST(MeshReport, JsonHasEveryDocumentedKey) {

@@ -34,19 +34,26 @@ double meanEdgeLength(const MeshTopology& topology, const Eigen::Matrix3Xd& posi
 TriangleQuality triangleQuality(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
   constexpr double kDegreesPerRadian = 57.295779513082320876798;
   const Eigen::Matrix3Xi& t = topology.triangles();
-  TriangleQuality quality;
-  for (Eigen::Index f = 0; f < t.cols(); ++f) {
+  const std::int64_t triangles = t.cols();
+  double min_angle = 180.0;
+  std::int64_t slivers = 0;
+#pragma omp parallel for schedule(static) reduction(min : min_angle) reduction(+ : slivers)
+  for (std::int64_t f = 0; f < triangles; ++f) {
     const Eigen::Vector3d p[3] = {positions.col(t(0, f)), positions.col(t(1, f)),
                                   positions.col(t(2, f))};
     if (isDegenerateTriangle(p[0], p[1], p[2])) continue;
-    double smallest = 180.0;
-    for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector3d u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
-      smallest = std::min(smallest, kDegreesPerRadian * std::atan2(u.cross(v).norm(), u.dot(v)));
-    }
-    quality.min_angle_degrees = std::min(quality.min_angle_degrees, smallest);
-    quality.slivers += smallest < kSliverAngleDegrees;
+    // The smallest angle is opposite the shortest side (law of sines): one atan2, not three.
+    const double opposite[3] = {(p[2] - p[1]).squaredNorm(), (p[0] - p[2]).squaredNorm(),
+                                (p[1] - p[0]).squaredNorm()};
+    const int k = static_cast<int>(std::min_element(opposite, opposite + 3) - opposite);
+    const Eigen::Vector3d u = p[(k + 1) % 3] - p[k], v = p[(k + 2) % 3] - p[k];
+    const double smallest = kDegreesPerRadian * std::atan2(u.cross(v).norm(), u.dot(v));
+    min_angle = std::min(min_angle, smallest);
+    slivers += smallest < kSliverAngleDegrees;
   }
+  TriangleQuality quality;
+  quality.min_angle_degrees = min_angle;
+  quality.slivers = slivers;
   return quality;
 }
 

@@ -110,11 +110,15 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
                      lumpedMass(topology, at, p.mass));
   };
 
+  // The before and after measures are for the report, and the shrinkage corrections' targets.
+  const bool closed = isClosedAndOriented(topology);
   MeshSmoothingReport r;
   r.solver = flow.backend();
-  r.area_before = surfaceArea(topology, positions);
-  r.quality_before = triangleQuality(topology, positions);
-  if (isClosedAndOriented(topology)) r.volume_before = enclosedVolume(topology, positions);
+  if (report || p.shrinkage == ShrinkageCorrection::PreserveArea)
+    r.area_before = surfaceArea(topology, positions);
+  if (closed && (report || p.shrinkage == ShrinkageCorrection::PreserveVolume))
+    r.volume_before = enclosedVolume(topology, positions);
+  if (report) r.quality_before = triangleQuality(topology, positions);
 
   Eigen::Matrix3Xd current = positions;
   Eigen::MatrixXd values = positions.transpose();  // one column per coordinate
@@ -158,10 +162,12 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
     r.iterations = iteration;
     if (progress) progress(iteration, p.iterations);
   }
-  r.area_after = surfaceArea(topology, current);
-  r.quality_after = triangleQuality(topology, current);
-  if (isClosedAndOriented(topology)) r.volume_after = enclosedVolume(topology, current);
-  if (report) *report = r;
+  if (report) {
+    r.area_after = surfaceArea(topology, current);
+    r.quality_after = triangleQuality(topology, current);
+    if (closed) r.volume_after = enclosedVolume(topology, current);
+    *report = r;
+  }
   return current;
 }
 
