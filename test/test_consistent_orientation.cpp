@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "analytic_surfaces.h"
 #include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/features/normal_orientation.h"
@@ -220,6 +221,37 @@ TEST(ConsistentOrientation, AnOrientationModeOfTheEstimators) {
   EXPECT_EQ(agreement(normals, ring.normals), 1.0);
   EXPECT_EQ(pca.getOrientationReport().components, 1);
   EXPECT_GT(pca.getOrientationReport().flippedShare(), 0.3);  // the outer half, turned
+
+  // Over a separate search surface the search answers in the surface's indices: refused.
+  pca.setSearchSurface(std::make_shared<pcl::PointCloud<pcl::PointXYZ>>(*points));
+  pca.compute(normals);
+  EXPECT_TRUE(normals.empty());
+}
+
+TEST(ConsistentOrientation, EachOrientationOfFitLocalSurfacesOnAMesh) {
+  // An icosphere about the origin with outward faces, fitted over its mesh rings: like the faces
+  // (out), towards the viewpoint (the origin: in, the faces notwithstanding), along the tree
+  // seeded up (out).
+  const test::SurfaceSample sphere = test::makeIcosphere(4);
+  const auto topology = std::make_shared<const MeshTopology>(static_cast<int>(sphere.points.cols()),
+                                                             sphere.triangles);
+  auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  pcl::PointCloud<pcl::Normal> outward;
+  for (Eigen::Index v = 0; v < sphere.points.cols(); ++v) {
+    const Eigen::Vector3f p = sphere.points.col(v).cast<float>();
+    const Eigen::Vector3f n = sphere.normals.col(v).cast<float>();
+    points->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    outward.push_back(pcl::Normal(n.x(), n.y(), n.z()));
+  }
+  for (const auto& [orientation, expected] :
+       {std::pair{NormalOrientation::MeshFaces, 1.0}, std::pair{NormalOrientation::Viewpoint, 0.0},
+        std::pair{NormalOrientation::SpanningTree, 1.0}}) {
+    LocalFitOptions options;
+    options.neighbourhood = NeighbourhoodKind::MeshRings;
+    options.orientation = orientation;
+    const LocalFitResult fit = fitLocalSurfaces(points, topology, options);
+    EXPECT_EQ(agreement(fit.normals, outward), expected) << static_cast<int>(orientation);
+  }
 }
 
 TEST(ConsistentOrientation, QuadricCurvaturesTurnWithTheirNormals) {

@@ -34,10 +34,9 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
   } else {
     estimator.setKSearch(options.k);
   }
-  if (options.viewpoint) {
-    const Eigen::Vector3f v = options.viewpoint->cast<float>();
-    estimator.setViewPoint(v.x(), v.y(), v.z());
-  }
+  // The orientation by default, and the spanning tree's seeds' or the faces' fallback.
+  const Eigen::Vector3f v = options.viewpoint.value_or(Eigen::Vector3d::Zero()).cast<float>();
+  estimator.setViewPoint(v.x(), v.y(), v.z());
   if (options.orientation == NormalOrientation::SpanningTree) {
     // Over the mesh's rings when there is a mesh, else the estimator's own neighbourhoods (the
     // grid's steps, or the nearest points in space).

@@ -45,6 +45,15 @@ bool LocalFitEstimation<PointInT, PointOutT>::initCompute() {
               this->getClassName().c_str(), spanning_tree_neighbours_);
     return false;
   }
+  if (used_orientation_ == NormalOrientation::SpanningTree && !spanning_tree_graph_ &&
+      this->surface_ != this->input_) {
+    // The search method answers in the surface's indices, which are not the graph's points.
+    PCL_ERROR(
+        "[pcl_ddg::%s] a spanning tree over a separate search surface needs a graph over "
+        "the input (setOrientationSpanningTree's third argument)\n",
+        this->getClassName().c_str());
+    return false;
+  }
   if (used_orientation_ == NormalOrientation::SpanningTree && spanning_tree_graph_ &&
       spanning_tree_graph_->getInputCloud() != this->input_) {
     spanning_tree_graph_->setInputCloud(this->input_);
