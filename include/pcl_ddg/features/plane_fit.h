@@ -35,8 +35,9 @@ struct PlaneNormal {
 /** The smallest eigenpair of a covariance (about the centroid, divided by the number of points):
  *  the eigenvalues in closed form, then only the smallest one's eigenvector, as the
  *  best-conditioned cross product of rows of A - lambda0 I. fitPlane's normal and surface
- *  variation up to rounding, at half the cost (the closed-form solver also finds the other two
- *  eigenvectors). */
+ *  variation up to rounding (both closed forms are good to rounding * (l2 / (l1 - l0))^2 in the
+ *  normal), at half the cost: the solver behind fitPlane also finds the other two eigenvectors.
+ *  Unlike fitPlane, an isotropic covariance (no preferred direction) is not valid. */
 PlaneNormal fitPlaneNormal(const Eigen::Matrix3d& covariance);
 
 /** fitPlaneNormal of the first count columns of points, their covariance formed as in fitPlane. */
