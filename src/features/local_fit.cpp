@@ -85,13 +85,11 @@ LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
     result.normals = std::move(normals.normals);
     result.failed_points = normals.failed_points;
     if (options.orientation == NormalOrientation::SpanningTree) {
-      OrganizedGridSearch<pcl::PointXYZ> steps(options.max_depth_jump);
-      steps.setInputCloud(cloud);
       ConsistentOrientationOptions tree;
       if (options.seed_facing_viewpoint)
         tree.viewpoint = grid.viewpoint.value_or(cloud->sensor_origin_.head<3>().cast<double>());
       tree.threads = options.threads;
-      result.orientation = orientNormalsConsistently(steps, result.normals, tree);
+      result.orientation = orientNormalsConsistently(*normals.grid, result.normals, tree);
     }
     return result;
   }

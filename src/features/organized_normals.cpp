@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <utility>
 #include <vector>
 
 #include "pcl_ddg/features/plane_fit.h"
@@ -297,6 +298,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
   result.failed_points = failed;
   result.window_points = window_points;
   result.jump_points = jump_points;
+  result.grid = std::move(search);
   return result;
 }
 

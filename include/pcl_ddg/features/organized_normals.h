@@ -18,6 +18,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <memory>
 #include <optional>
 
 #include "pcl_ddg/search/organized_grid_search.h"
@@ -39,6 +40,9 @@ struct OrganizedNormalResult {
   std::int64_t failed_points = 0;  ///< finite points without a plane (< 3 neighbours, a line)
   std::int64_t window_points = 0;  ///< fitted from the integral images (the whole window)
   std::int64_t jump_points = 0;    ///< a jump (or hole) cuts the window: fitted point by point
+  /** The pixel grid the windows were cut by, for further work on the same cloud (e.g. orienting
+   *  the normals along it) without building it again. */
+  std::shared_ptr<const OrganizedGridSearch<pcl::PointXYZ>> grid;
 };
 
 /** Throws pcl::BadArgumentException unless cloud is organized, window_radius >= 1 and
