@@ -84,6 +84,13 @@ bool isMeshMethod(NormalMethod method) {
   return method != NormalMethod::PCA && method != NormalMethod::Quadric;
 }
 
+std::vector<std::pair<NormalMethod, bool>> methodsOffered(const InputCapabilities& input) {
+  std::vector<std::pair<NormalMethod, bool>> offered;
+  for (const auto& [method, name] : kMethods)
+    offered.emplace_back(method, input.is_mesh || !isMeshMethod(method));
+  return offered;
+}
+
 ViewerState initialState(const InputCapabilities& input) {
   ViewerState state;
   if (!input.is_mesh) {

@@ -5,6 +5,7 @@
 // the equivalent command reach exactly the same state.
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace pcl_ddg {
@@ -85,6 +86,10 @@ std::string keyHelp();
 
 const char* methodName(NormalMethod method);
 bool isMeshMethod(NormalMethod method);
+
+/** Every normal method, in the order 'm' steps through them, with whether the input offers it
+ *  (the mesh methods not on a cloud): the window lists them all and greys out the others. */
+std::vector<std::pair<NormalMethod, bool>> methodsOffered(const InputCapabilities& input);
 
 }  // namespace viewer
 }  // namespace pcl_ddg

@@ -1,6 +1,7 @@
 #include "viewer/viewer_window.h"
 
 #include <X11/Xlib.h>
+#include <poll.h>
 #include <vtkActor.h>
 #include <vtkCellArray.h>
 #include <vtkFloatArray.h>
@@ -30,6 +31,10 @@
 namespace pcl_ddg {
 namespace viewer {
 namespace {
+
+// How long one turn of the event loop may wait for an X event: the bound on how late a frame
+// finished by the worker thread is drawn.
+constexpr int kEventWaitMs = 10;
 
 vtkRenderer* rendererOf(pcl::visualization::PCLVisualizer& visualizer) {
   return visualizer.getRendererCollection()->GetFirstRenderer();
@@ -92,7 +97,9 @@ std::string displayProblem() {
 
 ViewerWindow::ViewerWindow(ViewerModel& model, int width, int height)
     : model_(model), pending_(initialState(model.capabilities())) {
-  visualizer_ = std::make_unique<pcl::visualization::PCLVisualizer>("pcl_ddg_viewer");
+  const std::string& path = model_.path();
+  visualizer_ = std::make_unique<pcl::visualization::PCLVisualizer>(
+      "pcl_ddg_viewer: " + path.substr(path.find_last_of('/') + 1));
   visualizer_->setSize(width, height);
   visualizer_->setBackgroundColor(0.12, 0.12, 0.14);
   visualizer_->setShowFPS(false);
@@ -103,6 +110,24 @@ ViewerWindow::ViewerWindow(ViewerModel& model, int width, int height)
   text_->GetTextProperty()->SetColor(0.95, 0.95, 0.95);
   text_->SetDisplayPosition(10, 10);
   rendererOf(*visualizer_)->AddActor2D(text_);
+  addMethodLabels(height);
+}
+
+void ViewerWindow::addMethodLabels(int height) {
+  vtkRenderer* renderer = rendererOf(*visualizer_);
+  double x = 10;
+  for (const auto& [method, offered] : methodsOffered(model_.capabilities())) {
+    auto label = vtkSmartPointer<vtkTextActor>::New();
+    label->SetInput(methodName(method));
+    label->GetTextProperty()->SetFontSize(13);
+    label->GetTextProperty()->SetVerticalJustificationToTop();
+    label->SetDisplayPosition(static_cast<int>(x), height - 8);
+    renderer->AddActor2D(label);
+    double box[4];
+    label->GetBoundingBox(renderer, box);
+    x += box[1] - box[0] + 12;
+    method_labels_.push_back({method, offered, label});
+  }
 }
 
 ViewerWindow::~ViewerWindow() {
@@ -199,9 +224,29 @@ void ViewerWindow::takeScreenshot() {
   std::cout << "pcl_ddg_viewer: wrote " << name << "\n";
 }
 
+void ViewerWindow::processEvents() {
+  // Not PCLVisualizer::spinOnce(), which is VTK 9.1's ProcessEvents(): with no X event pending
+  // that waits in select() for one, or for a VTK timer, up to a second, so a frame finished by the
+  // worker waited that long to be drawn (a cached switch took 2.7 s, mostly waiting). A VTK timer
+  // cannot bound the wait: PCL's interactor style renders on every timer event. So the wait is
+  // ours, on the X connection, and VTK dispatches only what is pending.
+  // The connection is looked up afresh each time: closing the window ('q') closes it.
+  const auto display = [this] {
+    return static_cast<Display*>(visualizer_->getRenderWindow()->GetGenericDisplayId());
+  };
+  if (display() == nullptr) return;
+  if (XPending(display()) == 0) {
+    pollfd connection{ConnectionNumber(display()), POLLIN, 0};
+    poll(&connection, 1, kEventWaitMs);
+  }
+  while (!visualizer_->wasStopped() && display() != nullptr && XPending(display()) != 0) {
+    interactor()->ProcessEvents();
+  }
+}
+
 void ViewerWindow::run() {
   while (!visualizer_->wasStopped()) {
-    visualizer_->spinOnce(15);
+    processEvents();
     step();
     renderIfChanged();
   }
@@ -211,7 +256,7 @@ bool ViewerWindow::runUntilIdle(double timeout_seconds) {
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_seconds);
   while (std::chrono::steady_clock::now() < deadline) {
-    visualizer_->spinOnce(5);
+    processEvents();
     const bool idle = step() && !computing_.valid() && queue_.empty();
     renderIfChanged();
     if (idle) return true;
@@ -236,7 +281,7 @@ void ViewerWindow::draw(const Frame& frame) {
     color_bar_->SetTitle(frame.field_label.c_str());
     color_bar_->SetNumberOfLabels(5);
     color_bar_->SetOrientationToHorizontal();
-    color_bar_->SetPosition(0.55, 0.88);
+    color_bar_->SetPosition(0.55, 0.8);  // below the row of method names
     color_bar_->SetWidth(0.42);
     color_bar_->SetHeight(0.1);
     color_bar_->GetTitleTextProperty()->SetFontSize(12);
@@ -397,6 +442,12 @@ void ViewerWindow::drawOverlay(const Frame& frame, const std::string& status) {
   for (const std::string& warning : frame.warnings) text << "\n! " << warning;
   for (const std::string& note : notes_) text << "\n! " << note;
   text_->SetInput(text.str().c_str());
+  for (const MethodLabel& label : method_labels_) {
+    const bool current = label.method == frame.state.method;
+    const double grey = current ? 1.0 : label.offered ? 0.7 : 0.35;
+    label.actor->GetTextProperty()->SetColor(grey, grey, grey);
+    label.actor->GetTextProperty()->SetBold(current);
+  }
   needs_render_ = true;
 }
 

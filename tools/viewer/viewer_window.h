@@ -50,6 +50,8 @@ class ViewerWindow {
 
  private:
   void onKey(const pcl::visualization::KeyboardEvent& event);
+  /** Dispatches the pending X events and VTK timers, waiting at most kEventWaitMs for one. */
+  void processEvents();
   /** Collects a finished computation and starts the next one; true when idle afterwards. */
   bool step();
   void draw(const Frame& frame);
@@ -59,6 +61,7 @@ class ViewerWindow {
   void drawSurface(const Frame& frame);
   void drawNormals(const Frame& frame);
   void drawOverlay(const Frame& frame, const std::string& status);
+  void addMethodLabels(int height);
   void takeScreenshot();
 
   ViewerModel& model_;
@@ -76,6 +79,13 @@ class ViewerWindow {
   vtkSmartPointer<vtkActor> surface_, glyphs_;
   vtkSmartPointer<vtkPolyData> surface_data_;
   vtkSmartPointer<vtkTextActor> text_;
+  /** The normal methods along the top, the current one bright, those the input lacks greyed. */
+  struct MethodLabel {
+    NormalMethod method;
+    bool offered;
+    vtkSmartPointer<vtkTextActor> actor;
+  };
+  std::vector<MethodLabel> method_labels_;
   vtkSmartPointer<vtkScalarBarActor> color_bar_;
   vtkSmartPointer<vtkCellArray> cells_;  ///< triangles or vertices: the same in every frame
   vtkSmartPointer<vtkPoints> points_;    ///< of points_of_
