@@ -7,7 +7,8 @@
 //   clouds  points sampled on igea.ply's surface: load -> PCA normals through the kd-tree, k = 16
 // Reported per size: ns per element for each phase and in all, peak bytes per vertex (above the
 // process's own footprint before loading), and the ratio of the largest size's time per element
-// to the smallest's.
+// to the smallest's. With --write-cloud=COUNT:PATH it only writes such a cloud (for
+// bench_out_of_core.sh).
 #include <benchmark/benchmark.h>
 #include <pcl/conversions.h>
 #include <sys/resource.h>
@@ -108,6 +109,37 @@ void writeMesh(const std::string& path, const Eigen::Matrix3Xd& points,
   }
 }
 
+// A binary PLY cloud of `count` points on igea's surface, area-weighted, in triangle order.
+void writeSampledCloud(const std::string& path, std::int64_t count) {
+  const MeshFile igea = readMeshFile(sharedMesh("igea.ply"));
+  const MeshTopology topology(igea.mesh);
+  const Eigen::Matrix3Xi& t = topology.triangles();
+  std::vector<double> area(t.cols());
+  for (Eigen::Index i = 0; i < t.cols(); ++i) {
+    const Eigen::Vector3d a = igea.positions.col(t(0, i));
+    area[i] = (igea.positions.col(t(1, i)) - a).cross(igea.positions.col(t(2, i)) - a).norm();
+  }
+  std::mt19937_64 random(count);
+  std::discrete_distribution<Eigen::Index> triangle(area.begin(), area.end());
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Eigen::Index> picked(static_cast<std::size_t>(count));
+  for (auto& p : picked) p = triangle(random);
+  std::sort(picked.begin(), picked.end());
+  std::ofstream out(path, std::ios::binary);
+  out << "ply\nformat binary_little_endian 1.0\nelement vertex " << count
+      << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+  for (const Eigen::Index i : picked) {
+    double u = unit(random), v = unit(random);
+    if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
+    const Eigen::Vector3d a = igea.positions.col(t(0, i));
+    const Eigen::Vector3f p =
+        (a + u * (igea.positions.col(t(1, i)) - a) + v * (igea.positions.col(t(2, i)) - a))
+            .cast<float>();
+    out.write(reinterpret_cast<const char*>(p.data()), 12);
+  }
+  if (!out) throw std::runtime_error("cannot write " + path);
+}
+
 void makeInputs(const std::string& folder) {
   const std::pair<const char*, int> meshes[] = {
       {"igea.ply", 1}, {"igea.ply", 2}, {"bumpy.off", 6}, {"rocker-arm.off", 5}};
@@ -122,35 +154,9 @@ void makeInputs(const std::string& folder) {
     writeMesh(path, points, triangles);
     inputs().push_back({label.str(), path, triangles.cols(), false});
   }
-  // Clouds: points on igea's surface, area-weighted, in triangle order.
-  const MeshFile igea = readMeshFile(sharedMesh("igea.ply"));
-  const MeshTopology topology(igea.mesh);
-  const Eigen::Matrix3Xi& t = topology.triangles();
-  std::vector<double> area(t.cols());
-  for (Eigen::Index i = 0; i < t.cols(); ++i) {
-    const Eigen::Vector3d a = igea.positions.col(t(0, i));
-    area[i] = (igea.positions.col(t(1, i)) - a).cross(igea.positions.col(t(2, i)) - a).norm();
-  }
   for (const std::int64_t count : {1000000LL, 10000000LL, 50000000LL}) {
-    std::mt19937_64 random(count);
-    std::discrete_distribution<Eigen::Index> triangle(area.begin(), area.end());
-    std::uniform_real_distribution<double> unit(0.0, 1.0);
-    std::vector<Eigen::Index> picked(static_cast<std::size_t>(count));
-    for (auto& p : picked) p = triangle(random);
-    std::sort(picked.begin(), picked.end());
     const std::string path = folder + "/" + std::to_string(count / 1000000) + "M_points.ply";
-    std::ofstream out(path, std::ios::binary);
-    out << "ply\nformat binary_little_endian 1.0\nelement vertex " << count
-        << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-    for (const Eigen::Index i : picked) {
-      double u = unit(random), v = unit(random);
-      if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
-      const Eigen::Vector3d a = igea.positions.col(t(0, i));
-      const Eigen::Vector3f p =
-          (a + u * (igea.positions.col(t(1, i)) - a) + v * (igea.positions.col(t(2, i)) - a))
-              .cast<float>();
-      out.write(reinterpret_cast<const char*>(p.data()), 12);
-    }
+    writeSampledCloud(path, count);
     inputs().push_back({"cloud/" + std::to_string(count / 1000000) + "M", path, count, true});
   }
 }
@@ -248,6 +254,12 @@ void scale(benchmark::State& state, const Input* input) {
 
 int main(int argc, char** argv) {
   using namespace pcl_ddg::bench;
+  if (argc == 2 && std::string(argv[1]).rfind("--write-cloud=", 0) == 0) {
+    // For bench_out_of_core.sh: --write-cloud=COUNT:PATH
+    const std::string spec = std::string(argv[1]).substr(14);
+    writeSampledCloud(spec.substr(spec.find(':') + 1), std::stoll(spec.substr(0, spec.find(':'))));
+    return 0;
+  }
   if (argc == 2 && std::string(argv[1]).rfind("--pipeline=", 0) == 0) {
     const std::string spec = std::string(argv[1]).substr(11);
     return runPipeline(spec.substr(spec.find(':') + 1), spec.rfind("cloud:", 0) == 0);
