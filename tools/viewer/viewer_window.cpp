@@ -341,14 +341,12 @@ void ViewerWindow::drawSurface(const Frame& frame) {
       }
     }
   }
+  // Colours and normals go to VTK only when they changed: a new array is uploaded to the GPU
+  // again, 14 MB of normals for a million vertices.
   auto colors = vtkSmartPointer<vtkUnsignedCharArray>::New();
   colors->SetNumberOfComponents(3);
   colors->SetName("colors");
   colors->SetNumberOfTuples(n);
-  auto normals = vtkSmartPointer<vtkFloatArray>::New();
-  normals->SetNumberOfComponents(3);
-  normals->SetName("normals");
-  normals->SetNumberOfTuples(n);
   // Points are drawn unlit (VTK lights them one-sided and from the camera); uncoloured, they are
   // shaded grey by how squarely their normal faces the sensor, so that the shape shows.
   const bool shade_points = !model_.isMesh() && frame.field_label.empty();
@@ -364,10 +362,23 @@ void ViewerWindow::drawSurface(const Frame& frame) {
     } else {
       colors->SetTypedTuple(i, frame.colors.col(i).data());
     }
-    const Eigen::Vector3f normal = frame.normals->col(i).allFinite()
-                                       ? Eigen::Vector3f(frame.normals->col(i).cast<float>())
-                                       : Eigen::Vector3f::Zero();
-    normals->SetTypedTuple(i, normal.data());
+  }
+  const bool same_colors = colors_ && std::equal(colors->GetPointer(0), colors->GetPointer(3 * n),
+                                                 colors_->GetPointer(0));
+  if (!same_colors) colors_ = colors;
+  if (normals_of_ != frame.normals.get()) {
+    normals_ = vtkSmartPointer<vtkFloatArray>::New();
+    normals_->SetNumberOfComponents(3);
+    normals_->SetName("normals");
+    normals_->SetNumberOfTuples(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const Eigen::Vector3f normal = frame.normals->col(i).allFinite()
+                                         ? Eigen::Vector3f(frame.normals->col(i).cast<float>())
+                                         : Eigen::Vector3f::Zero();
+      normals_->SetTypedTuple(i, normal.data());
+    }
+    normals_of_ = frame.normals.get();
+    normals_owner_ = frame.normals;
   }
   // One polydata and mapper for the window's life: a new frame replaces arrays, so the mapper
   // keeps its shaders and the triangle index buffer.
@@ -387,8 +398,9 @@ void ViewerWindow::drawSurface(const Frame& frame) {
     rendererOf(*visualizer_)->AddActor(surface_);
   }
   if (surface_data_->GetPoints() != points_) surface_data_->SetPoints(points_);
-  surface_data_->GetPointData()->SetScalars(colors);
-  surface_data_->GetPointData()->SetNormals(normals);
+  vtkPointData* point_data = surface_data_->GetPointData();
+  if (point_data->GetScalars() != colors_) point_data->SetScalars(colors_);
+  if (point_data->GetNormals() != normals_) point_data->SetNormals(normals_);
   vtkProperty* property = surface_->GetProperty();
   if (frame.state.smooth_shading) {
     property->SetInterpolationToGouraud();

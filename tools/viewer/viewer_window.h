@@ -17,10 +17,12 @@
 
 class vtkActor;
 class vtkCellArray;
+class vtkFloatArray;
 class vtkPoints;
 class vtkPolyData;
 class vtkScalarBarActor;
 class vtkTextActor;
+class vtkUnsignedCharArray;
 class vtkRenderWindowInteractor;
 
 namespace pcl_ddg {
@@ -91,6 +93,10 @@ class ViewerWindow {
   vtkSmartPointer<vtkPoints> points_;    ///< of points_of_
   const Eigen::Matrix3Xd* points_of_ = nullptr;
   std::shared_ptr<const Eigen::Matrix3Xd> points_owner_;  ///< keeps points_of_ alive
+  vtkSmartPointer<vtkUnsignedCharArray> colors_;          ///< on screen
+  vtkSmartPointer<vtkFloatArray> normals_;                ///< of normals_of_
+  const Eigen::Matrix3Xd* normals_of_ = nullptr;
+  std::shared_ptr<const Eigen::Matrix3Xd> normals_owner_;  ///< keeps normals_of_ alive
 };
 
 /** One line saying why no window can open (no DISPLAY, or an X server that does not answer), or
