@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "pcl_ddg/features/plane_fit.h"
 
@@ -60,6 +61,77 @@ TEST(PlaneFit, SmallestEigenpairOfKnownMatricesFromFlatToNearlyIsotropic) {
     EXPECT_NEAR(fast.surface_variation, variation, 1e-15 / gap) << trial;
     EXPECT_NEAR(full.surface_variation, variation, 1e-15 / gap) << trial;
   }
+}
+
+/** fitPlaneNormals over the given matrices, as PlaneNormals. */
+std::vector<PlaneNormal> fitMany(const std::vector<Eigen::Matrix3d>& matrices) {
+  const std::size_t n = matrices.size();
+  std::vector<double> xx(n), xy(n), xz(n), yy(n), yz(n), zz(n), nx(n), ny(n), nz(n), variation(n);
+  std::vector<std::uint8_t> valid(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    xx[i] = matrices[i](0, 0), xy[i] = matrices[i](0, 1), xz[i] = matrices[i](0, 2);
+    yy[i] = matrices[i](1, 1), yz[i] = matrices[i](1, 2), zz[i] = matrices[i](2, 2);
+  }
+  fitPlaneNormals(static_cast<int>(n),
+                  {xx.data(), xy.data(), xz.data(), yy.data(), yz.data(), zz.data()},
+                  {nx.data(), ny.data(), nz.data(), variation.data(), valid.data()});
+  std::vector<PlaneNormal> planes(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    planes[i].valid = valid[i] != 0;
+    planes[i].normal = Eigen::Vector3d(nx[i], ny[i], nz[i]);
+    planes[i].surface_variation = variation[i];
+  }
+  return planes;
+}
+
+TEST(PlaneFit, ManyAtOnceAgreeWithTheClosedFormOnKnownMatrices) {
+  // The same range as above; in a batch whose length is not a multiple of the vector blocks.
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<KnownCovariance> known;
+  std::vector<Eigen::Matrix3d> matrices;
+  for (int trial = 0; trial < 20011; ++trial) {
+    const double l2 = std::pow(10.0, -12.0 + 24.0 * unit(random));
+    const double l1 = l2 * std::pow(10.0, -3.0 * unit(random));
+    const double l0 =
+        l1 * (trial % 4 == 0 ? 0.99 * unit(random) : std::pow(10.0, -9.0 * unit(random)));
+    known.push_back(rotated({l0, l1, l2}, random));
+    matrices.push_back(known.back().matrix);
+  }
+  const std::vector<PlaneNormal> planes = fitMany(matrices);
+  for (std::size_t i = 0; i < known.size(); ++i) {
+    const Eigen::Vector3d& l = known[i].eigenvalues;
+    const double gap = (l[1] - l[0]) / l[2];
+    ASSERT_TRUE(planes[i].valid) << i;
+    EXPECT_LT(angleBetweenLines(planes[i].normal, known[i].normal), 1e-15 / (gap * gap))
+        << i << " " << l.transpose() << " closed form "
+        << angleBetweenLines(fitPlaneNormal(matrices[i]).normal, known[i].normal);
+    EXPECT_NEAR(planes[i].normal.norm(), 1.0, 1e-15);
+    EXPECT_NEAR(planes[i].surface_variation, l[0] / l.sum(), 1e-15 / gap) << i;
+  }
+}
+
+TEST(PlaneFit, ManyAtOnceRejectWhatTheClosedFormRejects) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double infinity = std::numeric_limits<double>::infinity();
+  Eigen::Matrix3d line;
+  line << 1, 2, 3, 2, 4, 6, 3, 6, 9;  // rank one: all points on a line
+  Eigen::Matrix3d poisoned = Eigen::Matrix3d::Identity();
+  poisoned(2, 2) = 2.0;
+  poisoned(0, 1) = poisoned(1, 0) = nan;
+  Eigen::Matrix3d unbounded = poisoned;
+  unbounded(0, 1) = unbounded(1, 0) = infinity;
+  Eigen::Matrix3d nan_diagonal = Eigen::Matrix3d::Identity();
+  nan_diagonal(0, 0) = nan;
+  const std::vector<Eigen::Matrix3d> bad = {line,
+                                            Eigen::Matrix3d::Zero(),
+                                            Eigen::Matrix3d::Identity(),
+                                            poisoned,
+                                            unbounded,
+                                            nan_diagonal,
+                                            Eigen::Matrix3d::Constant(infinity)};
+  for (const PlaneNormal& plane : fitMany(bad)) EXPECT_FALSE(plane.valid);
+  for (const Eigen::Matrix3d& matrix : bad) EXPECT_FALSE(fitPlaneNormal(matrix).valid);
 }
 
 TEST(PlaneFit, PointsOnAPlaneHaveItsNormalAndNoVariation) {

@@ -1,6 +1,7 @@
 #pragma once
 // Least-squares plane through a neighbourhood: the PCA of its points.
 #include <Eigen/Core>
+#include <cstdint>
 
 namespace pcl_ddg {
 
@@ -42,5 +43,24 @@ PlaneNormal fitPlaneNormal(const Eigen::Matrix3d& covariance);
 
 /** fitPlaneNormal of the first count columns of points, their covariance formed as in fitPlane. */
 PlaneNormal fitPlaneNormal(const Eigen::Matrix3Xd& points, int count);
+
+/** Many covariances side by side, one array per entry (structure of arrays). */
+struct CovarianceArrays {
+  const double *xx, *xy, *xz, *yy, *yz, *zz;
+};
+
+/** Where fitPlaneNormals writes: one array per component; valid[i] is 0 or 1. */
+struct PlaneNormalArrays {
+  double *normal_x, *normal_y, *normal_z, *surface_variation;
+  std::uint8_t* valid;
+};
+
+/** fitPlaneNormal of covariances 0 .. count - 1, equal to it up to rounding, several at once in
+ *  the CPU's vector lanes: the smallest eigenvalue by Newton's method on the characteristic
+ *  polynomial from 0, which rises monotonically to it without trigonometry. The few covariances
+ *  where it has not converged within a fixed number of steps (l0 close to l1: nearly isotropic
+ *  neighbourhoods, never good planes) go to fitPlaneNormal. */
+void fitPlaneNormals(int count, const CovarianceArrays& covariances,
+                     const PlaneNormalArrays& planes);
 
 }  // namespace pcl_ddg

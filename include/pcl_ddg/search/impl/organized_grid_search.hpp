@@ -70,7 +70,7 @@ void OrganizedGridSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud,
   steps_.resize(range_.size());
 #pragma omp parallel for schedule(static)
   for (int y = 0; y < height_; ++y) {
-    for (int x = 0; x < width_; ++x) {
+    const auto stepsAt = [&](int x) {
       const pcl::index_t from = static_cast<pcl::index_t>(y) * width_ + x;
       std::uint8_t bits = 0;
       for (int dy = -1; dy <= 1; ++dy) {
@@ -81,7 +81,30 @@ void OrganizedGridSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud,
             bits |= static_cast<std::uint8_t>(1u << stepBit(dx, dy));
         }
       }
-      steps_[from] = bits;
+      return bits;
+    };
+    std::uint8_t* steps = &steps_[static_cast<std::size_t>(y) * width_];
+    if (y == 0 || y == height_ - 1 || width_ < 3) {
+      for (int x = 0; x < width_; ++x) steps[x] = stepsAt(x);
+      continue;
+    }
+    // Inside the image every pixel has 8 neighbours: no bounds to test, the same tests for all.
+    steps[0] = stepsAt(0);
+    steps[width_ - 1] = stepsAt(width_ - 1);
+    const float* above = &range_[static_cast<std::size_t>(y - 1) * width_];
+    const float* row = above + width_;
+    const float* below = row + width_;
+    const float jump = max_depth_jump_;
+    const auto free = [jump](float a, float b) {
+      return std::abs(a - b) <= jump * std::min(a, b) ? 1u : 0u;
+    };
+    for (int x = 1; x < width_ - 1; ++x) {
+      const float r = row[x];
+      steps[x] = static_cast<std::uint8_t>(
+          free(r, above[x - 1]) << stepBit(-1, -1) | free(r, above[x]) << stepBit(0, -1) |
+          free(r, above[x + 1]) << stepBit(1, -1) | free(r, row[x - 1]) << stepBit(-1, 0) |
+          free(r, row[x + 1]) << stepBit(1, 0) | free(r, below[x - 1]) << stepBit(-1, 1) |
+          free(r, below[x]) << stepBit(0, 1) | free(r, below[x + 1]) << stepBit(1, 1));
     }
   }
 }
