@@ -1,4 +1,4 @@
-// Integral-image PCA normals of organized clouds: exact against the per-point PCA of the same
+// Window-sum PCA normals of organized clouds: exact against the per-point PCA of the same
 // window, exact on a plane, first order on a sphere, not bent by a depth step, and in agreement
 // with pcl::IntegralImageNormalEstimation on the shared Kinect frames.
 #include <gtest/gtest.h>
@@ -88,13 +88,13 @@ TEST(OrganizedNormals, HolesStayHoles) {
   EXPECT_LT(result.failed_points, 100);
 }
 
-// The integral-image sums against the two-pass PCA of the points of the same window, which
+// The window sums against the two-pass PCA of the points of the same window, which
 // OrganizedGridSearch::windowSearch returns; near the origin and 1e5 away from it (where sums of
 // squares over a whole frame would cancel every digit of a window's covariance).
 void expectWindowSumsEqualPerPointPCA(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
-                                      int min_compared) {
+                                      int min_compared, int radius = 3) {
   OrganizedNormalOptions options;
-  options.window_radius = 3;
+  options.window_radius = radius;
   const OrganizedNormalResult result = computeOrganizedPCANormals(cloud, options);
   OrganizedGridSearch<pcl::PointXYZ> search(options.max_depth_jump);
   search.setInputCloud(cloud);
@@ -103,7 +103,7 @@ void expectWindowSumsEqualPerPointPCA(const pcl::PointCloud<pcl::PointXYZ>::Cons
   Eigen::Matrix3Xd points;
   int compared = 0;
   for (std::size_t i = 0; i < cloud->size(); ++i) {
-    const int count = search.windowSearch(static_cast<pcl::index_t>(i), 3, window, distances);
+    const int count = search.windowSearch(static_cast<pcl::index_t>(i), radius, window, distances);
     if (count == 0) continue;
     const Eigen::Vector3d query = (*cloud)[i].getVector3fMap().cast<double>();
     points.resize(3, count);
@@ -137,7 +137,7 @@ TEST(OrganizedNormals, WindowSumsEqualPerPointPCA) {
 }
 
 TEST(OrganizedNormals, WindowSumsEqualPerPointPCAOnAKinectFrame) {
-  // Holes, shadows and depth steps everywhere: every window the integral images serve must be
+  // Holes, shadows and depth steps everywhere: every window the sums serve must be
   // exactly the points the search reaches.
   pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
   ASSERT_EQ(pcl::io::loadPCDFile(test::sharedData("clouds/office1.pcd"), *cloud), 0);
@@ -146,6 +146,16 @@ TEST(OrganizedNormals, WindowSumsEqualPerPointPCAOnAKinectFrame) {
 
 TEST(OrganizedNormals, WindowSumsEqualPerPointPCAFarFromTheOrigin) {
   expectWindowSumsEqualPerPointPCA({1e5, -1e5, 1e5});
+}
+
+TEST(OrganizedNormals, WindowSumsEqualPerPointPCAForOtherWindowSizes) {
+  // 3 x 3 and 5 x 5 take the bit-mask flood fill on a smaller window shape; 11 x 11 and 13 x 13
+  // (beyond 7 x 7) check cut windows with the search and sum their rows without unrolling.
+  const auto image = renderRangeImage(RangeScene::BoxOnWall, PinholeCamera{}, 2e-3, 7);
+  for (const int radius : {1, 2, 5, 6}) {
+    SCOPED_TRACE(radius);
+    expectWindowSumsEqualPerPointPCA(image.cloud, 8000, radius);
+  }
 }
 
 TEST(OrganizedNormals, FirstOrderOnSphereAndCylinder) {

@@ -1,10 +1,11 @@
 #pragma once
 // PCA normals of an organized cloud (an RGB-D frame, a range image) at frame rate: each pixel's
 // plane is fitted to the finite points of the (2w+1)^2 pixel window around it, from windowed sums
-// of x, y, z and their products read off integral images (summed-area tables), so that no pixel
-// needs a search.
+// of x, y, z and their products, so that no pixel needs a search. A tile's rows are summed across
+// the window once and then down it (direct sums, no summed-area tables), and a row's eigenpairs are
+// found together in the CPU's vector lanes (fitPlaneNormals).
 //
-// Far from the origin the sums of squares would cancel the covariance away: the tables are built
+// Far from the origin the sums of squares would cancel the covariance away: the sums are formed
 // per 64 x 64 tile on coordinates relative to the tile's mean, so that a window's covariance is
 // as exact as the two-pass PCA of its points (1e-9 relative or better).
 //
@@ -38,7 +39,7 @@ struct OrganizedNormalResult {
    *  pixel has no finite point or no plane. */
   pcl::PointCloud<pcl::Normal> normals;
   std::int64_t failed_points = 0;  ///< finite points without a plane (< 3 neighbours, a line)
-  std::int64_t window_points = 0;  ///< fitted from the integral images (the whole window)
+  std::int64_t window_points = 0;  ///< fitted from the window sums (the whole window)
   std::int64_t jump_points = 0;    ///< a jump (or hole) cuts the window: fitted point by point
   /** The pixel grid the windows were cut by, for further work on the same cloud (e.g. orienting
    *  the normals along it) without building it again. */
