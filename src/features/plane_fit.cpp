@@ -97,10 +97,8 @@ constexpr int kLanes = 64;
 // l0 / l1: 12 steps reach rounding for r up to about 0.6; flatter neighbourhoods need 4 to 7.
 constexpr int kNewtonSteps = 12;
 
-}  // namespace
-
-PCL_DDG_WIDE_LANES void fitPlaneNormals(int count, const CovarianceArrays& in,
-                                        const PlaneNormalArrays& out) {
+PCL_DDG_WIDE_LANES void fitInLanes(int count, const CovarianceArrays& in,
+                                   const PlaneNormalArrays& out) {
   constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
   for (int begin = 0; begin < count; begin += kLanes) {
     const int lanes = std::min(kLanes, count - begin);
@@ -192,6 +190,13 @@ PCL_DDG_WIDE_LANES void fitPlaneNormals(int count, const CovarianceArrays& in,
       out.valid[k] = plane.valid ? 1 : 0;
     }
   }
+}
+
+}  // namespace
+
+void fitPlaneNormals(int count, const CovarianceArrays& covariances,
+                     const PlaneNormalArrays& planes) {
+  fitInLanes(count, covariances, planes);
 }
 
 }  // namespace pcl_ddg

@@ -20,7 +20,7 @@ inline void sumTerms(const double* in, int step, int count, double* out) {
   }
 }
 
-inline void sumTerms(int terms, const double* in, int step, int count, double* out) {
+PCL_DDG_WIDE_LANES void sumTerms(int terms, const double* in, int step, int count, double* out) {
   switch (terms) {
     case 3:
       return sumTerms<3>(in, step, count, out);
@@ -71,7 +71,7 @@ void WindowSums::startTile(int x0, int y0, int x1, int y1) {
   next_row_ = y0 - radius_;
 }
 
-PCL_DDG_WIDE_LANES void WindowSums::sumAcross(int v) {
+void WindowSums::sumAcross(int v) {
   const int span = tile_width_ + 2 * radius_, stride = kTileWidth + 2 * radius_;
   for (int k = 0; k < span; ++k) {
     const int u = x0_ - radius_ + k;
@@ -96,7 +96,7 @@ PCL_DDG_WIDE_LANES void WindowSums::sumAcross(int v) {
   }
 }
 
-PCL_DDG_WIDE_LANES const double* WindowSums::rowSums(int y) {
+const double* WindowSums::rowSums(int y) {
   // The ring's slots hold rows y - w .. y + w, rows outside the image as zeros.
   const int window = 2 * radius_ + 1;
   for (; next_row_ <= y + radius_; ++next_row_) {
