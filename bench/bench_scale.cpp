@@ -8,7 +8,7 @@
 // Reported per size: ns per element for each phase and in all, peak bytes per vertex (above the
 // process's own footprint before loading), and the ratio of the largest size's time per element
 // to the smallest's. With --write-cloud=COUNT:PATH it only writes such a cloud (for
-// bench_out_of_core.sh).
+// bench_out_of_core.sh), with --write-mesh=SHARED_MESH:LEVELS:PATH such a mesh.
 #include <benchmark/benchmark.h>
 #include <pcl/conversions.h>
 #include <sys/resource.h>
@@ -109,6 +109,19 @@ void writeMesh(const std::string& path, const Eigen::Matrix3Xd& points,
   }
 }
 
+struct SubdividedMesh {
+  Eigen::Matrix3Xd points;
+  Eigen::Matrix3Xi triangles;
+};
+
+/** A shared mesh after `levels` Loop subdivisions. */
+SubdividedMesh subdividedMesh(const std::string& name, int levels) {
+  const MeshFile file = readMeshFile(sharedMesh(name));
+  SubdividedMesh mesh{file.positions, MeshTopology(file.mesh).triangles()};
+  for (int l = 0; l < levels; ++l) loopSubdivide(mesh.points, mesh.triangles);
+  return mesh;
+}
+
 // A binary PLY cloud of `count` points on igea's surface, area-weighted, in triangle order.
 void writeSampledCloud(const std::string& path, std::int64_t count) {
   const MeshFile igea = readMeshFile(sharedMesh("igea.ply"));
@@ -144,15 +157,12 @@ void makeInputs(const std::string& folder) {
   const std::pair<const char*, int> meshes[] = {
       {"igea.ply", 1}, {"igea.ply", 2}, {"bumpy.off", 6}, {"rocker-arm.off", 5}};
   for (const auto& [name, levels] : meshes) {
-    const MeshFile file = readMeshFile(sharedMesh(name));
-    Eigen::Matrix3Xd points = file.positions;
-    Eigen::Matrix3Xi triangles = MeshTopology(file.mesh).triangles();
-    for (int l = 0; l < levels; ++l) loopSubdivide(points, triangles);
+    const SubdividedMesh mesh = subdividedMesh(name, levels);
     std::ostringstream label;
-    label << "mesh/" << (triangles.cols() + 500000) / 1000000 << "M";
+    label << "mesh/" << (mesh.triangles.cols() + 500000) / 1000000 << "M";
     const std::string path = folder + "/" + label.str().substr(5) + "_triangles.ply";
-    writeMesh(path, points, triangles);
-    inputs().push_back({label.str(), path, triangles.cols(), false});
+    writeMesh(path, mesh.points, mesh.triangles);
+    inputs().push_back({label.str(), path, mesh.triangles.cols(), false});
   }
   for (const std::int64_t count : {1000000LL, 10000000LL, 50000000LL}) {
     const std::string path = folder + "/" + std::to_string(count / 1000000) + "M_points.ply";
@@ -165,12 +175,18 @@ void makeInputs(const std::string& folder) {
 int runPipeline(const std::string& path, bool cloud) {
   const auto clock = [] { return std::chrono::steady_clock::now(); };
   const auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
+  // The peak so far after each phase, to see which one sets it.
+  const auto peak = [] {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return static_cast<long long>(usage.ru_maxrss) * 1024;
+  };
   rusage before{};
   getrusage(RUSAGE_SELF, &before);
   auto t0 = clock();
   MeshFile file = readMeshFile(path);
   auto t1 = clock();
-  std::printf("load %.6f\n", seconds(t0, t1));
+  std::printf("load %.6f\npeak_after_load %lld\n", seconds(t0, t1), peak());
   if (cloud) {
     auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
     pcl::fromPCLPointCloud2(file.mesh.cloud, *points);
@@ -185,11 +201,11 @@ int runPipeline(const std::string& path, bool cloud) {
     t0 = clock();
     const MeshTopology topology(file.mesh);
     t1 = clock();
-    std::printf("topology %.6f\n", seconds(t0, t1));
+    std::printf("topology %.6f\npeak_after_topology %lld\n", seconds(t0, t1), peak());
     const MeshNormals normals = computeMeshNormals(topology, file.positions);
     benchmark::DoNotOptimize(normals.normals.data());
     const auto t2 = clock();
-    std::printf("normals %.6f\n", seconds(t1, t2));
+    std::printf("normals %.6f\npeak_after_normals %lld\n", seconds(t1, t2), peak());
     const VertexCurvatures curvatures = computeCurvatures(topology, file.positions);
     benchmark::DoNotOptimize(curvatures.k1.data());
     std::printf("curvature %.6f\n", seconds(t2, clock()));
@@ -258,6 +274,15 @@ int main(int argc, char** argv) {
     // For bench_out_of_core.sh: --write-cloud=COUNT:PATH
     const std::string spec = std::string(argv[1]).substr(14);
     writeSampledCloud(spec.substr(spec.find(':') + 1), std::stoll(spec.substr(0, spec.find(':'))));
+    return 0;
+  }
+  if (argc == 2 && std::string(argv[1]).rfind("--write-mesh=", 0) == 0) {
+    // One of the scale meshes on its own: --write-mesh=SHARED_MESH:LEVELS:PATH
+    const std::string spec = std::string(argv[1]).substr(13);
+    const std::size_t first = spec.find(':'), second = spec.find(':', first + 1);
+    const SubdividedMesh mesh = subdividedMesh(
+        spec.substr(0, first), std::stoi(spec.substr(first + 1, second - first - 1)));
+    writeMesh(spec.substr(second + 1), mesh.points, mesh.triangles);
     return 0;
   }
   if (argc == 2 && std::string(argv[1]).rfind("--pipeline=", 0) == 0) {

@@ -57,7 +57,7 @@ TEST(MeshTopology, OutOfRangeFacesCanBeDroppedAndCounted) {
   const MeshTopology t = topologyOf(4, {{0, 1, 2}, {0, 2, 7}}, OutOfRangeFacePolicy::Drop);
   EXPECT_EQ(t.numTriangles(), 1);
   EXPECT_EQ(t.counts().out_of_range_polygons, 1);
-  EXPECT_EQ(t.triangleSource()[0], 0);
+  EXPECT_EQ(t.triangleSource(0), 0);
 }
 
 TEST(MeshTopology, SquareAdjacency) {
@@ -171,13 +171,24 @@ TEST(MeshTopology, CountsMatchBruteForceOnRandomPolygonSoups) {
   }
 }
 
+TEST(MeshTopology, TriangleSourcesNameThePolygons) {
+  const MeshTopology plain = topologyOf(4, {{0, 1, 2}, {0, 2, 3}});
+  EXPECT_EQ(plain.triangleSource(0), 0);
+  EXPECT_EQ(plain.triangleSource(1), 1);
+  // As many triangles as polygons, but polygon 0 dropped and polygon 1 split in two.
+  const MeshTopology split = topologyOf(4, {{0, 1, 9}, {0, 1, 2, 3}}, OutOfRangeFacePolicy::Drop);
+  ASSERT_EQ(split.numTriangles(), 2);
+  EXPECT_EQ(split.triangleSource(0), 1);
+  EXPECT_EQ(split.triangleSource(1), 1);
+}
+
 TEST(MeshTopology, QuadAndPentagonAreFanTriangulated) {
   const MeshTopology t = topologyOf(9, {{0, 1, 2, 3}, {4, 5, 6, 7, 8}});
   EXPECT_EQ(t.numTriangles(), 2 + 3);
   EXPECT_EQ(t.counts().triangulated_polygons, 2);
   EXPECT_EQ(t.counts().polygons_by_valence[4], 1);
   EXPECT_EQ(t.counts().polygons_by_valence[5], 1);
-  EXPECT_EQ(t.triangleSource()[4], 1);
+  EXPECT_EQ(t.triangleSource(4), 1);
   EXPECT_EQ(t.eulerCharacteristic(), 2);  // two discs
   EXPECT_EQ(t.counts().connected_components, 2);
   // Fan from corner 0 keeps the winding: (4,5,6), (4,6,7), (4,7,8).

@@ -14,14 +14,14 @@ std::int64_t countZeroAreaFaces(const MeshTopology& topology, const Eigen::Matri
   // A face counts when all its triangles are degenerate; its triangles are consecutive, and it is
   // counted from its first one.
   const Eigen::Matrix3Xi& tris = topology.triangles();
-  const std::vector<int>& source = topology.triangleSource();
+  const auto source = [&topology](int t) { return topology.triangleSource(t); };
   const int num_triangles = topology.numTriangles();
   std::int64_t count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : count)
   for (int t = 0; t < num_triangles; ++t) {
-    if (t > 0 && source[t - 1] == source[t]) continue;
+    if (t > 0 && source(t - 1) == source(t)) continue;
     bool all_degenerate = true;
-    for (int u = t; u < num_triangles && source[u] == source[t] && all_degenerate; ++u) {
+    for (int u = t; u < num_triangles && source(u) == source(t) && all_degenerate; ++u) {
       all_degenerate = isDegenerateTriangle(positions.col(tris(0, u)), positions.col(tris(1, u)),
                                             positions.col(tris(2, u)));
     }

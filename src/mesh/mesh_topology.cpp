@@ -139,6 +139,10 @@ void MeshTopology::triangulate(const std::vector<pcl::Vertices>& polygons,
     }
   }
   triangles_.conservativeResize(3, t);
+  // Every polygon one triangle, in order: the source of triangle t is t, not worth 4 bytes each.
+  bool identity = static_cast<std::size_t>(t) == polygons.size();
+  for (Eigen::Index i = 0; identity && i < t; ++i) identity = triangle_source_[i] == i;
+  if (identity) std::vector<int>().swap(triangle_source_);
 }
 
 void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons,
@@ -214,7 +218,7 @@ MeshTopology::Wedges MeshTopology::buildVertexTriangles(
   std::vector<char> plain(num_triangles);
 #pragma omp parallel for schedule(static)
   for (Eigen::Index t = 0; t < num_triangles; ++t) {
-    plain[t] = isPlainTriangle(polygons[triangle_source_[t]].vertices);
+    plain[t] = isPlainTriangle(polygons[triangleSource(static_cast<int>(t))].vertices);
   }
 
   const auto incidences = static_cast<std::size_t>(vt_offsets_.back());

@@ -80,9 +80,10 @@ class MeshTopology {
   int numTriangles() const { return static_cast<int>(triangles_.cols()); }
   int numEdges() const { return static_cast<int>(edge_vertices_.cols()); }
 
-  /** 3 x T corner indices; triangle t comes from input polygon triangleSource()[t]. */
+  /** 3 x T corner indices. */
   const Eigen::Matrix3Xi& triangles() const { return triangles_; }
-  const std::vector<int>& triangleSource() const { return triangle_source_; }
+  /** The input polygon triangle t comes from (sources ascend with t). */
+  int triangleSource(int t) const { return triangle_source_.empty() ? t : triangle_source_[t]; }
   /** 3 x T edge ids; entry (k, t) is the edge opposite corner k. */
   const Eigen::Matrix3Xi& triangleEdges() const { return triangle_edges_; }
   /** 2 x E vertex pairs, first < second. */
@@ -147,7 +148,7 @@ class MeshTopology {
 
   int num_vertices_ = 0;
   Eigen::Matrix3Xi triangles_;
-  std::vector<int> triangle_source_;
+  std::vector<int> triangle_source_;  ///< empty when triangle t is polygon t for all t
   Eigen::Matrix3Xi triangle_edges_;
   Eigen::Matrix2Xi edge_vertices_;
   std::vector<int> edge_triangle_count_;
