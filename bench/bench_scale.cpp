@@ -1,6 +1,6 @@
 // How the pipeline scales, from about 1M to 20M triangles and from 1M to 50M points: time per
 // element should stay flat, and memory per vertex small. Each measurement runs in a fresh process
-// (this program, started again with --pipeline), so that its peak resident memory (getrusage) is
+// (this program, started again with --pipeline), so that its peak resident memory (VmHWM) is
 // its own; the inputs are binary PLY files made first into a temporary folder:
 //   meshes  Loop subdivision of shared meshes (igea once and twice, bumpy six times, rocker-arm
 //           five times): load -> MeshTopology -> area normals -> all curvatures
@@ -11,7 +11,6 @@
 // bench_out_of_core.sh), with --write-mesh=SHARED_MESH:LEVELS:PATH such a mesh.
 #include <benchmark/benchmark.h>
 #include <pcl/conversions.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -171,22 +170,26 @@ void makeInputs(const std::string& folder) {
   }
 }
 
+/** This process's peak resident memory so far: VmHWM, the peak of its own address space.
+ *  getrusage's ru_maxrss would not do: Linux carries it over an exec, so the child started by
+ *  fork and exec would begin at the parent's size. */
+long long peakResidentBytes() {
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmHWM:", 0) == 0) return std::stoll(line.substr(6)) * 1024;  // in kB
+  }
+  throw std::runtime_error("no VmHWM in /proc/self/status");
+}
+
 // The child: runs the pipeline on one file and prints "phase seconds" lines and the peak memory.
 int runPipeline(const std::string& path, bool cloud) {
   const auto clock = [] { return std::chrono::steady_clock::now(); };
   const auto seconds = [](auto a, auto b) { return std::chrono::duration<double>(b - a).count(); };
-  // The peak so far after each phase, to see which one sets it.
-  const auto peak = [] {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return static_cast<long long>(usage.ru_maxrss) * 1024;
-  };
-  rusage before{};
-  getrusage(RUSAGE_SELF, &before);
+  const long long base = peakResidentBytes();
   auto t0 = clock();
   MeshFile file = readMeshFile(path);
   auto t1 = clock();
-  std::printf("load %.6f\npeak_after_load %lld\n", seconds(t0, t1), peak());
+  std::printf("load %.6f\npeak_after_load %lld\n", seconds(t0, t1), peakResidentBytes());
   if (cloud) {
     auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
     pcl::fromPCLPointCloud2(file.mesh.cloud, *points);
@@ -201,21 +204,17 @@ int runPipeline(const std::string& path, bool cloud) {
     t0 = clock();
     const MeshTopology topology(file.mesh);
     t1 = clock();
-    std::printf("topology %.6f\npeak_after_topology %lld\n", seconds(t0, t1), peak());
+    std::printf("topology %.6f\npeak_after_topology %lld\n", seconds(t0, t1), peakResidentBytes());
     const MeshNormals normals = computeMeshNormals(topology, file.positions);
     benchmark::DoNotOptimize(normals.normals.data());
     const auto t2 = clock();
-    std::printf("normals %.6f\npeak_after_normals %lld\n", seconds(t1, t2), peak());
+    std::printf("normals %.6f\npeak_after_normals %lld\n", seconds(t1, t2), peakResidentBytes());
     const VertexCurvatures curvatures = computeCurvatures(topology, file.positions);
     benchmark::DoNotOptimize(curvatures.k1.data());
     std::printf("curvature %.6f\n", seconds(t2, clock()));
   }
-  rusage after{};
-  getrusage(RUSAGE_SELF, &after);
   std::printf("vertices %lld\npeak_bytes %lld\nbase_bytes %lld\n",
-              static_cast<long long>(file.positions.cols()),
-              static_cast<long long>(after.ru_maxrss) * 1024,
-              static_cast<long long>(before.ru_maxrss) * 1024);
+              static_cast<long long>(file.positions.cols()), peakResidentBytes(), base);
   return 0;
 }
 
@@ -293,6 +292,9 @@ int main(int argc, char** argv) {
       (std::filesystem::temp_directory_path() / "pcl_ddg_bench_scale").string();
   std::filesystem::create_directories(folder);
   makeInputs(folder);
+  // The inputs' pages are written back to disk now rather than during the first measurements
+  // (that doubled the load time of the first meshes).
+  sync();
   for (const Input& input : inputs()) {
     benchmark::RegisterBenchmark(input.label.c_str(), scale, &input)
         ->Unit(benchmark::kMillisecond)
