@@ -14,6 +14,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -170,13 +171,18 @@ void makeInputs(const std::string& folder) {
   }
 }
 
-/** This process's peak resident memory so far: VmHWM, the peak of its own address space.
- *  getrusage's ru_maxrss would not do: Linux carries it over an exec, so the child started by
- *  fork and exec would begin at the parent's size. */
+/** This process's peak resident memory so far: the largest VmHWM read, the peak of its own
+ *  address space. getrusage's ru_maxrss would not do: Linux carries it over an exec, so the child
+ *  started by fork and exec would begin at the parent's size. The kernel brings VmHWM up to date
+ *  lazily (when memory is unmapped), so a later reading can be lower than an earlier one. */
 long long peakResidentBytes() {
+  static long long peak = 0;
   std::ifstream status("/proc/self/status");
   for (std::string line; std::getline(status, line);) {
-    if (line.rfind("VmHWM:", 0) == 0) return std::stoll(line.substr(6)) * 1024;  // in kB
+    if (line.rfind("VmHWM:", 0) == 0) {
+      peak = std::max(peak, std::stoll(line.substr(6)) * 1024);  // in kB
+      return peak;
+    }
   }
   throw std::runtime_error("no VmHWM in /proc/self/status");
 }
