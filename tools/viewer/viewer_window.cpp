@@ -103,6 +103,12 @@ ViewerWindow::ViewerWindow(ViewerModel& model, int width, int height)
   visualizer_->setSize(width, height);
   visualizer_->setBackgroundColor(0.12, 0.12, 0.14);
   visualizer_->setShowFPS(false);
+  // Edges smoothed by FXAA, one pass over the finished image, instead of VTK's default 4x
+  // multisampling: without a GPU (Mesa's llvmpipe, as under Xvfb or over a remote display)
+  // multisampling made every frame of a 1.15M-vertex mesh 3.1x slower (582 against 188 ms), and
+  // FXAA costs nothing measurable.
+  visualizer_->getRenderWindow()->SetMultiSamples(0);
+  rendererOf(*visualizer_)->UseFXAAOn();
   visualizer_->registerKeyboardCallback(
       [this](const pcl::visualization::KeyboardEvent& event) { onKey(event); });
   text_ = vtkSmartPointer<vtkTextActor>::New();
