@@ -243,7 +243,8 @@ void ViewerWindow::processEvents() {
   if (display() == nullptr) return;
   if (XPending(display()) == 0) {
     pollfd connection{ConnectionNumber(display()), POLLIN, 0};
-    poll(&connection, 1, kEventWaitMs);
+    // While the worker computes, look again within a millisecond: its frame is drawn sooner.
+    poll(&connection, 1, computing_.valid() ? 1 : kEventWaitMs);
   }
   while (!visualizer_->wasStopped() && display() != nullptr && XPending(display()) != 0) {
     interactor()->ProcessEvents();
@@ -357,17 +358,19 @@ void ViewerWindow::drawSurface(const Frame& frame) {
   // shaded grey by how squarely their normal faces the sensor, so that the shape shows.
   const bool shade_points = !model_.isMesh() && frame.field_label.empty();
   const Eigen::Vector3d sensor_axis = model_.sensorPose().orientation * Eigen::Vector3d::UnitZ();
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (shade_points) {
+  // Written through the arrays' own storage: a virtual SetTypedTuple per vertex cost more than
+  // the copies.
+  unsigned char* rgb = colors->GetPointer(0);
+  if (shade_points) {
+    for (Eigen::Index i = 0; i < n; ++i) {
       const double facing = frame.normals->col(i).allFinite()
                                 ? std::abs(frame.normals->col(i).dot(sensor_axis))
                                 : 0.5;
       const auto grey = static_cast<unsigned char>(60.0 + 180.0 * facing);
-      const unsigned char rgb[3] = {grey, grey, grey};
-      colors->SetTypedTuple(i, rgb);
-    } else {
-      colors->SetTypedTuple(i, frame.colors.col(i).data());
+      rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = grey;
     }
+  } else {
+    std::copy_n(frame.colors.data(), 3 * n, rgb);
   }
   const bool same_colors = colors_ && std::equal(colors->GetPointer(0), colors->GetPointer(3 * n),
                                                  colors_->GetPointer(0));
@@ -377,11 +380,11 @@ void ViewerWindow::drawSurface(const Frame& frame) {
     normals_->SetNumberOfComponents(3);
     normals_->SetName("normals");
     normals_->SetNumberOfTuples(n);
+    float* xyz = normals_->GetPointer(0);
     for (Eigen::Index i = 0; i < n; ++i) {
-      const Eigen::Vector3f normal = frame.normals->col(i).allFinite()
-                                         ? Eigen::Vector3f(frame.normals->col(i).cast<float>())
-                                         : Eigen::Vector3f::Zero();
-      normals_->SetTypedTuple(i, normal.data());
+      const bool finite = frame.normals->col(i).allFinite();
+      for (int c = 0; c < 3; ++c)
+        xyz[3 * i + c] = finite ? static_cast<float>((*frame.normals)(c, i)) : 0.0f;
     }
     normals_of_ = frame.normals.get();
     normals_owner_ = frame.normals;
