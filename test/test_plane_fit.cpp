@@ -84,8 +84,9 @@ std::vector<PlaneNormal> fitMany(const std::vector<Eigen::Matrix3d>& matrices) {
   return planes;
 }
 
-TEST(PlaneFit, ManyAtOnceAgreeWithTheClosedFormOnKnownMatrices) {
-  // The same range as above; in a batch whose length is not a multiple of the vector blocks.
+TEST(PlaneFit, ManyAtOnceFindTheSmallestEigenpairOfKnownMatrices) {
+  // The range above with l0 up to 0.99 l1, where Newton's steps run out and the closed form takes
+  // over; in a batch whose length is not a multiple of the vector blocks.
   std::mt19937 random(11);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<KnownCovariance> known;
