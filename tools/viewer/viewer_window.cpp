@@ -320,7 +320,7 @@ void ViewerWindow::placeCamera() {
 void ViewerWindow::drawSurface(const Frame& frame) {
   const Eigen::Matrix3Xd& positions = *frame.positions;
   const Eigen::Index n = positions.cols();
-  if (points_of_ != frame.positions.get()) {
+  if (points_owner_ != frame.positions) {
     points_ = vtkSmartPointer<vtkPoints>::New();
     points_->SetDataTypeToFloat();
     points_->SetNumberOfPoints(n);
@@ -329,7 +329,6 @@ void ViewerWindow::drawSurface(const Frame& frame) {
                                                              : Eigen::Vector3d::Zero();
       points_->SetPoint(i, p.data());
     }
-    points_of_ = frame.positions.get();
     points_owner_ = frame.positions;
   }
   if (!cells_) {
@@ -375,7 +374,7 @@ void ViewerWindow::drawSurface(const Frame& frame) {
   const bool same_colors = colors_ && std::equal(colors->GetPointer(0), colors->GetPointer(3 * n),
                                                  colors_->GetPointer(0));
   if (!same_colors) colors_ = colors;
-  if (normals_of_ != frame.normals.get()) {
+  if (normals_owner_ != frame.normals) {
     normals_ = vtkSmartPointer<vtkFloatArray>::New();
     normals_->SetNumberOfComponents(3);
     normals_->SetName("normals");
@@ -386,7 +385,6 @@ void ViewerWindow::drawSurface(const Frame& frame) {
       for (int c = 0; c < 3; ++c)
         xyz[3 * i + c] = finite ? static_cast<float>((*frame.normals)(c, i)) : 0.0f;
     }
-    normals_of_ = frame.normals.get();
     normals_owner_ = frame.normals;
   }
   // One polydata and mapper for the window's life: a new frame replaces arrays, so the mapper

@@ -90,13 +90,11 @@ class ViewerWindow {
   std::vector<MethodLabel> method_labels_;
   vtkSmartPointer<vtkScalarBarActor> color_bar_;
   vtkSmartPointer<vtkCellArray> cells_;  ///< triangles or vertices: the same in every frame
-  vtkSmartPointer<vtkPoints> points_;    ///< of points_of_
-  const Eigen::Matrix3Xd* points_of_ = nullptr;
-  std::shared_ptr<const Eigen::Matrix3Xd> points_owner_;  ///< keeps points_of_ alive
-  vtkSmartPointer<vtkUnsignedCharArray> colors_;          ///< on screen
-  vtkSmartPointer<vtkFloatArray> normals_;                ///< of normals_of_
-  const Eigen::Matrix3Xd* normals_of_ = nullptr;
-  std::shared_ptr<const Eigen::Matrix3Xd> normals_owner_;  ///< keeps normals_of_ alive
+  vtkSmartPointer<vtkPoints> points_;    ///< of points_owner_
+  std::shared_ptr<const Eigen::Matrix3Xd> points_owner_;   ///< the positions shown
+  vtkSmartPointer<vtkUnsignedCharArray> colors_;           ///< on screen
+  vtkSmartPointer<vtkFloatArray> normals_;                 ///< of normals_owner_
+  std::shared_ptr<const Eigen::Matrix3Xd> normals_owner_;  ///< the normals shown
 };
 
 /** One line saying why no window can open (no DISPLAY, or an X server that does not answer), or

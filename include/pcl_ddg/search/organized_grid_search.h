@@ -28,6 +28,8 @@
 // point returns nothing. Thread-safe, and a query allocates nothing once its buffers have grown.
 #include <pcl/search/search.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -97,6 +99,11 @@ class OrganizedGridSearch : public pcl::search::Search<PointT> {
                    std::vector<float>& k_sqr_distances, unsigned int max_nn = 0) const override;
 
  private:
+  /** Whether two adjacent pixels' ranges lie within the depth jump of each other. NaN compares
+   *  false: a pixel without a point joins nothing. */
+  bool rangesJoin(float a, float b) const {
+    return std::abs(a - b) <= max_depth_jump_ * std::min(a, b);
+  }
   bool isSearchable(pcl::index_t index) const;
   bool isQueryCloud(const PointCloud& cloud) const;
   float squaredDistance(pcl::index_t a, pcl::index_t b) const;

@@ -94,10 +94,7 @@ void OrganizedGridSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud,
     const float* above = &range_[static_cast<std::size_t>(y - 1) * width_];
     const float* row = above + width_;
     const float* below = row + width_;
-    const float jump = max_depth_jump_;
-    const auto free = [jump](float a, float b) {
-      return std::abs(a - b) <= jump * std::min(a, b) ? 1u : 0u;
-    };
+    const auto free = [this](float a, float b) { return rangesJoin(a, b) ? 1u : 0u; };
     for (int x = 1; x < width_ - 1; ++x) {
       const float r = row[x];
       steps[x] = static_cast<std::uint8_t>(
@@ -137,9 +134,7 @@ float OrganizedGridSearch<PointT>::squaredDistance(pcl::index_t a, pcl::index_t 
 
 template <typename PointT>
 bool OrganizedGridSearch<PointT>::isJumpFree(pcl::index_t a, pcl::index_t b) const {
-  const float ra = range_[a], rb = range_[b];
-  // NaN compares false: a pixel without a point joins nothing.
-  return std::abs(ra - rb) <= max_depth_jump_ * std::min(ra, rb);
+  return rangesJoin(range_[a], range_[b]);
 }
 
 template <typename PointT>
