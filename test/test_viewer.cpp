@@ -3,14 +3,18 @@
 // never pixel by pixel against a stored image; every shared file opens; errors are one line.
 #include <gtest/gtest.h>
 #include <stb/stb_image.h>
+#include <vtkCamera.h>
 #include <vtkCommand.h>
 #include <vtkRenderWindowInteractor.h>
+#include <vtkRenderer.h>
+#include <vtkRendererCollection.h>
 
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <future>
+#include <limits>
 #include <memory>
 #include <random>
 #include <string>
@@ -22,6 +26,7 @@
 #include "pcl_ddg/io/mesh_io.h"
 #include "test_data.h"
 #include "tool_runner.h"
+#include "viewer/hidden_faces.h"
 #include "viewer/viewer_window.h"
 #include "x_keyboard.h"
 
@@ -220,6 +225,105 @@ TEST_F(Viewer, SmoothingChangesTheSilhouetteAndUndoRestoresItExactly) {
   const Image undone = screenshot(window, "undone");
   EXPECT_TRUE(window.frame().positions->cwiseEqual(model->inputPositions()).all());
   EXPECT_TRUE(sameObject(undone, before)) << differingPixels(undone, before) << " pixels differ";
+}
+
+// The pixels where two pictures differ, and how many of them lie within two pixels of the
+// background of either (on the outline).
+std::pair<std::int64_t, std::int64_t> differencesOnOutline(const Image& a, const Image& b) {
+  std::int64_t differ = 0, on_outline = 0;
+  for (int y = 2; y + 2 < a.height; ++y) {
+    for (int x = 2; x + 2 < a.width; ++x) {
+      if (std::equal(a.at(x, y), a.at(x, y) + 3, b.at(x, y))) continue;
+      ++differ;
+      bool near_background = false;
+      for (int dy = -2; dy <= 2; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
+          near_background |=
+              isBackground(a.at(x + dx, y + dy)) || isBackground(b.at(x + dx, y + dy));
+        }
+      }
+      on_outline += near_background;
+    }
+  }
+  return {differ, on_outline};
+}
+
+// Back faces are left out only where none can be seen: the picture is the same without them, but
+// for a few pixels of the outline, where a back face sharing an edge with a front face may cover a
+// pixel's centre or win its depth test.
+TEST_F(Viewer, BackFacesAreCulledOnlyWhereNoneCanBeSeen) {
+  auto model = open(noisySphereFile(dir_));
+  ViewerWindow window(*model, 400, 400);
+  const Image culled = screenshot(window, "culled");
+  EXPECT_TRUE(window.culledBackFaces());
+  window.setHiddenFaceCulling(false);
+  const Image all_faces = screenshot(window, "all_faces");
+  EXPECT_FALSE(window.culledBackFaces());
+  const auto [differ, on_outline] = differencesOnOutline(culled, all_faces);
+  EXPECT_EQ(differ, on_outline);
+  EXPECT_LT(differ, culled.objectShare() * culled.width * culled.height / 1000);
+
+  // As a wireframe (PCL's key w) the back faces' edges show.
+  window.setHiddenFaceCulling(true);
+  pressKey(window, "w", 'w');
+  screenshot(window, "wireframe");
+  EXPECT_FALSE(window.culledBackFaces());
+  pressKey(window, "s", 's');
+  screenshot(window, "surface");
+  EXPECT_TRUE(window.culledBackFaces());
+
+  // From the centre of the sphere every face in sight is a back face: none may be culled.
+  vtkRenderer* renderer = window.visualizer().getRendererCollection()->GetFirstRenderer();
+  renderer->GetActiveCamera()->SetPosition(0.0, 0.0, 0.0);
+  renderer->GetActiveCamera()->SetFocalPoint(0.0, 0.0, -1.0);
+  renderer->ResetCameraClippingRange();
+  const Image inside = screenshot(window, "inside");
+  EXPECT_FALSE(window.culledBackFaces());
+  EXPECT_GT(inside.objectShare(), 0.95);
+}
+
+// Normals shown before are drawn again from VTK's buffers: the picture is the one first drawn.
+TEST_F(Viewer, SwitchingBackToNormalsShownBeforeDrawsTheSamePicture) {
+  auto model = open(sharedData("meshes/cow.off"));
+  ViewerWindow window(*model, 400, 300);
+  window.enqueue("field=mean");
+  const Image area = screenshot(window, "area");
+  window.enqueue("method=uniform");
+  window.enqueue("field=none");
+  const Image uniform = screenshot(window, "uniform");
+  EXPECT_GT(differingPixels(area, uniform), 1000);
+  window.enqueue("method=area");
+  window.enqueue("field=mean");
+  const Image area_again = screenshot(window, "area_again");
+  EXPECT_TRUE(sameObject(area, area_again)) << differingPixels(area, area_again) << " differ";
+}
+
+TEST(HiddenFaces, OnlyClosedOutwardSurfacesQualify) {
+  const SurfaceSample sphere = makeIcosphere(3);
+  const int n = static_cast<int>(sphere.points.cols());
+  EXPECT_TRUE(viewer::facesOutward(MeshTopology(n, sphere.triangles), sphere.points));
+
+  Eigen::Matrix3Xi inward = sphere.triangles;
+  inward.row(1).swap(inward.row(2));
+  EXPECT_FALSE(viewer::facesOutward(MeshTopology(n, inward), sphere.points));
+
+  const Eigen::Matrix3Xi open = sphere.triangles.leftCols(sphere.triangles.cols() - 1);
+  EXPECT_FALSE(viewer::facesOutward(MeshTopology(n, open), sphere.points));
+
+  // Two spheres side by side: both outward qualify; one inward does not, although the sum of
+  // their volumes is positive when the inward one is the smaller.
+  Eigen::Matrix3Xd two(3, 2 * n);
+  two << sphere.points, (0.5 * sphere.points).colwise() + Eigen::Vector3d(3.0, 0.0, 0.0);
+  Eigen::Matrix3Xi outward_pair(3, 2 * sphere.triangles.cols());
+  outward_pair << sphere.triangles, sphere.triangles.array() + n;
+  EXPECT_TRUE(viewer::facesOutward(MeshTopology(2 * n, outward_pair), two));
+  Eigen::Matrix3Xi mixed_pair(3, 2 * sphere.triangles.cols());
+  mixed_pair << sphere.triangles, inward.array() + n;
+  EXPECT_FALSE(viewer::facesOutward(MeshTopology(2 * n, mixed_pair), two));
+
+  Eigen::Matrix3Xd not_finite = sphere.points;
+  not_finite(0, 0) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(viewer::facesOutward(MeshTopology(n, sphere.triangles), not_finite));
 }
 
 TEST_F(Viewer, FiftyKeyPressesDuringAFitAreAllApplied) {

@@ -3,7 +3,9 @@
 #include <X11/Xlib.h>
 #include <poll.h>
 #include <vtkActor.h>
+#include <vtkCamera.h>
 #include <vtkCellArray.h>
+#include <vtkCommand.h>
 #include <vtkFloatArray.h>
 #include <vtkLookupTable.h>
 #include <vtkPointData.h>
@@ -20,6 +22,7 @@
 #include <vtkTextProperty.h>
 #include <vtkUnsignedCharArray.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -27,6 +30,8 @@
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
+
+#include "viewer/hidden_faces.h"
 
 namespace pcl_ddg {
 namespace viewer {
@@ -117,6 +122,9 @@ ViewerWindow::ViewerWindow(ViewerModel& model, int width, int height)
   text_->SetDisplayPosition(10, 10);
   rendererOf(*visualizer_)->AddActor2D(text_);
   addMethodLabels(height);
+  surface_property_ = vtkSmartPointer<vtkProperty>::New();
+  cull_observer_ = rendererOf(*visualizer_)
+                       ->AddObserver(vtkCommand::StartEvent, this, &ViewerWindow::cullHiddenFaces);
 }
 
 void ViewerWindow::addMethodLabels(int height) {
@@ -139,6 +147,7 @@ void ViewerWindow::addMethodLabels(int height) {
 ViewerWindow::~ViewerWindow() {
   // Not visualizer_->close(): PCL's X interactor then asks a closed display for an atom (crash).
   if (computing_.valid()) computing_.wait();
+  rendererOf(*visualizer_)->RemoveObserver(cull_observer_);
 }
 
 vtkRenderWindowInteractor* ViewerWindow::interactor() {
@@ -330,6 +339,11 @@ void ViewerWindow::drawSurface(const Frame& frame) {
       points_->SetPoint(i, p.data());
     }
     points_owner_ = frame.positions;
+    points_->GetBounds(bounds_);
+    faces_outward_ = model_.isMesh() && facesOutward(*model_.topology(), positions);
+    for (const SurfaceActor& surface : surfaces_)
+      rendererOf(*visualizer_)->RemoveActor(surface.actor);
+    surfaces_.clear();
   }
   if (!cells_) {
     cells_ = vtkSmartPointer<vtkCellArray>::New();
@@ -347,8 +361,8 @@ void ViewerWindow::drawSurface(const Frame& frame) {
       }
     }
   }
-  // Colours and normals go to VTK only when they changed: a new array is uploaded to the GPU
-  // again, 14 MB of normals for a million vertices.
+  vtkActor& surface = showSurface(frame.normals);
+  // Colours go to VTK only when they changed: a new array is uploaded to the GPU again.
   auto colors = vtkSmartPointer<vtkUnsignedCharArray>::New();
   colors->SetNumberOfComponents(3);
   colors->SetName("colors");
@@ -371,51 +385,83 @@ void ViewerWindow::drawSurface(const Frame& frame) {
   } else {
     std::copy_n(frame.colors.data(), 3 * n, rgb);
   }
-  const bool same_colors = colors_ && std::equal(colors->GetPointer(0), colors->GetPointer(3 * n),
-                                                 colors_->GetPointer(0));
-  if (!same_colors) colors_ = colors;
-  if (normals_owner_ != frame.normals) {
-    normals_ = vtkSmartPointer<vtkFloatArray>::New();
-    normals_->SetNumberOfComponents(3);
-    normals_->SetName("normals");
-    normals_->SetNumberOfTuples(n);
-    float* xyz = normals_->GetPointer(0);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const bool finite = frame.normals->col(i).allFinite();
-      for (int c = 0; c < 3; ++c)
-        xyz[3 * i + c] = finite ? static_cast<float>((*frame.normals)(c, i)) : 0.0f;
-    }
-    normals_owner_ = frame.normals;
+  vtkPointData* point_data =
+      vtkPolyData::SafeDownCast(surface.GetMapper()->GetInput())->GetPointData();
+  vtkUnsignedCharArray* shown = vtkUnsignedCharArray::SafeDownCast(point_data->GetScalars());
+  if (shown == nullptr || !std::equal(rgb, rgb + 3 * n, shown->GetPointer(0))) {
+    point_data->SetScalars(colors);
   }
-  // One polydata and mapper for the window's life: a new frame replaces arrays, so the mapper
-  // keeps its shaders and the triangle index buffer.
-  if (!surface_) {
-    surface_data_ = vtkSmartPointer<vtkPolyData>::New();
-    if (model_.isMesh()) {
-      surface_data_->SetPolys(cells_);
-    } else {
-      surface_data_->SetVerts(cells_);
+  if (frame.state.smooth_shading) {
+    surface_property_->SetInterpolationToGouraud();
+  } else {
+    surface_property_->SetInterpolationToFlat();
+  }
+  surface_property_->SetPointSize(model_.isMesh() ? 1.0f : 2.0f);
+  surface_property_->SetLighting(model_.isMesh());
+}
+
+vtkActor& ViewerWindow::showSurface(const std::shared_ptr<const Eigen::Matrix3Xd>& normals) {
+  // As many as there are normal methods: cycling through all of them rebuilds nothing.
+  constexpr std::size_t kSurfaceActors = 6;
+  vtkRenderer* renderer = rendererOf(*visualizer_);
+  auto found = std::find_if(surfaces_.begin(), surfaces_.end(),
+                            [&](const SurfaceActor& s) { return s.normals == normals; });
+  if (found != surfaces_.end()) {
+    std::rotate(surfaces_.begin(), found, found + 1);
+  } else {
+    const Eigen::Index n = normals->cols();
+    auto array = vtkSmartPointer<vtkFloatArray>::New();
+    array->SetNumberOfComponents(3);
+    array->SetName("normals");
+    array->SetNumberOfTuples(n);
+    float* xyz = array->GetPointer(0);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const bool finite = normals->col(i).allFinite();
+      for (int c = 0; c < 3; ++c)
+        xyz[3 * i + c] = finite ? static_cast<float>((*normals)(c, i)) : 0.0f;
     }
+    auto data = vtkSmartPointer<vtkPolyData>::New();
+    data->SetPoints(points_);
+    if (model_.isMesh()) {
+      data->SetPolys(cells_);
+    } else {
+      data->SetVerts(cells_);
+    }
+    data->GetPointData()->SetNormals(array);
     auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-    mapper->SetInputData(surface_data_);
+    mapper->SetInputData(data);
     mapper->SetColorModeToDirectScalars();
     mapper->ScalarVisibilityOn();
-    surface_ = vtkSmartPointer<vtkActor>::New();
-    surface_->SetMapper(mapper);
-    rendererOf(*visualizer_)->AddActor(surface_);
+    auto actor = vtkSmartPointer<vtkActor>::New();
+    actor->SetMapper(mapper);
+    actor->SetProperty(surface_property_);
+    renderer->AddActor(actor);
+    surfaces_.insert(surfaces_.begin(), {normals, actor});
+    if (surfaces_.size() > kSurfaceActors) {
+      renderer->RemoveActor(surfaces_.back().actor);
+      surfaces_.pop_back();
+    }
   }
-  if (surface_data_->GetPoints() != points_) surface_data_->SetPoints(points_);
-  vtkPointData* point_data = surface_data_->GetPointData();
-  if (point_data->GetScalars() != colors_) point_data->SetScalars(colors_);
-  if (point_data->GetNormals() != normals_) point_data->SetNormals(normals_);
-  vtkProperty* property = surface_->GetProperty();
-  if (frame.state.smooth_shading) {
-    property->SetInterpolationToGouraud();
-  } else {
-    property->SetInterpolationToFlat();
-  }
-  property->SetPointSize(model_.isMesh() ? 1.0f : 2.0f);
-  property->SetLighting(model_.isMesh());
+  for (std::size_t i = 0; i < surfaces_.size(); ++i) surfaces_[i].actor->SetVisibility(i == 0);
+  return *surfaces_.front().actor;
+}
+
+void ViewerWindow::cullHiddenFaces() {
+  // Drawn as wireframe or points (PCL's keys w and p) or translucent, every face shows.
+  const bool opaque_surface = surface_property_->GetRepresentation() == VTK_SURFACE &&
+                              surface_property_->GetOpacity() >= 1.0;
+  const bool cull = cull_allowed_ && faces_outward_ && opaque_surface &&
+                    boxBeyondNearPlane(*rendererOf(*visualizer_)->GetActiveCamera(), bounds_);
+  surface_property_->SetBackfaceCulling(cull);
+}
+
+void ViewerWindow::setHiddenFaceCulling(bool allowed) {
+  cull_allowed_ = allowed;
+  needs_render_ = true;
+}
+
+bool ViewerWindow::culledBackFaces() const {
+  return surface_property_->GetBackfaceCulling() != 0;
 }
 
 void ViewerWindow::drawNormals(const Frame& frame) {

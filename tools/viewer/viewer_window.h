@@ -20,6 +20,7 @@ class vtkCellArray;
 class vtkFloatArray;
 class vtkPoints;
 class vtkPolyData;
+class vtkProperty;
 class vtkScalarBarActor;
 class vtkTextActor;
 class vtkUnsignedCharArray;
@@ -49,6 +50,10 @@ class ViewerWindow {
   const std::vector<std::string>& errors() const { return errors_; }
   vtkRenderWindowInteractor* interactor();
   pcl::visualization::PCLVisualizer& visualizer() { return *visualizer_; }
+  /** Whether back faces may be left out where none can be seen (the default); false draws all. */
+  void setHiddenFaceCulling(bool allowed);
+  /** Whether the last render left out the back faces. */
+  bool culledBackFaces() const;
 
  private:
   void onKey(const pcl::visualization::KeyboardEvent& event);
@@ -61,6 +66,10 @@ class ViewerWindow {
   /** One render when something changed since the last (the only place that renders). */
   void renderIfChanged();
   void drawSurface(const Frame& frame);
+  /** The surface actor drawing these normals, made if none does; it becomes the one shown. */
+  vtkActor& showSurface(const std::shared_ptr<const Eigen::Matrix3Xd>& normals);
+  /** Before every render (also the interactor's): cull back faces where none can be seen. */
+  void cullHiddenFaces();
   void drawNormals(const Frame& frame);
   void drawOverlay(const Frame& frame, const std::string& status);
   void addMethodLabels(int height);
@@ -78,8 +87,21 @@ class ViewerWindow {
   bool drawn_once_ = false;
   std::vector<std::string> errors_;
   std::vector<std::string> notes_;  ///< of actions since the last frame (k clamped, refusals)
-  vtkSmartPointer<vtkActor> surface_, glyphs_;
-  vtkSmartPointer<vtkPolyData> surface_data_;
+  /** A surface actor per normals recently shown, the one on screen first: switching back to
+   *  normals still here draws buffers VTK already has (a changed normals array makes VTK rebuild
+   *  its vertex buffers, a quarter of a software render of a million vertices). All share the
+   *  points, the cells and one property. */
+  struct SurfaceActor {
+    std::shared_ptr<const Eigen::Matrix3Xd> normals;
+    vtkSmartPointer<vtkActor> actor;
+  };
+  std::vector<SurfaceActor> surfaces_;
+  vtkSmartPointer<vtkProperty> surface_property_;
+  vtkSmartPointer<vtkActor> glyphs_;
+  bool cull_allowed_ = true;
+  bool faces_outward_ = false;  ///< of the positions shown (see hidden_faces.h)
+  double bounds_[6] = {};       ///< of the positions shown
+  unsigned long cull_observer_ = 0;
   vtkSmartPointer<vtkTextActor> text_;
   /** The normal methods along the top, the current one bright, those the input lacks greyed. */
   struct MethodLabel {
@@ -91,10 +113,7 @@ class ViewerWindow {
   vtkSmartPointer<vtkScalarBarActor> color_bar_;
   vtkSmartPointer<vtkCellArray> cells_;  ///< triangles or vertices: the same in every frame
   vtkSmartPointer<vtkPoints> points_;    ///< of points_owner_
-  std::shared_ptr<const Eigen::Matrix3Xd> points_owner_;   ///< the positions shown
-  vtkSmartPointer<vtkUnsignedCharArray> colors_;           ///< on screen
-  vtkSmartPointer<vtkFloatArray> normals_;                 ///< of normals_owner_
-  std::shared_ptr<const Eigen::Matrix3Xd> normals_owner_;  ///< the normals shown
+  std::shared_ptr<const Eigen::Matrix3Xd> points_owner_;  ///< the positions shown
 };
 
 /** One line saying why no window can open (no DISPLAY, or an X server that does not answer), or
