@@ -9,6 +9,7 @@
 #include "estimator_support.h"
 
 #include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/operators/curvature.h"
 #include "pcl_ddg/surface/mesh_normals.h"
@@ -150,6 +151,33 @@ TEST(MeshNormals, RealScansGiveUnitFiniteNormalsWhereValid) {
       for (Eigen::Index i = 0; i < p.cols(); ++i) {
         if (n.valid[i]) ASSERT_NEAR(n.normals.col(i).norm(), 1.0, 1e-12);
       }
+    }
+  }
+}
+
+// Area and uniform normals sum each vertex's triangles in ascending order: to the bit what a
+// gather over incidentTriangles() with the textbook face normals gives, on a scan with duplicate
+// and degenerate faces.
+TEST(MeshNormals, FaceWeightingsSumEachVertexsTrianglesInOrder) {
+  const pcl::PolygonMesh mesh = loadMesh(sharedData("meshes/bun_zipper_res3.ply"));
+  const MeshTopology topology(mesh);
+  const Eigen::Matrix3Xd p = vertexPositions(mesh.cloud);
+  const Eigen::Matrix3Xi& triangles = topology.triangles();
+  for (const NormalWeighting w : {NormalWeighting::Area, NormalWeighting::Uniform}) {
+    const MeshNormals normals = computeMeshNormals(topology, p, {w});
+    for (int v = 0; v < topology.numVertices(); ++v) {
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (const int t : topology.incidentTriangles(v)) {
+        const Eigen::Vector3d a = p.col(triangles(0, t)), b = p.col(triangles(1, t)),
+                              c = p.col(triangles(2, t));
+        if (isDegenerateTriangle(a, b, c)) continue;
+        const Eigen::Vector3d area_vector = 0.5 * (b - a).cross(c - a);
+        sum += w == NormalWeighting::Area ? area_vector
+                                          : Eigen::Vector3d(area_vector / area_vector.norm());
+      }
+      if (!normals.valid[v]) continue;
+      const Eigen::Vector3d expected = sum / sum.norm();
+      ASSERT_EQ(normals.normals.col(v), expected) << "vertex " << v;
     }
   }
 }

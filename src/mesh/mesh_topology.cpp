@@ -4,12 +4,9 @@
 #include <numeric>
 #include <sstream>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "disjoint_sets.h"
 #include "pcl_ddg/exceptions.h"
+#include "vertex_ranges.h"
 
 namespace pcl_ddg {
 namespace {
@@ -22,24 +19,6 @@ std::vector<pcl::Vertices> trianglesAsPolygons(const Eigen::Matrix3Xi& triangles
     }
   }
   return polygons;
-}
-
-// Runs body(first, last) once per thread, on the thread's own contiguous range of vertices. Passes
-// that scatter per-triangle or per-edge data into per-vertex rows use it: every thread reads the
-// whole input but writes only its own rows, so no atomics are needed and each thread's random
-// writes land in a smaller part of memory.
-template <class Body>
-void forEachVertexRange(int num_vertices, const Body& body) {
-#pragma omp parallel
-  {
-#ifdef _OPENMP
-    const std::int64_t threads = omp_get_num_threads(), id = omp_get_thread_num();
-#else
-    const std::int64_t threads = 1, id = 0;
-#endif
-    body(static_cast<int>(num_vertices * id / threads),
-         static_cast<int>(num_vertices * (id + 1) / threads));
-  }
 }
 
 bool isPlainTriangle(const pcl::Indices& corners) {
@@ -206,7 +185,7 @@ MeshTopology::Wedges MeshTopology::buildVertexTriangles(
     const std::vector<pcl::Vertices>& polygons) {
   const Eigen::Index num_triangles = triangles_.cols();
   vt_offsets_.assign(num_vertices_ + 1, 0);
-  forEachVertexRange(num_vertices_, [&](int first, int last) {
+  detail::forEachVertexRange(num_vertices_, [&](int first, int last) {
     for (Eigen::Index c = 0; c < 3 * num_triangles; ++c) {
       const int v = triangles_.data()[c];
       if (v >= first && v < last) ++vt_offsets_[v + 1];
@@ -227,7 +206,7 @@ MeshTopology::Wedges MeshTopology::buildVertexTriangles(
                 std::unique_ptr<int[]>(new int[incidences]),
                 std::unique_ptr<std::uint8_t[]>(new std::uint8_t[incidences])};
   std::vector<int> cursor(vt_offsets_.begin(), vt_offsets_.end() - 1);
-  forEachVertexRange(num_vertices_, [&](int first, int last) {
+  detail::forEachVertexRange(num_vertices_, [&](int first, int last) {
     for (Eigen::Index t = 0; t < num_triangles; ++t) {
       for (int k = 0; k < 3; ++k) {
         const int v = triangles_(k, t);
@@ -295,7 +274,7 @@ void MeshTopology::buildEdges(const Wedges& wedges) {
   vv_edges_.resize(vv_neighbours_.size());
   edge_vertices_.resize(2, num_edges);
   std::vector<int> smaller_filled(vv_offsets_.begin(), vv_offsets_.end() - 1);
-  forEachVertexRange(num_vertices_, [&](int first, int last) {
+  detail::forEachVertexRange(num_vertices_, [&](int first, int last) {
     for (int v = 0; v < num_vertices_; ++v) {
       const IndexSpan row = neighbours(v);
       const int larger = first_edge[v + 1] - first_edge[v];
