@@ -39,10 +39,11 @@ NormalSums faceNormalSums(const MeshTopology& topology, const Eigen::Matrix3Xd& 
       const Eigen::Vector3d& a = positions.col(triangles(0, t));
       const Eigen::Vector3d& b = positions.col(triangles(1, t));
       const Eigen::Vector3d& d = positions.col(triangles(2, t));
+      const Eigen::Vector3d cross = (b - a).cross(d - a);
       Eigen::Vector3d normal = Eigen::Vector3d::Zero();
       double length = 0.0;
-      if (!isDegenerateTriangle(a, b, d)) {
-        normal = 0.5 * (b - a).cross(d - a);  // the area vector
+      if (!isDegenerateTriangle(a, b, d, cross)) {
+        normal = 0.5 * cross;  // the area vector
         length = normal.norm();
         if (weighting == NormalWeighting::Uniform) {
           normal /= length;

@@ -17,15 +17,22 @@ namespace pcl_ddg {
  */
 constexpr double kDegenerateTriangleTolerance = 1e-12;
 
-/** True for a zero-area (collinear or repeated-corner) triangle, by the relative guard above. */
+/** True for a zero-area (collinear or repeated-corner) triangle, by the relative guard above, given
+ *  its corners and (b - a) x (c - a), for loops that need that cross product anyway. */
 inline bool isDegenerateTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                 const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, bc = c - b;
-  const double longest_squared = std::max({ab.squaredNorm(), ac.squaredNorm(), bc.squaredNorm()});
+                                 const Eigen::Vector3d& c, const Eigen::Vector3d& cross) {
+  const double longest_squared =
+      std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
   // Squared on both sides: no square root in the operators' innermost loop. (Edges shorter than
   // about 1e-75 underflow here; such coordinates are outside what double geometry supports.)
   const double bound = kDegenerateTriangleTolerance * longest_squared;
-  return ab.cross(ac).squaredNorm() <= bound * bound;
+  return cross.squaredNorm() <= bound * bound;
+}
+
+/** True for a zero-area (collinear or repeated-corner) triangle, by the relative guard above. */
+inline bool isDegenerateTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                 const Eigen::Vector3d& c) {
+  return isDegenerateTriangle(a, b, c, (b - a).cross(c - a));
 }
 
 /** Mean length of the unique edges whose end points are finite (0 if there are none). */
