@@ -17,13 +17,10 @@
 
 class vtkActor;
 class vtkCellArray;
-class vtkFloatArray;
 class vtkPoints;
-class vtkPolyData;
 class vtkProperty;
 class vtkScalarBarActor;
 class vtkTextActor;
-class vtkUnsignedCharArray;
 class vtkRenderWindowInteractor;
 
 namespace pcl_ddg {
