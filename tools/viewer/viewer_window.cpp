@@ -339,7 +339,6 @@ void ViewerWindow::drawSurface(const Frame& frame) {
       points_->SetPoint(i, p.data());
     }
     points_owner_ = frame.positions;
-    points_->GetBounds(bounds_);
     faces_outward_ = model_.isMesh() && facesOutward(*model_.topology(), positions);
     for (const SurfaceActor& surface : surfaces_)
       rendererOf(*visualizer_)->RemoveActor(surface.actor);
@@ -450,8 +449,9 @@ void ViewerWindow::cullHiddenFaces() {
   // Drawn as wireframe or points (PCL's keys w and p) or translucent, every face shows.
   const bool opaque_surface = surface_property_->GetRepresentation() == VTK_SURFACE &&
                               surface_property_->GetOpacity() >= 1.0;
-  const bool cull = cull_allowed_ && faces_outward_ && opaque_surface &&
-                    boxBeyondNearPlane(*rendererOf(*visualizer_)->GetActiveCamera(), bounds_);
+  const bool cull =
+      cull_allowed_ && faces_outward_ && opaque_surface &&
+      boxBeyondNearPlane(*rendererOf(*visualizer_)->GetActiveCamera(), points_->GetBounds());
   surface_property_->SetBackfaceCulling(cull);
 }
 

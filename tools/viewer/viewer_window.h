@@ -97,7 +97,6 @@ class ViewerWindow {
   vtkSmartPointer<vtkActor> glyphs_;
   bool cull_allowed_ = true;
   bool faces_outward_ = false;  ///< of the positions shown (see hidden_faces.h)
-  double bounds_[6] = {};       ///< of the positions shown
   unsigned long cull_observer_ = 0;
   vtkSmartPointer<vtkTextActor> text_;
   /** The normal methods along the top, the current one bright, those the input lacks greyed. */
