@@ -5,10 +5,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <random>
 
 #include <pcl/conversions.h>
 #include <pcl/point_cloud.h>
@@ -384,6 +386,79 @@ TEST_F(MeshIOFiles, AFullDiskIsAnErrorAndLeavesNoFile) {
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 2) << "both writers must report the failed write";
   EXPECT_TRUE(std::filesystem::is_empty(dir_));
+}
+
+// Binary PLY faces are read in blocks of rows on several threads: faces of every size (including
+// none) across many blocks must come back as written, in either byte order (big-endian goes
+// through the general reader, value by value).
+TEST_F(MeshIOFiles, BinaryPlyFacesOfMixedSizesReadAsWrittenInBothByteOrders) {
+  std::mt19937 random(12);
+  std::vector<std::vector<std::int32_t>> faces(20011);
+  for (auto& face : faces) {
+    face.resize(random() % 7);
+    for (auto& corner : face) corner = static_cast<std::int32_t>(random() % 5);
+  }
+  for (const bool big_endian : {false, true}) {
+    SCOPED_TRACE(big_endian ? "big-endian" : "little-endian");
+    const auto put = [&](std::string& data, auto value) {
+      std::string bytes(sizeof(value), '\0');
+      std::memcpy(bytes.data(), &value, sizeof(value));
+      if (big_endian) std::reverse(bytes.begin(), bytes.end());
+      data += bytes;
+    };
+    std::string data = std::string("ply\nformat binary_") + (big_endian ? "big" : "little") +
+                       "_endian 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+                       "property float z\nelement face " +
+                       std::to_string(faces.size()) +
+                       "\nproperty list uchar int vertex_indices\nend_header\n";
+    for (int v = 0; v < 15; ++v) put(data, static_cast<float>(v));
+    for (const auto& face : faces) {
+      put(data, static_cast<std::uint8_t>(face.size()));
+      for (std::int32_t corner : face) put(data, corner);
+    }
+    writeText(path("mixed.ply"), data);
+    const MeshFile file = readMeshFile(path("mixed.ply"));
+    EXPECT_EQ(file.positions.col(4), Eigen::Vector3d(12, 13, 14));
+    ASSERT_EQ(file.mesh.polygons.size(), faces.size());
+    for (std::size_t f = 0; f < faces.size(); ++f) {
+      ASSERT_EQ(file.mesh.polygons[f].vertices,
+                std::vector<pcl::index_t>(faces[f].begin(), faces[f].end()))
+          << "face " << f;
+    }
+  }
+}
+
+// A process that has used OpenMP and then forks (a test runner, a server handing each file to a
+// child): loading in the child must not wait for OpenMP threads the child does not have. The
+// parallel loaders are horse.ply's binary faces and an ascii OFF of 80,000 lines.
+TEST_F(MeshIOFiles, LoadingInAChildForkedAfterOpenMPFinishes) {
+  {
+    std::ofstream off(path("grid.off"));
+    const int side = 200;
+    off << "OFF\n" << side * side << " " << 2 * (side - 1) * (side - 1) << " 0\n";
+    for (int i = 0; i < side * side; ++i) off << i % side << " " << i / side << " 0\n";
+    for (int r = 0; r + 1 < side; ++r) {
+      for (int c = 0; c + 1 < side; ++c) {
+        const int v = r * side + c;
+        off << "3 " << v << " " << v + 1 << " " << v + side << "\n3 " << v + 1 << " "
+            << v + side + 1 << " " << v + side << "\n";
+      }
+    }
+  }
+  int team = 0;
+#pragma omp parallel reduction(+ : team)
+  team += 1;
+  EXPECT_GE(team, 1);
+  const pid_t child = fork();
+  if (child == 0) {
+    alarm(20);  // a hang becomes a SIGALRM death
+    const bool loaded = loadMesh(sharedData("meshes/horse.ply")).polygons.size() == 96966 &&
+                        loadMesh(path("grid.off")).polygons.size() == 2 * 199 * 199;
+    _exit(loaded ? 0 : 1);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "child status " << status;
 }
 
 }  // namespace

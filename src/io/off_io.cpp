@@ -6,6 +6,7 @@
 
 #include "byte_cursor.h"
 #include "formats.h"
+#include "loader_threads.h"
 #include "xyz_cloud.h"
 
 namespace pcl_ddg {
@@ -124,18 +125,9 @@ pcl::PolygonMesh parseOFF(std::string_view data) {
     polygon.vertices.resize(static_cast<std::size_t>(n));
     for (auto& corner : polygon.vertices) corner = cornerIndex(values.readInt("face index"));
   };
-  const std::int64_t total = num_vertices + num_faces;
-  std::int64_t first_error = total;
-#pragma omp parallel for schedule(static)
-  for (std::int64_t i = 0; i < total; ++i) {
-    try {
-      parseLine(i);
-    } catch (const FileFormatException&) {
-#pragma omp critical(off_parse_error)
-      first_error = std::min(first_error, i);
-    }
-  }
-  if (first_error < total) parseLine(first_error);  // rethrows the first error, in order
+  // The first error by line order is the one reported: each thread's lines are contiguous.
+  constexpr std::int64_t kLinesPerThread = 16384;  // fewer do not repay starting a thread
+  parallelForInLoader(num_vertices + num_faces, kLinesPerThread, parseLine);
   mesh.cloud = makeXYZCloud(xyz);
   return mesh;
 }
