@@ -30,8 +30,8 @@ std::vector<CholeskyBackend> availableBackends() {
   return backends;
 }
 
-// Large enough for CHOLMOD's supernodal path and for blocks of several MiB (those advised for huge
-// pages).
+// Large enough for CHOLMOD's supernodal path and for blocks of several MiB (those mapped and
+// populated).
 TEST(SparseCholesky, SolvesAndRefactorisesLikeAnIndependentSolver) {
   Sampling sampling;
   sampling.resolution = 256;

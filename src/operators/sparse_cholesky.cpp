@@ -7,6 +7,8 @@
 
 #ifdef PCL_DDG_HAVE_CHOLMOD
 #include <Eigen/CholmodSupport>
+
+#include "cholmod_memory.h"
 #endif
 
 #ifdef _OPENMP
@@ -77,6 +79,7 @@ SparseCholesky::SparseCholesky(CholeskyBackend backend)
         "pcl_ddg was built without CHOLMOD (install libsuitesparse-dev)");
   }
 #ifdef PCL_DDG_HAVE_CHOLMOD
+  if (backend_ == CholeskyBackend::Cholmod) detail::populateCholmodAllocations();
   // A matrix that is not positive definite is reported by exception, not printed by CHOLMOD.
   cholmod_common& common = impl_->cholmod.cholmod();
   common.print = 0;
