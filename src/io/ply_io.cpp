@@ -273,7 +273,8 @@ void readVertices(const PlyElement& element, PlyFormat format, PlyValueReader& r
                                      [](const PlyProperty& p) { return p.is_list; });
   cloud.is_dense = false;  // unknown until checked; consumers test finiteness themselves
   if (isHostOrderBinary(format) && !has_lists) {
-    std::memcpy(cloud.data.data(), cursor.take(cloud.data.size(), "vertex"), cloud.data.size());
+    const char* rows = cursor.take(cloud.data.size(), "vertex");
+    if (!cloud.data.empty()) std::memcpy(cloud.data.data(), rows, cloud.data.size());
     return;
   }
   for (std::int64_t i = 0; i < element.count; ++i) {
