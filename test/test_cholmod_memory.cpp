@@ -5,9 +5,11 @@
 
 #include <SuiteSparse_config.h>
 
+#include <Eigen/SparseCore>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <vector>
 
 #include "operators/cholmod_memory.h"
 #include "pcl_ddg/operators/sparse_cholesky.h"
@@ -17,6 +19,11 @@ namespace test {
 namespace {
 
 constexpr std::size_t kSmall = 1000, kLarge = std::size_t{3} << 20;
+
+// Constructed before the allocator's table of mapped blocks exists, so destroyed after it would
+// be: its factor's blocks are freed during exit (a crash or a sanitizer report if the table were
+// gone by then).
+SparseCholesky solver_in_a_static(CholeskyBackend::Cholmod);
 
 void fill(void* block, std::size_t bytes) {
   auto* data = static_cast<unsigned char*>(block);
@@ -68,6 +75,23 @@ TEST(CholmodMemory, SparseCholeskyInstallsItOverTheDefaults) {
   const SparseCholesky solver(CholeskyBackend::Cholmod);
   EXPECT_EQ(SuiteSparse_config.malloc_func, &detail::populatedMalloc);
   EXPECT_EQ(SuiteSparse_config.free_func, &detail::populatedFree);
+}
+
+TEST(CholmodMemory, AFactorInAStaticObjectIsFreedAtExit) {
+  // The 5-point Laplacian of a 300 x 300 grid plus the identity: a factor of several MiB.
+  const int side = 300, n = side * side;
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < n; ++i) {
+    entries.emplace_back(i, i, 5.0);
+    if (i % side + 1 < side) entries.emplace_back(i, i + 1, -1.0);
+    if (i + side < n) entries.emplace_back(i, i + side, -1.0);
+  }
+  Eigen::SparseMatrix<double> upper(n, n);
+  upper.setFromTriplets(entries.begin(), entries.end());
+  const Eigen::SparseMatrix<double> matrix = upper.selfadjointView<Eigen::Upper>();
+  solver_in_a_static.compute(matrix);
+  const Eigen::VectorXd x = solver_in_a_static.solve(Eigen::MatrixXd::Ones(n, 1));
+  EXPECT_LT((matrix * x - Eigen::VectorXd::Ones(n)).cwiseAbs().maxCoeff(), 1e-12);
 }
 
 }  // namespace

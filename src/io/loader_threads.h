@@ -17,9 +17,9 @@
 namespace pcl_ddg {
 namespace detail {
 
-/** Calls body(i) for every i in [0, count), each thread on its own contiguous range; loops shorter
- *  than `min_per_thread` per thread use fewer threads (the shortest, only the caller's). The first
- * exception thrown by any range (by range order) is rethrown once all threads have finished. */
+/** Calls body(i) for every i in [0, count), each thread on its own contiguous range, with fewer
+ *  threads than OpenMP's setting when a thread would get fewer than `min_per_thread` items. The
+ *  first exception by range order is rethrown once all threads have finished. */
 template <class Body>
 void parallelForInLoader(std::int64_t count, std::int64_t min_per_thread, const Body& body) {
 #ifdef _OPENMP

@@ -126,7 +126,7 @@ pcl::PolygonMesh parseOFF(std::string_view data) {
     for (auto& corner : polygon.vertices) corner = cornerIndex(values.readInt("face index"));
   };
   // The first error by line order is the one reported: each thread's lines are contiguous.
-  constexpr std::int64_t kLinesPerThread = 16384;  // fewer do not repay starting a thread
+  constexpr std::int64_t kLinesPerThread = 16384;  // small files: no thread started
   parallelForInLoader(num_vertices + num_faces, kLinesPerThread, parseLine);
   mesh.cloud = makeXYZCloud(xyz);
   return mesh;

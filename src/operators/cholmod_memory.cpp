@@ -15,11 +15,12 @@ namespace {
 
 constexpr std::size_t kPopulatedBytes = std::size_t{1} << 20;
 
-// The mapped blocks and their lengths, which munmap needs and free() must never see.
+// The mapped blocks and their lengths, which munmap needs and free() must never see. Never
+// destroyed: a solver in a static object frees its factor after function-local statics are gone.
 std::mutex mapped_mutex;
 std::unordered_map<void*, std::size_t>& mappedBlocks() {
-  static std::unordered_map<void*, std::size_t> blocks;
-  return blocks;
+  static auto* const blocks = new std::unordered_map<void*, std::size_t>();
+  return *blocks;
 }
 
 // The length of a mapped block, or 0 for one from malloc.
