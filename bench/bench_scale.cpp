@@ -7,8 +7,9 @@
 //   clouds  points sampled on igea.ply's surface: load -> PCA normals through the kd-tree, k = 16
 // Reported per size: ns per element for each phase and in all, peak bytes per vertex (above the
 // process's own footprint before loading), and the ratio of the largest size's time per element
-// to the smallest's. With --write-cloud=COUNT:PATH it only writes such a cloud (for
-// bench_out_of_core.sh), with --write-mesh=SHARED_MESH:LEVELS:PATH such a mesh.
+// to the smallest's: medians with --benchmark_repetitions=N, which a shared VM needs (single runs
+// of the 1M mesh took 299 and 447 ns per triangle). With --write-cloud=COUNT:PATH it only writes
+// such a cloud (for bench_out_of_core.sh), with --write-mesh=SHARED_MESH:LEVELS:PATH such a mesh.
 #include <benchmark/benchmark.h>
 #include <pcl/conversions.h>
 #include <sys/wait.h>
@@ -22,6 +23,7 @@
 #include <map>
 #include <random>
 #include <sstream>
+#include <vector>
 
 #include "bench_support.h"
 #include "pcl_ddg/features/local_fit.h"
@@ -252,6 +254,12 @@ std::map<std::string, double> measure(const Input& input) {
   return values;
 }
 
+// Every run's time per element, by input, for the flatness line printed at the end.
+std::map<const Input*, std::vector<double>>& nsPerElement() {
+  static std::map<const Input*, std::vector<double>> runs;
+  return runs;
+}
+
 void scale(benchmark::State& state, const Input* input) {
   for (auto _ : state) {
     const std::map<std::string, double> v = measure(*input);
@@ -263,9 +271,34 @@ void scale(benchmark::State& state, const Input* input) {
     }
     state.SetIterationTime(total);
     state.counters["ns_per_element"] = 1e9 * total / input->elements;
+    nsPerElement()[input].push_back(1e9 * total / input->elements);
     state.counters["bytes_per_vertex"] =
         (v.at("peak_bytes") - v.at("base_bytes")) / v.at("vertices");
     state.counters["elements"] = static_cast<double>(input->elements);
+  }
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values[values.size() / 2];
+}
+
+// The largest input's time per element over the smallest's, for meshes and for clouds (medians
+// of the runs, one per --benchmark_repetitions).
+void printFlatness() {
+  for (const bool cloud : {false, true}) {
+    const Input *smallest = nullptr, *largest = nullptr;
+    for (const auto& [input, runs] : nsPerElement()) {
+      if (input->cloud != cloud || runs.empty()) continue;
+      if (!smallest || input->elements < smallest->elements) smallest = input;
+      if (!largest || input->elements > largest->elements) largest = input;
+    }
+    if (!smallest || smallest == largest) continue;
+    const double small = median(nsPerElement()[smallest]), large = median(nsPerElement()[largest]);
+    std::printf("%s: %s %.0f ns per element, %s %.0f: %.2fx (median of %zu and %zu runs)\n",
+                cloud ? "clouds" : "meshes", smallest->label.c_str(), small, largest->label.c_str(),
+                large, large / small, nsPerElement()[smallest].size(),
+                nsPerElement()[largest].size());
   }
 }
 
@@ -308,6 +341,7 @@ int main(int argc, char** argv) {
         ->Iterations(1);
   }
   const int result = runWithRatios(argc, argv);
+  printFlatness();
   std::filesystem::remove_all(folder);
   return result;
 }
