@@ -445,10 +445,9 @@ TEST_F(MeshIOFiles, LoadingInAChildForkedAfterOpenMPFinishes) {
       }
     }
   }
-  int team = 0;
-#pragma omp parallel reduction(+ : team)
-  team += 1;
-  EXPECT_GE(team, 1);
+  // This process starts OpenMP's thread team, as a test runner or a server may have.
+#pragma omp parallel
+  {}
   const pid_t child = fork();
   if (child == 0) {
     alarm(20);  // a hang becomes a SIGALRM death
