@@ -17,9 +17,9 @@ namespace {
 constexpr const char* kName = "pcl_ddg_smooth";
 constexpr const char* kDescription =
     "Smooths a mesh by Laplacian flow dx/dt = M^-1 L x: explicit (forward Euler; stable only for\n"
-    "small steps, the bound is printed) or implicit (backward Euler, one sparse Cholesky solve "
-    "per\n"
-    "iteration; any step). The time step -lambda_dt is in units of h^2 (h = mean edge length), so\n"
+    "small steps, the bound is printed) or implicit (backward Euler, one sparse Cholesky or\n"
+    "conjugate-gradient solve per iteration, by default whichever costs less; any step). The time "
+    "step -lambda_dt is in units of h^2 (h = mean edge length), so\n"
     "one command line works on any scan; -absolute_time takes it in length^2.";
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk} output.{ply,pcd}\n"
@@ -29,7 +29,7 @@ constexpr const char* kSyntax =
     "the stability bound)]\n"
     "         [-iterations n (default 1)] [-absolute_time] [-freeze_weights | -rebuild_weights]\n"
     "         [-fix_boundary] [-allow_unstable]\n"
-    "         [-preserve volume|area] [-solver auto|cholmod|ldlt] [-precision float|double]";
+    "         [-preserve volume|area] [-solver auto|cholmod|ldlt|cg] [-precision float|double]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
@@ -57,7 +57,9 @@ int run(int argc, char** argv) {
   p.shrinkage = preserve == "volume" ? ShrinkageCorrection::PreserveVolume
                 : preserve == "area" ? ShrinkageCorrection::PreserveArea
                                      : ShrinkageCorrection::None;
-  p.solver = tools::solverArgument(args);
+  const tools::SolverChoice solver = tools::solverArgument(args);
+  p.implicit_solver = solver.method;
+  p.solver = solver.backend;
   if (args.has("absolute_time") && !args.has("lambda_dt"))
     throw tools::UsageError("-absolute_time needs -lambda_dt");
   const double lambda_dt = args.number("lambda_dt", 1.0);
@@ -104,7 +106,13 @@ int run(int argc, char** argv) {
         timer.done(points);
         if (p.scheme == SmoothingScheme::Implicit) {
           std::cerr << kName << ": " << report.iterations << " implicit step(s) of "
-                    << p.time_step / (h * h) << " h^2, solver " << toString(report.solver) << "\n";
+                    << p.time_step / (h * h) << " h^2, solver ";
+          if (report.implicit_solver == ImplicitSolver::ConjugateGradient) {
+            std::cerr << "conjugate gradients (" << report.conjugate_gradient_iterations
+                      << " iterations)\n";
+          } else {
+            std::cerr << toString(report.solver) << "\n";
+          }
         }
         if (report.fixed_vertices == in.topology.numVertices()) {
           tools::warn(kName,

@@ -24,7 +24,7 @@ constexpr const char* kDescription =
 constexpr const char* kSyntax =
     "input.{pcd,ply} output.{pcd,ply} [-method explicit|implicit (default implicit)]\n"
     "         [-lambda_dt t (default: implicit 1, explicit 0.2)] [-iterations n (default 1)]\n"
-    "         [-max_jump f (default 0.05)] [-solver auto|cholmod|ldlt] [-allow_unstable]";
+    "         [-max_jump f (default 0.05)] [-solver auto|cholmod|ldlt|cg] [-allow_unstable]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
@@ -40,7 +40,9 @@ int run(int argc, char** argv) {
   if (!(p.time_step > 0.0)) throw tools::UsageError("-lambda_dt must be > 0");
   if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
   if (!(p.max_depth_jump > 0.0)) throw tools::UsageError("-max_jump must be > 0");
-  p.solver = tools::solverArgument(args);
+  const tools::SolverChoice solver = tools::solverArgument(args);
+  p.implicit_solver = solver.method;
+  p.solver = solver.backend;
   if (p.scheme == SmoothingScheme::Explicit && p.time_step >= 0.25) {
     if (!args.has("allow_unstable")) {
       throw pcl::BadArgumentException(

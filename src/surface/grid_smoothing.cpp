@@ -79,7 +79,8 @@ Eigen::Matrix3Xd smoothOrganizedPositions(const Eigen::Matrix3Xd& positions, int
   Eigen::VectorXd mass(n);
   for (int i = 0; i < n; ++i) mass[i] = valid[i] ? 1.0 : 0.0;
 
-  detail::LaplacianFlow flow(n, {}, p.solver);
+  detail::LaplacianFlow flow(n, {}, p.solver, p.implicit_solver);
+  flow.planSteps(p.iterations, 1);
   flow.setOperator(std::move(laplacian), std::move(mass));
   for (int iteration = 1; iteration <= p.iterations; ++iteration) {
     if (p.scheme == SmoothingScheme::Explicit) {

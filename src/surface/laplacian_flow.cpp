@@ -2,19 +2,61 @@
 
 #include <pcl/exceptions.h>
 
+#include <Eigen/IterativeLinearSolvers>
 #include <algorithm>
+#include <climits>
+#include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 
 namespace pcl_ddg {
-namespace detail {
 
-LaplacianFlow::LaplacianFlow(int num_vertices, std::vector<char> fixed, CholeskyBackend backend)
-    : num_vertices_(num_vertices), fixed_(std::move(fixed)), solver_(backend) {
+const char* toString(ImplicitSolver solver) {
+  switch (solver) {
+    case ImplicitSolver::Automatic:
+      return "automatic";
+    case ImplicitSolver::Cholesky:
+      return "Cholesky";
+    case ImplicitSolver::ConjugateGradient:
+      return "conjugate gradients";
+  }
+  return "?";
+}
+
+namespace detail {
+namespace {
+
+// Residual of the displacement's system relative to its right-hand side tau L X: the solution then
+// agrees with a Cholesky solve of the positions to rounding (test_mesh_smoothing).
+constexpr double kConjugateGradientTolerance = 1e-12;
+
+// Costs in conjugate-gradient iterations (one sparse matrix-vector product and a few vector
+// operations), measured with bench_smoothing's tori from 18k to 1.15M vertices, two threads: a
+// CHOLMOD factorisation with its analysis 240-390 iterations at every size, a solve 10-17 per
+// column; Eigen's SimplicialLDLT factorises in about 4 sqrt(n).
+constexpr double kCholmodFactorisationCost = 300.0;
+constexpr double kSimplicialFactorisationCostPerRootVertex = 4.0;
+constexpr double kCholeskySolveCostPerColumn = 15.0;
+
+}  // namespace
+
+LaplacianFlow::LaplacianFlow(int num_vertices, std::vector<char> fixed, CholeskyBackend backend,
+                             ImplicitSolver solver)
+    : num_vertices_(num_vertices),
+      fixed_(std::move(fixed)),
+      solver_(backend),
+      method_(solver),
+      automatic_(solver == ImplicitSolver::Automatic) {
   if (fixed_.empty()) fixed_.assign(num_vertices_, 0);
   if (static_cast<int>(fixed_.size()) != num_vertices_) {
     throw pcl::BadArgumentException("fixed-vertex mask of the wrong size");
   }
+}
+
+void LaplacianFlow::planSteps(int steps, int new_operators) {
+  planned_steps_ = std::max(steps, 1);
+  planned_new_operators_ = std::clamp(new_operators, 1, planned_steps_);
 }
 
 void LaplacianFlow::setOperator(Eigen::SparseMatrix<double> laplacian, Eigen::VectorXd mass) {
@@ -36,13 +78,13 @@ void LaplacianFlow::setOperator(Eigen::SparseMatrix<double> laplacian, Eigen::Ve
     buildSystemPattern();
     pattern_analysed_ = false;
   }
-  factor_current_ = false;
+  system_current_ = factor_current_ = false;
 }
 
 void LaplacianFlow::setMass(Eigen::VectorXd mass) {
   if (mass.size() != num_vertices_) throw pcl::BadArgumentException("mass of the wrong size");
   mass_ = std::move(mass);
-  factor_current_ = false;
+  system_current_ = factor_current_ = false;
 }
 
 void LaplacianFlow::chooseFreeVertices() {
@@ -106,15 +148,116 @@ void LaplacianFlow::explicitStep(Eigen::MatrixXd& values, double tau) const {
 
 void LaplacianFlow::implicitStep(Eigen::MatrixXd& values, double tau) {
   if (numFree() == 0) return;  // every value constrained: nothing to solve for
-  if (!factor_current_ || tau != factor_tau_) {
+  if (!system_current_ || tau != system_tau_) {
     fillSystem(tau);
+    system_current_ = true;
+    system_tau_ = tau;
+    factor_current_ = false;
+  }
+  if (method_ == ImplicitSolver::Automatic) {
+    method_ = cheaperSolver(static_cast<int>(values.cols()));
+  }
+  if (method_ == ImplicitSolver::ConjugateGradient) {
+    if (conjugateGradientStep(values, tau)) return;
+    if (!automatic_) {
+      throw pcl::ComputeFailedException(
+          "conjugate gradients did not converge within twice their iteration bound (" +
+          std::to_string(conjugateGradientIterationBound()) + "): use the Cholesky solver");
+    }
+    method_ = ImplicitSolver::Cholesky;
+  }
+  choleskyStep(values, tau);
+}
+
+ImplicitSolver LaplacianFlow::cheaperSolver(int columns) const {
+  const double factorisation =
+      backend() == CholeskyBackend::Cholmod
+          ? kCholmodFactorisationCost
+          : kSimplicialFactorisationCostPerRootVertex * std::sqrt(static_cast<double>(numFree()));
+  const double cholesky = planned_new_operators_ * factorisation +
+                          planned_steps_ * columns * kCholeskySolveCostPerColumn;
+  const double conjugate_gradients =
+      static_cast<double>(planned_steps_) * columns * conjugateGradientIterationBound();
+  return conjugate_gradients < cholesky ? ImplicitSolver::ConjugateGradient
+                                        : ImplicitSolver::Cholesky;
+}
+
+int LaplacianFlow::conjugateGradientIterationBound() const {
+  // The Jacobi-scaled system D^-1 A (A = M - tau L on the free vertices, D its diagonal): A >= M
+  // bounds its smallest eigenvalue below by min m_i / A_ii, Gershgorin its largest above by
+  // max sum_j |A_ij| / A_ii (columns are rows: A is symmetric).
+  double smallest = std::numeric_limits<double>::infinity(), largest = 0.0;
+  const double* a = system_.valuePtr();
+  const int* outer = system_.outerIndexPtr();
+#pragma omp parallel for reduction(min : smallest) reduction(max : largest)
+  for (int c = 0; c < numFree(); ++c) {
+    double row = 0.0;
+    for (int k = outer[c]; k < outer[c + 1]; ++k) row += std::abs(a[k]);
+    const double diagonal = a[diagonal_entry_[c]];
+    smallest = std::min(smallest, mass_[free_vertices_[c]] / diagonal);
+    largest = std::max(largest, row / diagonal);
+  }
+  // In the worst case the error's A-norm shrinks by (sqrt(kappa) - 1) / (sqrt(kappa) + 1) an
+  // iteration, from at most 2 sqrt(kappa) times the tolerated residual.
+  const double root_kappa = std::sqrt(std::max(largest / smallest, 1.0));
+  const double rate = (root_kappa - 1.0) / (root_kappa + 1.0);
+  if (!(rate > 0.0)) return 1;
+  const double bound =
+      std::ceil(std::log(kConjugateGradientTolerance / (2.0 * root_kappa)) / std::log(rate));
+  return bound < INT_MAX / 4 ? std::max(static_cast<int>(bound), 1) : INT_MAX / 4;
+}
+
+bool LaplacianFlow::conjugateGradientStep(Eigen::MatrixXd& values, double tau) {
+  const int n = numFree();
+  const Eigen::Index columns = values.cols();
+  // The right-hand side tau L X on the free rows, summed as differences x_u - x_v: L's rows sum
+  // to zero, and far from the origin the sum of w x_u would cancel the displacement's digits.
+  rhs_.resize(n, columns);
+  const int* outer = laplacian_.outerIndexPtr();
+  const int* inner = laplacian_.innerIndexPtr();
+  const double* weight = laplacian_.valuePtr();
+#pragma omp parallel for schedule(static)
+  for (int c = 0; c < n; ++c) {
+    const int v = free_vertices_[c];
+    for (Eigen::Index column = 0; column < columns; ++column) {
+      double sum = 0.0;
+      for (int k = outer[v]; k < outer[v + 1]; ++k) {
+        if (inner[k] != v) sum += weight[k] * (values(inner[k], column) - values(v, column));
+      }
+      rhs_(c, column) = tau * sum;
+    }
+  }
+  // The system is symmetric, so its column-major arrays read as row-major: the form whose
+  // products Eigen runs on several threads.
+  const Eigen::Map<const Eigen::SparseMatrix<double, Eigen::RowMajor>> system(
+      n, n, system_.nonZeros(), system_.outerIndexPtr(), system_.innerIndexPtr(),
+      system_.valuePtr());
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double, Eigen::RowMajor>,
+                           Eigen::Lower | Eigen::Upper>
+      cg;
+  cg.setTolerance(kConjugateGradientTolerance);
+  cg.setMaxIterations(2 * conjugateGradientIterationBound());
+  cg.compute(system);
+  solution_.resize(n, columns);
+  long iterations = 0;
+  for (Eigen::Index column = 0; column < columns; ++column) {
+    solution_.col(column) = cg.solve(rhs_.col(column));
+    iterations += cg.iterations();
+    if (cg.info() != Eigen::Success) return false;
+  }
+  cg_iterations_ += iterations;
+  for (int c = 0; c < n; ++c) values.row(free_vertices_[c]) += solution_.row(c);
+  return true;
+}
+
+void LaplacianFlow::choleskyStep(Eigen::MatrixXd& values, double tau) {
+  if (!factor_current_) {
     if (!pattern_analysed_) {
       solver_.analyzePattern(system_);
       pattern_analysed_ = true;
     }
     solver_.factorize(system_);
     factor_current_ = true;
-    factor_tau_ = tau;
   }
   // rhs_ and solution_ keep their storage from step to step: at a million vertices each is 27 MB
   // that would otherwise be page-faulted in again.

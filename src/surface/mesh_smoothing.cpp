@@ -104,7 +104,8 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   if (p.boundary == BoundaryCondition::Fixed) {
     for (int v = 0; v < n; ++v) fixed[v] = topology.isBoundary(v);
   }
-  detail::LaplacianFlow flow(n, std::move(fixed), p.solver);
+  detail::LaplacianFlow flow(n, std::move(fixed), p.solver, p.implicit_solver);
+  flow.planSteps(p.iterations, p.weight_update == WeightUpdate::Frozen ? 1 : p.iterations);
   const auto setOperator = [&](const Eigen::Matrix3Xd& at) {
     flow.setOperator(laplacian(topology, at, p.weights, LaplacianForm::Summed),
                      lumpedMass(topology, at, p.mass));
@@ -162,6 +163,8 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
     r.iterations = iteration;
     if (progress) progress(iteration, p.iterations);
   }
+  r.implicit_solver = flow.implicitSolver();
+  r.conjugate_gradient_iterations = flow.conjugateGradientIterations();
   if (report) {
     r.area_after = surfaceArea(topology, current);
     r.quality_after = triangleQuality(topology, current);

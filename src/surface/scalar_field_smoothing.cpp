@@ -46,7 +46,8 @@ Eigen::MatrixXd smoothScalarFields(const MeshTopology& topology, const Eigen::Ma
   if (p.boundary == BoundaryCondition::Fixed) {
     for (int v = 0; v < n; ++v) fixed[v] = topology.isBoundary(v);
   }
-  detail::LaplacianFlow flow(n, std::move(fixed), p.solver);
+  detail::LaplacianFlow flow(n, std::move(fixed), p.solver, p.implicit_solver);
+  flow.planSteps(p.iterations, 1);
   flow.setOperator(laplacian(topology, positions, p.weights, LaplacianForm::Summed), mass);
   const double tau = p.diffusion_time / p.iterations;
   for (int iteration = 1; iteration <= p.iterations; ++iteration) {

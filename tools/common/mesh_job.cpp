@@ -48,11 +48,12 @@ MassType massTypeArgument(const ToolArguments& args, const std::string& option) 
                                  : MassType::MixedVoronoi;
 }
 
-CholeskyBackend solverArgument(const ToolArguments& args) {
-  const std::string solver = args.choice("solver", {"auto", "cholmod", "ldlt"}, "auto");
-  return solver == "cholmod" ? CholeskyBackend::Cholmod
-         : solver == "ldlt"  ? CholeskyBackend::SimplicialLDLT
-                             : CholeskyBackend::Automatic;
+SolverChoice solverArgument(const ToolArguments& args) {
+  const std::string solver = args.choice("solver", {"auto", "cholmod", "ldlt", "cg"}, "auto");
+  if (solver == "cholmod") return {ImplicitSolver::Cholesky, CholeskyBackend::Cholmod};
+  if (solver == "ldlt") return {ImplicitSolver::Cholesky, CholeskyBackend::SimplicialLDLT};
+  if (solver == "cg") return {ImplicitSolver::ConjugateGradient, CholeskyBackend::Automatic};
+  return {ImplicitSolver::Automatic, CholeskyBackend::Automatic};
 }
 
 FieldPrecision precisionArgument(const ToolArguments& args) {

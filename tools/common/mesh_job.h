@@ -12,6 +12,7 @@
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/operators/mass_matrix.h"
 #include "pcl_ddg/operators/sparse_cholesky.h"
+#include "pcl_ddg/surface/implicit_solver.h"
 
 namespace pcl_ddg {
 namespace tools {
@@ -33,8 +34,14 @@ SurfaceMesh checkSurfaceMesh(MeshFile file, const char* tool_name);
 /** A vertex-area option (-area or -mass): mixed|voronoi|barycentric, default mixed. */
 MassType massTypeArgument(const ToolArguments& args, const std::string& option);
 
-/** -solver auto|cholmod|ldlt. */
-CholeskyBackend solverArgument(const ToolArguments& args);
+struct SolverChoice {
+  ImplicitSolver method;
+  CholeskyBackend backend;
+};
+
+/** -solver auto|cholmod|ldlt|cg: auto picks the cheaper of Cholesky and conjugate gradients for
+ *  the run; cholmod and ldlt factorise with that backend; cg always iterates. */
+SolverChoice solverArgument(const ToolArguments& args);
 
 /** -precision float|double. */
 FieldPrecision precisionArgument(const ToolArguments& args);

@@ -6,7 +6,8 @@
 // With r the distance of a pixel's point from the sensor origin and tau the time step in
 // pixel^2 units:
 //   explicit  r <- r + tau L r          (stable for tau < 1/4: L's eigenvalues lie in [-8, 0])
-//   implicit  (I - tau L) r' = r        (stable for any tau; one factorisation for all steps)
+//   implicit  (I - tau L) r' = r        (stable for any tau; one factorisation for all steps, or
+//                                        conjugate gradients: implicit_solver.h)
 // where (L r)_i = sum over coupled 4-neighbours j of (r_j - r_i). Pixels with a non-finite point
 // are holes: missing data, never coupled, never filled; they stay NaN. A point exactly at the
 // sensor origin has no ray: it is not coupled and kept as it is. With no valid pixel at all the
@@ -28,7 +29,8 @@ struct GridSmoothingParameters {
   double time_step = 1.0;  ///< tau, pixel^2
   int iterations = 1;
   double max_depth_jump = 0.05;  ///< relative range difference above which pixels decouple
-  CholeskyBackend solver = CholeskyBackend::Automatic;
+  ImplicitSolver implicit_solver = ImplicitSolver::Automatic;
+  CholeskyBackend solver = CholeskyBackend::Automatic;  ///< when the implicit solver factorises
 };
 
 struct GridSmoothingReport {

@@ -6,14 +6,16 @@
 //             length): larger steps make every iteration amplify the finest wrinkles, and the
 //             positions blow up (raised as an exception naming the iteration).
 //   Implicit  (M - tau L) x' = M x (backward Euler, Desbrun et al. 1999): one sparse Cholesky
-//             solve per iteration, x, y, z as three right-hand sides. Stable for any tau, so one
-//             large step replaces thousands of small ones.
+//             or conjugate-gradient solve per iteration (implicit_solver.h; by default whichever
+//             costs less for the run), x, y, z as three right-hand sides. Stable for any tau, so
+//             one large step replaces thousands of small ones.
 // L is the summed uniform or cotangent Laplacian (laplacian.h), M the lumped mass of the chosen
 // type. By default L is frozen at the input and M follows the current positions (Kazhdan et al.
 // 2012, "Can mean-curvature flow be modified to be non-singular?"; libigl's smoothing tutorial):
 // rebuilding cotangent weights every iteration is the singular mean-curvature flow, which pinches
 // triangles into slivers within a few large steps. Both can also be rebuilt every iteration or
-// both frozen at the input. The system's pattern is analysed once and refactorised per iteration.
+// both frozen at the input. With Cholesky the system's pattern is analysed once and refactorised
+// per iteration.
 // The report gives the triangles' angle quality before and after (slivers: a corner under 1 deg).
 //
 // Boundary vertices move (Free, default) or keep their position (Fixed). Vertices without mass
@@ -36,6 +38,7 @@
 #include "pcl_ddg/operators/laplacian.h"
 #include "pcl_ddg/operators/mass_matrix.h"
 #include "pcl_ddg/operators/sparse_cholesky.h"
+#include "pcl_ddg/surface/implicit_solver.h"
 
 namespace pcl_ddg {
 
@@ -55,14 +58,17 @@ struct MeshSmoothingParameters {
   WeightUpdate weight_update = WeightUpdate::FrozenStiffness;
   BoundaryCondition boundary = BoundaryCondition::Free;
   ShrinkageCorrection shrinkage = ShrinkageCorrection::None;
-  CholeskyBackend solver = CholeskyBackend::Automatic;
+  ImplicitSolver implicit_solver = ImplicitSolver::Automatic;
+  CholeskyBackend solver = CholeskyBackend::Automatic;  ///< when the implicit solver factorises
 };
 
 struct MeshSmoothingReport {
   int iterations = 0;
-  CholeskyBackend solver = CholeskyBackend::Automatic;  ///< the one used (implicit)
-  int fixed_vertices = 0;                               ///< fixed boundary + massless
-  double volume_before = 0.0, volume_after = 0.0;       ///< closed meshes (else 0)
+  ImplicitSolver implicit_solver = ImplicitSolver::Automatic;  ///< the one used (implicit)
+  CholeskyBackend solver = CholeskyBackend::Automatic;         ///< the one used by Cholesky
+  long conjugate_gradient_iterations = 0;                      ///< over all steps and columns
+  int fixed_vertices = 0;                                      ///< fixed boundary + massless
+  double volume_before = 0.0, volume_after = 0.0;              ///< closed meshes (else 0)
   double area_before = 0.0, area_after = 0.0;
   TriangleQuality quality_before, quality_after;
 };
@@ -115,6 +121,7 @@ class MeshSmoothing {
   void setShrinkageCorrection(ShrinkageCorrection correction) {
     parameters_.shrinkage = correction;
   }
+  void setImplicitSolver(ImplicitSolver solver) { parameters_.implicit_solver = solver; }
   void setSolver(CholeskyBackend solver) { parameters_.solver = solver; }
   void setProgressCallback(SmoothingProgress progress) { progress_ = std::move(progress); }
 

@@ -4,7 +4,8 @@
 //
 // With tau = lambda * dt = diffusion_time / iterations per step:
 //   explicit  f <- f + tau M^-1 L f           (stable for tau below a fraction of h^2)
-//   implicit  (M - tau L) f' = M f            (one factorisation for all steps and all fields)
+//   implicit  (M - tau L) f' = M f            (one factorisation for all steps and all fields, or
+//                                              conjugate gradients: implicit_solver.h)
 // L (summed, cotangent or uniform) and M (lumped) are those of the fixed mesh. Both schemes
 // conserve the mass-weighted sum of f on a closed mesh (1^T L = 0); a free boundary is insulated
 // (no flux), a fixed one keeps its values (Dirichlet). diffusion_time is in length^2: after a time
@@ -27,7 +28,8 @@ struct HeatFlowParameters {
   double diffusion_time = 0.0;  ///< lambda * t, length^2
   int iterations = 1;
   BoundaryCondition boundary = BoundaryCondition::Free;
-  CholeskyBackend solver = CholeskyBackend::Automatic;
+  ImplicitSolver implicit_solver = ImplicitSolver::Automatic;
+  CholeskyBackend solver = CholeskyBackend::Automatic;  ///< when the implicit solver factorises
 };
 
 /** Smooths every column of fields (N x c, one row per vertex). */
