@@ -67,6 +67,32 @@ TEST_F(SmoothingTools, SmoothSharedMeshesBothSchemesKeepTheMeshAndPreserveVolume
   expectNoLeftovers();
 }
 
+TEST_F(SmoothingTools, EverySolverGivesTheSameSurfaceAndIsNamed) {
+  // One step of h^2 (the default): Automatic iterates. Double coordinates out, so the solvers'
+  // agreement is not hidden by float rounding.
+  const std::string input = sharedData("meshes/cow.off");
+  const auto smoothed = [&](const std::string& solver, const std::string& expected_name) {
+    SCOPED_TRACE(solver);
+    const ToolRun run = runTool(PCL_DDG_SMOOTH_TOOL,
+                                input + " " + path("out.ply") + " -precision double " + solver);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_NE(run.err.find("solver " + expected_name), std::string::npos) << run.err;
+    return readMeshFile(path("out.ply")).positions;
+  };
+  const Eigen::Matrix3Xd automatic = smoothed("", "conjugate gradients (");
+  const Eigen::Matrix3Xd cg = smoothed("-solver cg", "conjugate gradients (");
+  const Eigen::Matrix3Xd ldlt = smoothed("-solver ldlt", "SimplicialLDLT");
+  const Eigen::Matrix3Xd input_positions = readMeshFile(input).positions;
+  EXPECT_EQ(automatic, cg);
+  EXPECT_GT((ldlt - input_positions).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_LT((cg - ldlt).cwiseAbs().maxCoeff(), 1e-12);
+  if (cholmodAvailable()) {
+    const Eigen::Matrix3Xd cholmod = smoothed("-solver cholmod", "CHOLMOD");
+    EXPECT_LT((cg - cholmod).cwiseAbs().maxCoeff(), 1e-12);
+  }
+  expectNoLeftovers();
+}
+
 TEST_F(SmoothingTools, ExplicitStepsAboveTheStabilityBoundAreRefusedUnlessAllowed) {
   const std::string cow = sharedData("meshes/cow.off");
   const ToolRun safe =

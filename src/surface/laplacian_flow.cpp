@@ -154,11 +154,11 @@ void LaplacianFlow::implicitStep(Eigen::MatrixXd& values, double tau) {
     system_tau_ = tau;
     factor_current_ = false;
   }
-  if (method_ == ImplicitSolver::Automatic) {
-    method_ = cheaperSolver(static_cast<int>(values.cols()));
-  }
-  if (method_ == ImplicitSolver::ConjugateGradient) {
-    if (conjugateGradientStep(values, tau)) return;
+  if (method_ != ImplicitSolver::Cholesky) {
+    if (conjugateGradientStep(values, tau)) {
+      method_ = ImplicitSolver::ConjugateGradient;
+      return;
+    }
     if (!automatic_) {
       throw pcl::ComputeFailedException(
           "conjugate gradients did not converge within twice their iteration bound (" +
@@ -169,17 +169,14 @@ void LaplacianFlow::implicitStep(Eigen::MatrixXd& values, double tau) {
   choleskyStep(values, tau);
 }
 
-ImplicitSolver LaplacianFlow::cheaperSolver(int columns) const {
+int LaplacianFlow::trialIterations(int columns) const {
   const double factorisation =
       backend() == CholeskyBackend::Cholmod
           ? kCholmodFactorisationCost
           : kSimplicialFactorisationCostPerRootVertex * std::sqrt(static_cast<double>(numFree()));
-  const double cholesky = planned_new_operators_ * factorisation +
-                          planned_steps_ * columns * kCholeskySolveCostPerColumn;
-  const double conjugate_gradients =
-      static_cast<double>(planned_steps_) * columns * conjugateGradientIterationBound();
-  return conjugate_gradients < cholesky ? ImplicitSolver::ConjugateGradient
-                                        : ImplicitSolver::Cholesky;
+  return static_cast<int>(std::ceil(planned_new_operators_ * factorisation /
+                                        (static_cast<double>(planned_steps_) * columns) +
+                                    kCholeskySolveCostPerColumn));
 }
 
 int LaplacianFlow::conjugateGradientIterationBound() const {
@@ -236,16 +233,19 @@ bool LaplacianFlow::conjugateGradientStep(Eigen::MatrixXd& values, double tau) {
                            Eigen::Lower | Eigen::Upper>
       cg;
   cg.setTolerance(kConjugateGradientTolerance);
-  cg.setMaxIterations(2 * conjugateGradientIterationBound());
+  const int safe_iterations = 2 * conjugateGradientIterationBound();
+  // Automatic's first column is a trial: stopped where the run's Cholesky would cost less.
+  cg.setMaxIterations(method_ == ImplicitSolver::Automatic
+                          ? std::min(trialIterations(static_cast<int>(columns)), safe_iterations)
+                          : safe_iterations);
   cg.compute(system);
   solution_.resize(n, columns);
-  long iterations = 0;
   for (Eigen::Index column = 0; column < columns; ++column) {
     solution_.col(column) = cg.solve(rhs_.col(column));
-    iterations += cg.iterations();
+    cg_iterations_ += cg.iterations();
     if (cg.info() != Eigen::Success) return false;
+    cg.setMaxIterations(safe_iterations);
   }
-  cg_iterations_ += iterations;
   for (int c = 0; c < n; ++c) values.row(free_vertices_[c]) += solution_.row(c);
   return true;
 }

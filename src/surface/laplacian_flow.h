@@ -47,7 +47,11 @@ class LaplacianFlow {
   CholeskyBackend backend() const { return solver_.backend(); }
   /** Cholesky or ConjugateGradient once an implicit step has chosen (Automatic before). */
   ImplicitSolver implicitSolver() const { return method_; }
-  /** Conjugate-gradient iterations so far, summed over steps and columns. */
+  /** Conjugate gradients' worst-case iterations per column for the system of the last implicit
+   *  step (implicit_solver.h). */
+  int conjugateGradientIterationBound() const;
+  /** Conjugate-gradient iterations so far, summed over steps and columns (an abandoned trial
+   *  included). */
   long conjugateGradientIterations() const { return cg_iterations_; }
   int numFree() const { return static_cast<int>(free_vertices_.size()); }
 
@@ -55,8 +59,8 @@ class LaplacianFlow {
   void chooseFreeVertices();
   void buildSystemPattern();
   void fillSystem(double tau);
-  ImplicitSolver cheaperSolver(int columns) const;
-  int conjugateGradientIterationBound() const;
+  /** Automatic's trial: the iterations per column at which the run's Cholesky costs as much. */
+  int trialIterations(int columns) const;
   /** false if it did not converge (values untouched). */
   bool conjugateGradientStep(Eigen::MatrixXd& values, double tau);
   void choleskyStep(Eigen::MatrixXd& values, double tau);
@@ -76,7 +80,7 @@ class LaplacianFlow {
   std::vector<int> diagonal_entry_;  ///< per free vertex: its diagonal entry in system_
   SparseCholesky solver_;
   ImplicitSolver method_;
-  bool automatic_;  ///< method_ chosen by cost, falling back to Cholesky
+  bool automatic_;  ///< method_ chosen by a trial, falling back to Cholesky
   int planned_steps_ = 1, planned_new_operators_ = 1;
   long cg_iterations_ = 0;
   Eigen::MatrixXd rhs_, solution_;  ///< implicit step buffers, free vertices x value columns
