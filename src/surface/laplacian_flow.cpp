@@ -28,7 +28,7 @@ namespace detail {
 namespace {
 
 // Residual of the displacement's system relative to its right-hand side tau L X: the solution then
-// agrees with a Cholesky solve of the positions to rounding (test_mesh_smoothing).
+// agrees with a Cholesky solve of the positions to rounding (test_implicit_solver).
 constexpr double kConjugateGradientTolerance = 1e-12;
 
 // Costs in conjugate-gradient iterations (one sparse matrix-vector product and a few vector
