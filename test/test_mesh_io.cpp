@@ -279,6 +279,135 @@ TEST_F(MeshIOFiles, BinaryOffIsBigEndian) {
   EXPECT_THROW(loadMesh(path("tri.off")), FileFormatException);
 }
 
+enum class Endian { Big, Little };
+enum class FaceEnd { ColourCount, Nothing };  // Geomview's spec, pmp-library's write_off
+
+struct BinaryFace {
+  std::vector<std::int32_t> corners;
+  std::vector<float> colour;  // Geomview's layout only
+};
+
+// A binary OFF composed from the two layouts' definitions (not by a writer of ours): the header
+// line, int32 counts, float32 vertices, each face as `n i0 .. i(n-1)` followed, in Geomview's
+// layout, by a colour count and that many float32 values.
+std::string binaryOff(const std::vector<float>& xyz, const std::vector<BinaryFace>& faces,
+                      Endian endian, FaceEnd face_end) {
+  std::string data = "OFF BINARY\n";
+  const auto put = [&](auto value) {
+    std::string bytes(sizeof(value), '\0');
+    std::memcpy(bytes.data(), &value, sizeof(value));
+    if (endian == Endian::Big) std::reverse(bytes.begin(), bytes.end());
+    data += bytes;
+  };
+  for (const std::int32_t count :
+       {static_cast<std::int32_t>(xyz.size() / 3), static_cast<std::int32_t>(faces.size()), 0}) {
+    put(count);
+  }
+  for (const float v : xyz) put(v);
+  for (const BinaryFace& face : faces) {
+    put(static_cast<std::int32_t>(face.corners.size()));
+    for (const std::int32_t corner : face.corners) put(corner);
+    if (face_end == FaceEnd::Nothing) continue;
+    put(static_cast<std::int32_t>(face.colour.size()));
+    for (const float c : face.colour) put(c);
+  }
+  return data;
+}
+
+// A square pyramid far from the origin, so that a wrong byte order or offset cannot pass.
+const std::vector<float> kPyramid = {100000.5f, -2.25f, 3e-5f,  //
+                                     100001.5f, -2.25f, 3e-5f,  //
+                                     100001.5f, -1.25f, 3e-5f,  //
+                                     100000.5f, -1.25f, 3e-5f,  //
+                                     100001.f,  -1.75f, 0.8125f};
+const std::vector<BinaryFace> kPyramidFaces = {{{0, 3, 2, 1}, {}},
+                                               {{0, 1, 4}, {0.5f}},
+                                               {{1, 2, 4}, {1.f, 0.f, 0.f}},
+                                               {{2, 3, 4}, {0.f, 1.f, 0.f, 0.5f}},
+                                               {{3, 0, 4}, {}}};
+
+void expectPyramid(const pcl::PolygonMesh& mesh) {
+  const Eigen::Matrix3Xd p = vertexPositions(mesh.cloud);
+  ASSERT_EQ(p.cols(), 5);
+  for (int i = 0; i < 15; ++i) EXPECT_EQ(p(i % 3, i / 3), static_cast<double>(kPyramid[i])) << i;
+  ASSERT_EQ(mesh.polygons.size(), kPyramidFaces.size());
+  for (std::size_t f = 0; f < kPyramidFaces.size(); ++f) {
+    const std::vector<std::int32_t>& expected = kPyramidFaces[f].corners;
+    EXPECT_EQ(mesh.polygons[f].vertices,
+              std::vector<pcl::index_t>(expected.begin(), expected.end()))
+        << "face " << f;
+  }
+}
+
+// pmp-library's write_off (binary) ends a face after its corners, in host (little-endian) order.
+TEST_F(MeshIOFiles, BinaryOffInPmpLibraryLayoutIsRead) {
+  for (const Endian endian : {Endian::Little, Endian::Big}) {
+    SCOPED_TRACE(endian == Endian::Big ? "big-endian" : "little-endian");
+    writeText(path("pmp.off"), binaryOff(kPyramid, kPyramidFaces, endian, FaceEnd::Nothing));
+    expectPyramid(loadMesh(path("pmp.off")));
+  }
+}
+
+TEST_F(MeshIOFiles, BinaryOffInGeomviewLayoutIsRead) {
+  for (const Endian endian : {Endian::Big, Endian::Little}) {
+    SCOPED_TRACE(endian == Endian::Big ? "big-endian" : "little-endian");
+    const std::string data = binaryOff(kPyramid, kPyramidFaces, endian, FaceEnd::ColourCount);
+    writeText(path("geomview.off"), data);
+    expectPyramid(loadMesh(path("geomview.off")));
+    writeText(path("cgal.off"), data + "\n");  // CGAL's writer ends with a newline
+    expectPyramid(loadMesh(path("cgal.off")));
+  }
+}
+
+// The message of the FileFormatException that loading `data` throws ("" if it loads).
+std::string binaryOffError(const std::string& file, const std::string& data) {
+  writeText(file, data);
+  try {
+    loadMesh(file);
+  } catch (const FileFormatException& e) {
+    return errorDescription(e);
+  }
+  return "";
+}
+
+TEST_F(MeshIOFiles, BinaryOffFittingNoLayoutIsRefusedWithByteOffsets) {
+  // Header 11 bytes, counts 12, vertices 60: the faces start at byte 83; the pmp layout's last
+  // face (3 corners) at 151, 2 bytes short of the 167 it needs.
+  const std::string pmp = binaryOff(kPyramid, kPyramidFaces, Endian::Little, FaceEnd::Nothing);
+  ASSERT_EQ(pmp.size(), 167u);
+  const std::string truncated = binaryOffError(path("truncated.off"), pmp.substr(0, 165));
+  for (const char* expected : {"fits neither Geomview's", "nor pmp-library's",
+                               "pmp-library little-endian at byte offset 151: face 4 of 5 has 3",
+                               "Geomview little-endian at byte offset", "big-endian: the counts"}) {
+    EXPECT_NE(truncated.find(expected), std::string::npos) << expected << " in " << truncated;
+  }
+  EXPECT_EQ(truncated.find("line"), std::string::npos) << truncated;
+
+  // A colour count beyond the spec's 0..4, in Geomview's byte order: neither layout fits.
+  std::vector<BinaryFace> faces = kPyramidFaces;
+  faces[1].colour.assign(7, 0.f);
+  const std::string colours = binaryOffError(
+      path("colours.off"), binaryOff(kPyramid, faces, Endian::Big, FaceEnd::ColourCount));
+  EXPECT_NE(colours.find("Geomview big-endian at byte offset 123: face 1 of 5 has colour count 7"),
+            std::string::npos)
+      << colours;
+  EXPECT_NE(colours.find("pmp-library big-endian at byte offset"), std::string::npos) << colours;
+  EXPECT_EQ(colours.find("line"), std::string::npos) << colours;
+
+  // Bytes after the last face (not whitespace).
+  const std::string trailing = binaryOffError(path("trailing.off"), pmp + "abcd");
+  EXPECT_NE(trailing.find("pmp-library little-endian at byte offset 167: 4 bytes left"),
+            std::string::npos)
+      << trailing;
+
+  // Counts that fit the file in neither byte order.
+  EXPECT_NE(binaryOffError(path("counts.off"), pmp.substr(0, 40)).find("byte offset 11:"),
+            std::string::npos);
+  // Per-vertex normals would be read as coordinates.
+  EXPECT_NE(binaryOffError(path("noff.off"), "N" + pmp).find("binary NOFF is not supported"),
+            std::string::npos);
+}
+
 TEST_F(MeshIOFiles, SavedFilesHaveOrdinaryPermissions) {
   saveMesh(path("p.ply"), makeMesh(Eigen::Matrix3Xd::Zero(3, 3), {{0, 1, 2}}));
   const auto perms = std::filesystem::status(path("p.ply")).permissions();

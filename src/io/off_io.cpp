@@ -1,7 +1,9 @@
 // Object File Format (Geomview): "OFF" header, counts, vertices, faces. Colour and normal variants
 // (COFF, NOFF, CNOFF) carry extra values per line, which are ignored; "OFF BINARY" in either byte
-// order.
+// order and either face layout (Geomview's, pmp-library's).
 #include <algorithm>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "byte_cursor.h"
@@ -24,54 +26,133 @@ std::string_view contentLine(ByteCursor& cursor, const char* what) {
   }
 }
 
-// Binary OFF exists in both byte orders: Geomview's spec says big-endian, pmp-library writes the
-// host's (little-endian). The order is the one whose reading of the three counts fits the file:
-// every vertex takes 12 bytes and every face at least 8 (its size and its colour count).
-ByteOrder binaryOffByteOrder(const ByteCursor& cursor) {
-  const auto fits = [&](ByteOrder order) {
-    ByteCursor probe = cursor;
-    std::int64_t counts[3];
-    for (std::int64_t& n : counts) {
-      if (probe.remaining() < 4) return false;
-      n = probe.readBinary<std::int32_t>(order, "count");
-      if (n < 0) return false;
-    }
-    return 12 * counts[0] + 8 * counts[1] <= static_cast<std::int64_t>(probe.remaining());
-  };
-  if (fits(ByteOrder::Big)) return ByteOrder::Big;
-  if (fits(ByteOrder::Little)) return ByteOrder::Little;
-  cursor.fail("binary OFF counts fit the file in neither byte order (truncated or not OFF?)");
+// Binary OFF: after the header line three int32 counts (vertices, faces, edges), each vertex as
+// three float32, then the faces. Two face layouts are in use: Geomview's spec ends each face with
+// a colour count c (0 to 4) and c float32 values, big-endian; pmp-library's write_off writes
+// `n i0 … i(n−1)` alone, in host order (little-endian). Neither the header nor the counts tell
+// them apart, so each layout is walked over the face sizes and the one that ends where the file
+// does is read (trailing whitespace allowed: CGAL's writer ends with a newline). Should two fit,
+// the first tried wins: big-endian (the spec's) before little-endian, Geomview's before pmp's.
+enum class FaceLayout { Geomview, Pmp };
+
+const char* name(ByteOrder order) {
+  return order == ByteOrder::Big ? "big-endian" : "little-endian";
+}
+const char* name(FaceLayout faces) {
+  return faces == FaceLayout::Geomview ? "Geomview" : "pmp-library";
 }
 
-pcl::PolygonMesh parseBinaryOFF(ByteCursor& cursor) {
-  const ByteOrder order = binaryOffByteOrder(cursor);
-  // A count of n items of at least `bytes` each, which the remaining data must be able to hold.
-  const auto read_count = [&](const char* what, std::size_t bytes) {
-    const std::int32_t n = cursor.readBinary<std::int32_t>(order, what);
-    if (n < 0) cursor.fail(std::string("negative ") + what);
-    if (static_cast<std::size_t>(n) > cursor.remaining() / bytes) {
-      cursor.fail(std::string(what) + " " + std::to_string(n) + " is more than the file holds");
+// A binary file has no lines: its errors name the byte.
+std::string atByte(std::size_t offset, const std::string& message) {
+  return "byte offset " + std::to_string(offset) + ": " + message;
+}
+
+struct BinaryOffCounts {
+  std::int64_t vertices = 0;
+  std::int64_t faces = 0;
+};
+
+// The counts read in `order` (cursor at the first), or nothing when they are negative or more
+// than the bytes after them hold (a vertex takes 12, a face at least 4).
+std::optional<BinaryOffCounts> countsIn(ByteCursor probe, ByteOrder order) {
+  if (probe.remaining() < 12) return std::nullopt;
+  BinaryOffCounts counts;
+  counts.vertices = probe.readBinary<std::int32_t>(order, "vertex count");
+  counts.faces = probe.readBinary<std::int32_t>(order, "face count");
+  probe.skip(4, "edge count");
+  const auto left = static_cast<std::int64_t>(probe.remaining());
+  if (counts.vertices < 0 || counts.faces < 0 || counts.vertices > left / 12 ||
+      counts.faces > (left - 12 * counts.vertices) / 4) {
+    return std::nullopt;
+  }
+  return counts;
+}
+
+// Empty when the faces in this layout end where the data does (cursor at the first count);
+// otherwise where and why they do not. Nothing is allocated: only the sizes are read.
+std::string misfit(ByteCursor probe, ByteOrder order, FaceLayout faces, BinaryOffCounts counts) {
+  const auto next = [&] { return probe.readBinary<std::int32_t>(order, "binary OFF"); };
+  probe.skip(12 + 12 * static_cast<std::size_t>(counts.vertices), "vertices");  // fits: countsIn
+  for (std::int64_t f = 0; f < counts.faces; ++f) {
+    const auto face = [&] {
+      return "face " + std::to_string(f) + " of " + std::to_string(counts.faces);
+    };
+    if (probe.remaining() < 4) return atByte(probe.position(), "the file ends before " + face());
+    const std::size_t size_at = probe.position();
+    const std::int32_t n = next();
+    if (n < 0) return atByte(size_at, face() + " has a negative size");
+    if (static_cast<std::size_t>(n) > probe.remaining() / 4) {
+      return atByte(size_at, face() + " has " + std::to_string(n) + " corners, more than the " +
+                                 std::to_string(probe.remaining()) + " bytes left hold");
     }
-    return n;
-  };
-  const std::int32_t num_vertices = cursor.readBinary<std::int32_t>(order, "vertex count");
-  const std::int32_t num_faces = cursor.readBinary<std::int32_t>(order, "face count");
-  cursor.skip(4, "edge count");
-  std::vector<double> xyz(3 * static_cast<std::size_t>(num_vertices));  // fits: checked above
+    probe.skip(4 * static_cast<std::size_t>(n), "face");
+    if (faces == FaceLayout::Pmp) continue;
+    if (probe.remaining() < 4) {
+      return atByte(probe.position(), "the file ends before the colour count of " + face());
+    }
+    const std::size_t colour_at = probe.position();
+    const std::int32_t colour_values = next();
+    if (colour_values < 0 || colour_values > 4) {
+      return atByte(colour_at,
+                    face() + " has colour count " + std::to_string(colour_values) + ", not 0 to 4");
+    }
+    if (4 * static_cast<std::size_t>(colour_values) > probe.remaining()) {
+      return atByte(colour_at, "the file ends in the colour of " + face());
+    }
+    probe.skip(4 * static_cast<std::size_t>(colour_values), "face colour");
+  }
+  const std::size_t end = probe.position();
+  const std::size_t rest_size = probe.remaining();
+  const std::string_view rest(probe.take(rest_size, "trailer"), rest_size);
+  if (rest.find_first_not_of(" \t\r\n") == std::string_view::npos) return {};
+  return atByte(end, std::to_string(rest.size()) + " bytes left after the last face");
+}
+
+// Reads a layout that misfit() accepted: every read stays within the data.
+pcl::PolygonMesh readBinaryOFF(ByteCursor& cursor, ByteOrder order, FaceLayout faces,
+                               BinaryOffCounts counts) {
+  const auto next = [&] { return cursor.readBinary<std::int32_t>(order, "binary OFF"); };
+  cursor.skip(12, "counts");
+  std::vector<double> xyz(3 * static_cast<std::size_t>(counts.vertices));
   for (double& v : xyz) v = cursor.readBinary<float>(order, "vertex");
   pcl::PolygonMesh mesh;
   mesh.cloud = makeXYZCloud(xyz);
-  mesh.polygons.resize(static_cast<std::size_t>(num_faces));
+  mesh.polygons.resize(static_cast<std::size_t>(counts.faces));
   for (auto& polygon : mesh.polygons) {
-    const std::int32_t n = read_count("face size", 4);
-    polygon.vertices.resize(static_cast<std::size_t>(n));
-    for (auto& corner : polygon.vertices) {
-      corner = cornerIndex(cursor.readBinary<std::int32_t>(order, "face"));
-    }
-    const std::int32_t colour_values = read_count("face colour count", 4);
-    cursor.skip(4 * static_cast<std::size_t>(colour_values), "face colour");
+    polygon.vertices.resize(static_cast<std::size_t>(next()));
+    for (auto& corner : polygon.vertices) corner = cornerIndex(next());
+    if (faces == FaceLayout::Geomview) cursor.skip(4 * static_cast<std::size_t>(next()), "colour");
   }
   return mesh;
+}
+
+pcl::PolygonMesh parseBinaryOFF(ByteCursor& cursor) {
+  std::string misfits;
+  bool counts_fit = false;
+  for (const ByteOrder order : {ByteOrder::Big, ByteOrder::Little}) {
+    const std::optional<BinaryOffCounts> counts = countsIn(cursor, order);
+    if (!counts) {
+      misfits += std::string(misfits.empty() ? ": " : "; ") + name(order) +
+                 ": the counts do not fit the file";
+      continue;
+    }
+    counts_fit = true;
+    for (const FaceLayout faces : {FaceLayout::Geomview, FaceLayout::Pmp}) {
+      const std::string why = misfit(cursor, order, faces, *counts);
+      if (why.empty()) return readBinaryOFF(cursor, order, faces, *counts);
+      misfits += std::string(misfits.empty() ? ": " : "; ") + name(faces) + " " + name(order) +
+                 " at " + why;
+    }
+  }
+  if (!counts_fit) {
+    throw FileFormatException(
+        atByte(cursor.position(),
+               "binary OFF counts fit the file in neither byte order (truncated or not OFF?)"));
+  }
+  throw FileFormatException(
+      "binary OFF fits neither Geomview's face layout (n i0 .. i(n-1) c colour[c]) nor "
+      "pmp-library's (n i0 .. i(n-1)) in either byte order" +
+      misfits);
 }
 
 }  // namespace
@@ -84,6 +165,9 @@ pcl::PolygonMesh parseOFF(std::string_view data) {
   }
   if (!cursor.lineEnded()) {
     if (cursor.token() != "BINARY") cursor.fail("unexpected text after the OFF header");
+    // C/N/ST add per-vertex values that would be taken for coordinates: refused, never misread.
+    if (magic != "OFF")
+      cursor.fail("binary " + std::string(magic) + " is not supported (only OFF)");
     cursor.line();
     return parseBinaryOFF(cursor);
   }

@@ -1,7 +1,7 @@
 # The consumer matrix: find_package(pcl_ddg) from the build tree and from an install into a
-# temporary prefix, each by a consumer declared project(x CXX) and project(x C CXX); then the
-# installed pkg-config file, used by a plain compiler command line. Every consumer is built with the
-# build's compilers and sanitizer flags and run.
+# temporary prefix, each by a consumer declared project(x CXX) and project(x C CXX). Every consumer
+# is built with the build's compilers and sanitizer flags and run. (pkg-config, from the build tree
+# and from a moved install, is test/pkg_config.)
 file(REMOVE_RECURSE "${WORK_DIR}")
 set(prefix "${WORK_DIR}/prefix")
 macro(step)
@@ -30,17 +30,3 @@ foreach(place build_tree install)
     step("${build}/consumer")
   endforeach()
 endforeach()
-
-# pkg-config from the install (relocatable: the prefix comes from where pcl_ddg.pc lies).
-find_program(PKG_CONFIG pkg-config REQUIRED)
-set(ENV{PKG_CONFIG_PATH} "${prefix}/lib/pkgconfig:$ENV{PKG_CONFIG_PATH}")
-execute_process(COMMAND ${PKG_CONFIG} --cflags --libs pcl_ddg OUTPUT_VARIABLE flags
-                RESULT_VARIABLE result OUTPUT_STRIP_TRAILING_WHITESPACE)
-if(NOT result EQUAL 0)
-  message(FATAL_ERROR "pkg-config --cflags --libs pcl_ddg failed")
-endif()
-separate_arguments(flags UNIX_COMMAND "${flags}")
-separate_arguments(sanitize UNIX_COMMAND "${CONSUMER_FLAGS}")
-step(${CONSUMER_CXX_COMPILER} -std=c++17 ${sanitize} "${CONSUMER_SOURCE}/main.cpp" ${flags}
-     -o "${WORK_DIR}/pkg_config_consumer")
-step("${WORK_DIR}/pkg_config_consumer")
