@@ -145,6 +145,110 @@ TEST(ConsistentOrientation, EachComponentOnItsOwn) {
   EXPECT_GT(inward, 3900);
 }
 
+/** A terrain as an aerial survey sees it: ground z = 0.1 sin x on [0, 20]^2 (normals up), and a
+ *  thin vertical fin (both faces sampled 0.05 apart, normals +-x) standing on it: the tree steps
+ *  across the fin's two faces and, without a reference, flips whole regions. */
+OrientedCloud terrainWithFin() {
+  OrientedCloud cloud;
+  for (int i = 0; i < 100; ++i) {
+    for (int j = 0; j < 100; ++j) {
+      const double x = 0.2 * i, y = 0.2 * j;
+      add(cloud, Eigen::Vector3d(x, y, 0.1 * std::sin(x)),
+          Eigen::Vector3d(-0.1 * std::cos(x), 0.0, 1.0));
+    }
+  }
+  for (int j = 0; j < 50; ++j) {
+    for (int k = 1; k < 20; ++k) {
+      for (const double side : {-1.0, 1.0}) {
+        add(cloud, Eigen::Vector3d(10.0 + 0.025 * side, 5.0 + 0.2 * j, 0.2 * k),
+            Eigen::Vector3d(side, 0.0, 0.0));
+      }
+    }
+  }
+  return cloud;
+}
+
+TEST(ConsistentOrientation, AReferenceSignsWhatItCanAndTheTreeOnlyTheRest) {
+  // With up (or a viewpoint above) as the reference, no point whose normal the reference signs
+  // with confidence (|n . d| >= 0.1) is turned against it, whatever the tree says; the fin's
+  // faces (|n . up| = 0: ambiguous) are filled in along the tree, each consistent.
+  const OrientedCloud terrain = terrainWithFin();
+  for (const bool by_viewpoint : {false, true}) {
+    SCOPED_TRACE(by_viewpoint ? "viewpoint" : "up");
+    pcl::PointCloud<pcl::Normal> normals = terrain.normals;
+    scramble(normals, 5);
+    ConsistentOrientationOptions options;
+    if (by_viewpoint)
+      options.viewpoint = Eigen::Vector3d(10.0, 10.0, 2000.0);
+    else
+      options.up = Eigen::Vector3d::UnitZ();
+    const ConsistentOrientationReport report =
+        orientNormalsConsistently(terrain.points, normals, options);
+    int ground_down = 0;
+    for (int i = 0; i < 10000; ++i) ground_down += normals[i].normal_z < 0.0f;
+    EXPECT_EQ(ground_down, 0);
+    EXPECT_EQ(report.confident_points, 10000);
+    EXPECT_GE(report.ambiguous_regions, 1);
+    // Each face of the fin is one sign throughout (which sign is the tree's choice).
+    for (const double side : {-1.0, 1.0}) {
+      int along = 0, faces = 0;
+      for (std::size_t i = 10000; i < normals.size(); ++i) {
+        if ((terrain.points[i].x - 10.0f) * side < 0.0f) continue;
+        ++faces;
+        along += normals[i].normal_x * side > 0.0f;
+      }
+      EXPECT_TRUE(along == 0 || along == faces) << along << " of " << faces;
+    }
+  }
+  // Without a reference the same cloud is one tree seeded at its highest point (the fin's top):
+  // the ground is still consistent, but nothing stops a wrong step at the fin from flipping it.
+  pcl::PointCloud<pcl::Normal> free = terrain.normals;
+  const ConsistentOrientationReport report = orientNormalsConsistently(terrain.points, free);
+  EXPECT_EQ(report.confident_points, 0);
+  EXPECT_EQ(report.ambiguous_regions, 0);
+}
+
+TEST(ConsistentOrientation, AnAmbiguousRegionTakesTheMajoritySignOfItsConfidentNeighbours) {
+  // A cylinder's side (normals horizontal: ambiguous for up, scrambled) under a cap whose
+  // normals lean outwards (confident): the side is one region, signed by its tree edges to the
+  // cap, so it comes out outward.
+  OrientedCloud cylinder;
+  for (int k = 0; k < 40; ++k) {
+    for (int a = 0; a < 60; ++a) {
+      const double t = 2 * M_PI * a / 60;
+      const Eigen::Vector3d n(std::cos(t), std::sin(t), 0.0);
+      cylinder.points.push_back(
+          pcl::PointXYZ(static_cast<float>(n.x()), static_cast<float>(n.y()), 0.1f * k));
+      cylinder.normals.push_back(
+          pcl::Normal(static_cast<float>(n.x()), static_cast<float>(n.y()), 0.0f));
+    }
+  }
+  const int side = static_cast<int>(cylinder.points.size());
+  for (int r = 1; r < 10; ++r) {
+    for (int a = 0; a < 6 * r; ++a) {
+      const double t = 2 * M_PI * a / (6 * r), radius = 0.1 * r;
+      add(cylinder, Eigen::Vector3d(radius * std::cos(t), radius * std::sin(t), 3.95),
+          Eigen::Vector3d(0.3 * std::cos(t), 0.3 * std::sin(t), 1.0));
+    }
+  }
+  pcl::PointCloud<pcl::Normal> normals = cylinder.normals;
+  for (int i = 0; i < side; i += 2) {
+    normals[i].normal_x = -normals[i].normal_x;
+    normals[i].normal_y = -normals[i].normal_y;
+  }
+  ConsistentOrientationOptions options;
+  options.up = Eigen::Vector3d::UnitZ();
+  const ConsistentOrientationReport report =
+      orientNormalsConsistently(cylinder.points, normals, options);
+  EXPECT_EQ(report.confident_points, static_cast<std::int64_t>(normals.size()) - side);
+  // The cap's normals lean outwards: the side, joined to them, comes out outward.
+  int outward = 0;
+  for (int i = 0; i < side; ++i)
+    outward +=
+        normals[i].getNormalVector3fMap().dot(cylinder.normals[i].getNormalVector3fMap()) > 0.0f;
+  EXPECT_EQ(outward, side);
+}
+
 TEST(ConsistentOrientation, GridGraphOfARangeImage) {
   // A sphere seen by a camera looking up z: the tree over the pixel grid orients its normals
   // consistently; seeded by the camera, all face it.

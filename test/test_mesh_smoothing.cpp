@@ -97,6 +97,40 @@ TEST(MeshSmoothing, ExplicitLargeStepBlowsUpWhileImplicitWithTheSameStepStaysBou
   }
 }
 
+TEST(MeshSmoothing, AStepThatCollapsesTheSurfaceIsAnErrorNotASliverWarning) {
+  // Backward Euler with tau -> infinity sends every vertex to the mass-weighted mean (L's null
+  // space): a sphere of radius 1 becomes a point. Caught before any correction would blow the
+  // remnant up again; a large but sane step (10 h^2) is not.
+  const SurfaceSample sphere = makeIcosphere(3);
+  const MeshTopology topology = topologyOf(sphere);
+  const double h2 = squaredEdge(topology, sphere.points);
+  MeshSmoothingParameters p;
+  p.time_step = 1e9 * h2;
+  for (const ShrinkageCorrection correction :
+       {ShrinkageCorrection::None, ShrinkageCorrection::PreserveVolume,
+        ShrinkageCorrection::PreserveArea}) {
+    p.shrinkage = correction;
+    try {
+      smoothMeshPositions(topology, sphere.points, p);
+      FAIL() << "expected a SurfaceCollapseException";
+    } catch (const SurfaceCollapseException& e) {
+      EXPECT_NE(std::string(e.what()).find("iteration 1"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("collapsed"), std::string::npos) << e.what();
+    }
+  }
+  p.time_step = 10.0 * h2;
+  p.shrinkage = ShrinkageCorrection::None;
+  const Eigen::Matrix3Xd smoothed = smoothMeshPositions(topology, sphere.points, p);
+  EXPECT_GT(smoothed.colwise().norm().minCoeff(), 0.1);
+  // A mesh no larger than one edge length around its centroid (one triangle) is not "collapsed"
+  // by that test: only area and volume can say so there.
+  const Eigen::Matrix3Xd triangle =
+      (Eigen::Matrix3Xd(3, 3) << 0, 1, 0, 0, 0, 1, 0, 0, 0).finished();
+  const MeshTopology one(3, (Eigen::Matrix3Xi(3, 1) << 0, 1, 2).finished());
+  p.time_step = 0.1;
+  EXPECT_NO_THROW(smoothMeshPositions(one, triangle, p));
+}
+
 TEST(MeshSmoothing, SmoothingANoisySphereBringsItCloserToTheSphereInTheFirstSteps) {
   const SurfaceSample sphere = makeIcosphere(4);
   const MeshTopology topology = topologyOf(sphere);

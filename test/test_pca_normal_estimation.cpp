@@ -269,6 +269,115 @@ TEST(PCANormals, KLargerThanAComponentUsesWhatThereIsAndFailsBelowThreePoints) {
   EXPECT_TRUE(std::isnan(normals[n + 3].normal_x));
 }
 
+TEST(PCANormals, TheDefaultViewpointIsTheSensorOriginAsInPCL) {
+  // pcl::NormalEstimation turns normals towards the cloud's sensor_origin_ unless setViewPoint
+  // chose a point (useSensorOriginAsViewPoint brings the origin back). A sphere with its sensor
+  // at the centre: every normal inward, for PCL and for ours; the setters agree with PCL's too.
+  const SurfaceSample sphere =
+      makeIcosphere(3, 2.0, 0.2, 1).transform(Eigen::Isometry3d(Eigen::Translation3d(5, 6, 7)));
+  const Cloud::Ptr cloud = toCloud(sphere.points);
+  cloud->sensor_origin_ = Eigen::Vector4f(5, 6, 7, 0);
+  const auto inward = [&](const Normals& normals) {
+    int count = 0;
+    for (std::size_t i = 0; i < normals.size(); ++i)
+      count += normals[i].getNormalVector3fMap().cast<double>().dot(sphere.normals.col(i)) < 0.0;
+    return count;
+  };
+  const int n = static_cast<int>(cloud->size());
+  pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> pcl_estimator;
+  PCANormalEstimation<pcl::PointXYZ, pcl::Normal> ours;
+  pcl_estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  ours.setSearchMethod(kdTree());
+  for (auto* estimator :
+       std::initializer_list<pcl::Feature<pcl::PointXYZ, pcl::Normal>*>{&pcl_estimator, &ours}) {
+    estimator->setInputCloud(cloud);
+    estimator->setKSearch(12);
+  }
+  Normals by_pcl, by_ours;
+  pcl_estimator.compute(by_pcl);
+  ours.compute(by_ours);
+  EXPECT_EQ(inward(by_pcl), n);
+  EXPECT_EQ(inward(by_ours), n);
+  float x, y, z;
+  ours.getViewPoint(x, y, z);
+  EXPECT_EQ(Eigen::Vector3f(x, y, z), Eigen::Vector3f(5, 6, 7));
+  // A viewpoint outside: the sides facing away from it turn inward, for both point by point;
+  // back to the sensor: both inward again.
+  pcl_estimator.setViewPoint(100, 100, 100);
+  ours.setViewPoint(100, 100, 100);
+  pcl_estimator.compute(by_pcl);
+  ours.compute(by_ours);
+  int same_sign = 0;
+  for (std::size_t i = 0; i < by_ours.size(); ++i)
+    same_sign += by_ours[i].getNormalVector3fMap().dot(by_pcl[i].getNormalVector3fMap()) > 0.0f;
+  EXPECT_EQ(same_sign, n);
+  EXPECT_LT(inward(by_ours), n * 3 / 4);
+  pcl_estimator.useSensorOriginAsViewPoint();
+  ours.useSensorOriginAsViewPoint();
+  pcl_estimator.compute(by_pcl);
+  ours.compute(by_ours);
+  EXPECT_EQ(inward(by_pcl), n);
+  EXPECT_EQ(inward(by_ours), n);
+}
+
+TEST(PCANormals, OrientedUpEveryNormalHasANonNegativeUpComponent) {
+  // A bumpy height field seen from a sensor at the origin, far to its side: towards the sensor
+  // about half the normals point down; up, none does, along +z or along the direction given.
+  const SurfaceSample saddle = makeSaddle({40, 0.3, 3});
+  Eigen::Matrix3Xd far = saddle.points;
+  far.colwise() += Eigen::Vector3d(5e4, 0.0, 0.0);
+  const Cloud::Ptr cloud = toCloud(far);
+  for (const Eigen::Vector3d& up : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 0.6, -0.8)}) {
+    PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+    estimator.setInputCloud(cloud);
+    estimator.setSearchMethod(kdTree());
+    estimator.setKSearch(12);
+    estimator.setUpDirection(up.x(), up.y(), up.z());
+    estimator.setOrientationUp();
+    Normals normals;
+    estimator.compute(normals);
+    EXPECT_EQ(estimator.getOrientation(), NormalOrientation::Up);
+    int down = 0;
+    for (const pcl::Normal& n : normals)
+      down += n.getNormalVector3fMap().cast<double>().dot(up) < 0.0;
+    EXPECT_EQ(down, 0);
+    // The lines are those of the viewpoint-oriented fit: only signs change.
+    const Eigen::Matrix3Xd towards_origin = normalsOf(ourNormals(cloud, kdTree(), 12));
+    EXPECT_LT(angleErrors(normalsOf(normals), towards_origin, SignMode::Unsigned).max, 1e-6);
+  }
+}
+
+TEST(PCANormals, MinNeighboursFillsABallThatHoldsTooFew) {
+  // Two patches: a dense one (spacing 0.01) and a sparse one (spacing 1). A ball of 0.05 holds
+  // a dozen points in the first and only the query in the second: NaN there, unless
+  // min_neighbours replaces the ball by that many nearest, which then equals the k-nearest fit.
+  Eigen::Matrix3Xd points(3, 2 * 400);
+  for (int i = 0; i < 400; ++i) {
+    const double u = i % 20, v = i / 20;
+    points.col(i) = Eigen::Vector3d(0.01 * u, 0.01 * v, 0.001 * u * v * 0.01);
+    points.col(400 + i) = Eigen::Vector3d(100 + u, v, 0.05 * u);
+  }
+  const Cloud::Ptr cloud = toCloud(points);
+  const auto estimate = [&](unsigned int min_nn) {
+    PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+    estimator.setInputCloud(cloud);
+    estimator.setSearchMethod(kdTree());
+    estimator.setRadiusSearch(0.05);
+    estimator.setRadiusSearchMinNeighbours(min_nn);
+    Normals normals;
+    estimator.compute(normals);
+    EXPECT_EQ(estimator.getRadiusSearchMinNeighbours(), min_nn);
+    return std::make_pair(normalsOf(normals), estimator.getFailedPoints());
+  };
+  const auto [plain, plain_failed] = estimate(0);
+  EXPECT_EQ(plain_failed, 400);
+  const auto [filled, filled_failed] = estimate(8);
+  EXPECT_EQ(filled_failed, 0);
+  const Eigen::Matrix3Xd by_k = normalsOf(ourNormals(cloud, kdTree(), 8));
+  EXPECT_EQ(filled.rightCols(400), by_k.rightCols(400));
+  EXPECT_EQ(filled.leftCols(400), plain.leftCols(400));  // full balls are kept
+}
+
 TEST(PCANormals, RadiusWithMaxNeighboursIsTheNearestWithinTheRadius) {
   // Open3D's hybrid search: with a radius covering the whole cloud, at most max_nn neighbours
   // are the max_nn nearest, so the result is the k = max_nn result, bit for bit; with a radius

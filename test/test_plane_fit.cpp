@@ -147,6 +147,52 @@ TEST(PlaneFit, PointsOnAPlaneHaveItsNormalAndNoVariation) {
   EXPECT_LT(fit.surface_variation, 1e-15);
 }
 
+TEST(PlaneFit, RandomLinesRoundedToDoubleHaveNoPlaneAndThinPlanesDo) {
+  // Points on a line in a random direction through a random offset, each coordinate rounded to
+  // double: collinear to rounding, so no plane, however the solver's rounding falls at the
+  // double zero eigenvalue. A strip a thousandth as wide as it is long is a plane.
+  std::mt19937 random(2024);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  const auto randomUnit = [&] {
+    return Eigen::Vector3d(uniform(random), uniform(random), uniform(random)).normalized();
+  };
+  int planes_on_lines = 0, normals_on_lines = 0, batched_on_lines = 0, missed_strips = 0;
+  constexpr int kTrials = 10000, kPoints = 16;
+  std::vector<Eigen::Matrix3d> covariances;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    const Eigen::Vector3d direction = randomUnit(), offset = 100.0 * uniform(random) * randomUnit();
+    const Eigen::Vector3d across = direction.unitOrthogonal();
+    Eigen::Matrix3Xd line(3, kPoints), strip(3, kPoints);
+    for (int i = 0; i < kPoints; ++i) {
+      const double t = uniform(random);
+      line.col(i) = offset + t * direction;
+      strip.col(i) = offset + t * direction + 1e-3 * uniform(random) * across;
+    }
+    planes_on_lines += fitPlane(line, kPoints).valid;
+    normals_on_lines += fitPlaneNormal(line, kPoints).valid;
+    missed_strips += !fitPlane(strip, kPoints).valid + !fitPlaneNormal(strip, kPoints).valid;
+    const Eigen::Vector3d centroid = line.rowwise().mean();
+    const Eigen::Matrix3Xd centred = line.colwise() - centroid;
+    covariances.push_back(centred * centred.transpose() / kPoints);
+  }
+  std::vector<double> c[6];
+  for (const Eigen::Matrix3d& m : covariances) {
+    const double entries[6] = {m(0, 0), m(0, 1), m(0, 2), m(1, 1), m(1, 2), m(2, 2)};
+    for (int e = 0; e < 6; ++e) c[e].push_back(entries[e]);
+  }
+  std::vector<double> n[3], variation(kTrials);
+  std::vector<std::uint8_t> valid(kTrials);
+  for (auto& component : n) component.resize(kTrials);
+  fitPlaneNormals(kTrials, {c[0].data(), c[1].data(), c[2].data(), c[3].data(), c[4].data(),
+                            c[5].data()},
+                  {n[0].data(), n[1].data(), n[2].data(), variation.data(), valid.data()});
+  for (const std::uint8_t v : valid) batched_on_lines += v;
+  EXPECT_EQ(planes_on_lines, 0);
+  EXPECT_EQ(normals_on_lines, 0);
+  EXPECT_EQ(batched_on_lines, 0);
+  EXPECT_EQ(missed_strips, 0);
+}
+
 TEST(PlaneFit, DegenerateNeighbourhoodsHaveNoPlane) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   Eigen::Matrix3Xd line(3, 4);

@@ -114,6 +114,23 @@ TEST_F(SmoothingTools, ExplicitStepsAboveTheStabilityBoundAreRefusedUnlessAllowe
       << allowed.err;
 }
 
+TEST_F(SmoothingTools, AStepThatCollapsesTheScanFailsNamingLambdaDt) {
+  // 1e9 h^2 squeezes the cow to a point: exit 1, one line that names the remedy, no output.
+  const ToolRun run = runTool(PCL_DDG_SMOOTH_TOOL, sharedData("meshes/cow.off") + " " +
+                                                       path("out.ply") + " -lambda_dt 1e9");
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("pcl_ddg_smooth: error: smoothing iteration 1: the surface collapsed"),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.err.find("-lambda_dt"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(path("out.ply")));
+  // With the volume preserved the remnant would be inflated back into a needle: refused too.
+  EXPECT_EQ(runTool(PCL_DDG_SMOOTH_TOOL, sharedData("meshes/cow.off") + " " + path("out.ply") +
+                                             " -lambda_dt 1e9 -preserve volume")
+                .exit_code,
+            1);
+}
+
 TEST_F(SmoothingTools, MeshQualityIsReportedAndAnOpenScanWarnsAboutItsShrinkingBoundary) {
   const std::string scan = sharedData("meshes/bun045_rangegrid_tri.ply");
   const ToolRun free_boundary =

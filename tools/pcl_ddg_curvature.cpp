@@ -135,6 +135,7 @@ int run(int argc, char** argv) {
         } else {
           const LocalFitOptions options =
               tools::localFitArguments(args, in, LocalFitMethod::Quadric);
+          const tools::SamplingCheck sampling = tools::checkSampling(kName, in, options);
           tools::Timer timer("Fitting quadrics");
           const LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
@@ -142,6 +143,7 @@ int run(int argc, char** argv) {
           }();
           timer.done(in.points->size());
           tools::warnAboutLocalFit(kName, result);
+          tools::warnAboutRadius(kName, sampling, options, result);
           curvatures = quadricFields(in.mesh.cloud, output, result, precision);
         }
         if (args.has("smooth")) {

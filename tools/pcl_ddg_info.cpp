@@ -2,6 +2,7 @@
 // parse: out-of-range faces, non-finite vertices and the like are counted, not fatal.
 #include <iostream>
 
+#include "common/local_fit_job.h"
 #include "common/tool_common.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/cloud_report.h"
@@ -30,6 +31,7 @@ int run(int argc, char** argv) {
     if (mesh.polygons.empty()) {
       const CloudReport report = makeCloudReport(mesh.cloud);
       std::cout << (json ? report.toJson() + "\n" : report.toText());
+      tools::warnAboutQuantisation(kName, *tools::toXYZ(file.positions));
       return;
     }
     const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);

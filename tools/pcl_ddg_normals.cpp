@@ -36,12 +36,16 @@ constexpr const char* kSyntax =
     "                  default 0.02)]\n"
     "         [-radius r (a length, or a multiple of the mean spacing like 2.5h; instead of -k)]\n"
     "         [-max_nn N (with -radius: at most the N nearest; default 64)]\n"
+    "         [-min_nn N (with -radius: the N nearest where the ball holds fewer)]\n"
     "         [-viewpoint x,y,z (clouds: orient normals towards it; default the PCD's VIEWPOINT)]\n"
-    "         [-orient viewpoint|mst|mesh (pca, quadric: towards the viewpoint (clouds' default),\n"
-    "                  along a minimum spanning tree of the 10 nearest on the mesh, the pixel\n"
-    "                  grid or in space (merged scans; each tree seeded facing -viewpoint, an\n"
-    "                  organized frame's sensor, or up),\n"
+    "         [-orient viewpoint|up|mst|mesh (pca, quadric: towards the viewpoint (clouds' "
+    "default),\n"
+    "                  up (aerial and terrestrial LiDAR: n . up >= 0), along a minimum spanning\n"
+    "                  tree of the 10 nearest on the mesh, the pixel grid or in space (merged\n"
+    "                  scans; -viewpoint, an organized frame's sensor or -up decides every sign\n"
+    "                  it can and the tree the rest; else each tree's highest point faces up),\n"
     "                  or like the faces (meshes' default))]\n"
+    "         [-up x,y,z (-orient up and mst: the up direction; default 0,0,1)]\n"
     "         [-normal_map out.png (organized clouds: the normals as an image, (n + 1) / 2 as "
     "RGB)]\n"
     "         [-precision float|double]\n"
@@ -62,7 +66,13 @@ void reportSpanningTree(const pcl_ddg::ConsistentOrientationReport& report) {
   std::snprintf(share, sizeof share, "%.1f %%", 100.0 * report.flippedShare());
   std::cerr << kName << ": the spanning tree turned " << report.flipped_points << " of "
             << report.oriented_points << " normals (" << share << ") in " << report.components
-            << " components\n";
+            << " components";
+  if (report.confident_points > 0 || report.ambiguous_regions > 0) {
+    std::cerr << "; " << report.confident_points << " signed by the reference, "
+              << report.propagated_flips << " of the others turned by propagation in "
+              << report.ambiguous_regions << " regions";
+  }
+  std::cerr << "\n";
 }
 
 /** An organized cloud's normals as an image: (n + 1) / 2 as red, green, blue; black where none. */
@@ -90,7 +100,7 @@ int run(int argc, char** argv) {
   const tools::ToolArguments args(
       argc, argv,
       {"method", "epsilon", "neighbours", "k", "radius", "max_nn", "viewpoint", "precision",
-       "memory", "max_depth_jump", "orient", "normal_map"},
+       "memory", "max_depth_jump", "orient", "normal_map", "up", "min_nn"},
       {});
   const FieldPrecision precision = tools::precisionArgument(args);
   const std::vector<std::string> methods = {"uniform",        "area", "angle",
@@ -98,10 +108,12 @@ int run(int argc, char** argv) {
   const std::string requested = args.has("method") ? args.choice("method", methods, "area") : "";
   const bool fitted = requested == "pca" || requested == "quadric";
   const bool neighbour_options = args.has("neighbours") || args.has("k") || args.has("radius") ||
-                                 args.has("max_depth_jump") || args.has("orient");
+                                 args.has("max_depth_jump") || args.has("orient") ||
+                                 args.has("up") || args.has("min_nn");
   if (!requested.empty() && !fitted && neighbour_options) {
     throw tools::UsageError(
-        "-neighbours, -k, -radius, -max_depth_jump and -orient apply to pca and quadric");
+        "-neighbours, -k, -radius, -min_nn, -max_depth_jump, -orient and -up apply to pca and "
+        "quadric");
   }
   if (args.has("epsilon") && requested != "mean_curvature") {
     throw tools::UsageError("-epsilon applies to -method mean_curvature only");
@@ -109,25 +121,32 @@ int run(int argc, char** argv) {
   if (args.has("epsilon") && !(args.number("epsilon", 0.0) >= 0.0))
     throw tools::UsageError("-epsilon must be >= 0");
   tools::checkLocalFitArguments(args);
+  const std::string orient =
+      args.has("orient") ? args.choice("orient", {"viewpoint", "up", "mst", "mesh"}, "mesh") : "";
+  if (args.has("up") && orient != "up" && orient != "mst")
+    throw tools::UsageError("-up applies to -orient up and -orient mst");
+  if (orient == "mst" && args.has("up") && args.has("viewpoint"))
+    throw tools::UsageError("-orient mst takes one reference: -viewpoint or -up");
   if (args.has("memory")) {
     // A cloud larger than memory: fitted tile by tile from the file (pcl_ddg/tiling).
     if (!requested.empty() && !fitted)
       throw tools::UsageError("-memory applies to pca and quadric on clouds");
-    if (args.has("orient") && *args.value("orient") != "viewpoint")
-      throw tools::UsageError("-orient " + *args.value("orient") +
-                              " needs the whole cloud; with -memory normals face the viewpoint");
-    const LocalFitOptions options = tools::outOfCoreFitArguments(
+    if (!orient.empty() && orient != "viewpoint" && orient != "up")
+      throw tools::UsageError("-orient " + orient +
+                              " needs the whole cloud; with -memory normals face the viewpoint "
+                              "or up");
+    LocalFitOptions options = tools::outOfCoreFitArguments(
         args, requested == "quadric" ? LocalFitMethod::Quadric : LocalFitMethod::PCA);
+    if (orient == "up") options.orientation = NormalOrientation::Up;
     return tools::fitEachInputOutOfCore(
         kName, args, options, precision,
         [&](pcl::PCLPointCloud2& piece, const std::string& output, const LocalFitResult& fit) {
           tools::setNormalFields(piece, output, fit.normals, precision);
         });
   }
-  const std::string orient =
-      args.has("orient") ? args.choice("orient", {"viewpoint", "mst", "mesh"}, "mesh") : "";
   return tools::forEachInput(
       args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+        if (args.has("normal_map")) tools::checkOutputFile(*args.value("normal_map"), {input});
         tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
         if (orient == "mesh" && !in.topology)
           throw tools::UsageError("-orient mesh needs a mesh; this input is a point cloud");
@@ -169,10 +188,13 @@ int run(int argc, char** argv) {
           LocalFitOptions options = tools::localFitArguments(
               args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
           options.orientation = orient == "viewpoint" ? NormalOrientation::Viewpoint
+                                : orient == "up"      ? NormalOrientation::Up
                                 : orient == "mst"     ? NormalOrientation::SpanningTree
                                                       : NormalOrientation::MeshFaces;
-          // An organized frame has one sensor: its trees are seeded facing it.
-          options.seed_facing_viewpoint = args.has("viewpoint") || in.points->height > 1;
+          // An organized frame has one sensor: it decides the tree's signs (unless -up does).
+          options.seed_facing_viewpoint =
+              !args.has("up") && (args.has("viewpoint") || in.points->height > 1);
+          const tools::SamplingCheck sampling = tools::checkSampling(kName, in, options);
           tools::Timer timer("Computing " + method + " normals (" +
                              tools::describeNeighbourhood(options) +
                              (orient == "mst" ? ", oriented along a spanning tree)" : ")"));
@@ -182,6 +204,7 @@ int run(int argc, char** argv) {
           }();
           timer.done(in.points->size());
           tools::warnAboutLocalFit(kName, result);
+          tools::warnAboutRadius(kName, sampling, options, result);
           if (orient == "mst") reportSpanningTree(result.orientation);
           if (args.has("normal_map")) saveNormalMap(*args.value("normal_map"), result.normals);
           tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);

@@ -7,6 +7,7 @@
 
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
+#include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -99,9 +100,15 @@ int run(int argc, char** argv) {
         tools::Timer timer("Smoothing");
         tools::ProgressBar progress("> Smoothing");  // redrawn over the Timer's line
         MeshSmoothingReport report;
-        const Eigen::Matrix3Xd smoothed =
-            smoothMeshPositions(in.topology, in.positions, p, &report,
-                                [&](int done, int total) { progress.update(done, total); });
+        const Eigen::Matrix3Xd smoothed = [&] {
+          try {
+            return smoothMeshPositions(in.topology, in.positions, p, &report,
+                                       [&](int done, int total) { progress.update(done, total); });
+          } catch (const SurfaceCollapseException& e) {
+            throw std::runtime_error(errorDescription(e) + ": use a smaller -lambda_dt (" +
+                                     std::to_string(p.time_step / (h * h)) + " h^2 now)");
+          }
+        }();
         progress.finish();
         timer.done(points);
         if (p.scheme == SmoothingScheme::Implicit) {

@@ -62,6 +62,8 @@ int run(int argc, char** argv) {
   if (args.has("screenshot") && fileExtension(*args.value("screenshot")) != "png") {
     throw tools::UsageError("-screenshot writes a .png");
   }
+  if (args.has("screenshot"))
+    tools::checkOutputFile(*args.value("screenshot"), {args.positional().front()});
   // Before the file is read: a window that cannot open should not cost a load first.
   if (const std::string problem = viewer::displayProblem(); !problem.empty()) {
     throw std::runtime_error(problem);

@@ -35,6 +35,92 @@ std::vector<char> orientablePoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
 }
 
 /**
+ * The tree (CSR: degree offsets, adjacent points) with a reference: confident points keep the
+ * reference's sign, each region of ambiguous points is made consistent along the tree and takes
+ * the majority sign of its edges to confident points (see the header).
+ */
+ConsistentOrientationReport orientByReference(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                              pcl::PointCloud<pcl::Normal>& normals,
+                                              const std::vector<char>& usable,
+                                              const std::vector<int>& degree,
+                                              const std::vector<int>& adjacent,
+                                              detail::DisjointSets& sets,
+                                              const ConsistentOrientationOptions& options) {
+  const int n = static_cast<int>(cloud.size());
+  ConsistentOrientationReport report;
+  // n . d for every usable point, in double: UTM coordinates in float lose the direction to a
+  // nearby viewpoint otherwise.
+  std::vector<double> facing(static_cast<std::size_t>(n), 0.0);
+  std::vector<char> confident(static_cast<std::size_t>(n), 0),
+      turned(static_cast<std::size_t>(n), 0);
+  const auto unitNormal = [&](int i) {
+    return Eigen::Vector3d(normals[i].getNormalVector3fMap().cast<double>().normalized());
+  };
+  const auto flip = [&](int i) {
+    normals[i].normal_x = -normals[i].normal_x;
+    normals[i].normal_y = -normals[i].normal_y;
+    normals[i].normal_z = -normals[i].normal_z;
+    facing[i] = -facing[i];
+    turned[i] = !turned[i];
+  };
+  for (int i = 0; i < n; ++i) {
+    if (!usable[i]) continue;
+    ++report.oriented_points;
+    if (sets.find(i) == i) ++report.components;
+    const Eigen::Vector3d d =
+        options.viewpoint
+            ? Eigen::Vector3d(
+                  (*options.viewpoint - cloud[i].getVector3fMap().cast<double>()).normalized())
+            : Eigen::Vector3d(options.up->normalized());
+    facing[i] = unitNormal(i).dot(d);
+    if (std::abs(facing[i]) >= options.confidence) {
+      confident[i] = 1;
+      ++report.confident_points;
+      if (facing[i] < 0.0) flip(i);
+    }
+  }
+  // Ambiguous regions, each grown from its most confident point (the most reliable start).
+  std::vector<int> by_facing;
+  for (int i = 0; i < n; ++i)
+    if (usable[i] && !confident[i]) by_facing.push_back(i);
+  std::stable_sort(by_facing.begin(), by_facing.end(),
+                   [&](int a, int b) { return std::abs(facing[a]) > std::abs(facing[b]); });
+  std::vector<char> reached(static_cast<std::size_t>(n), 0);
+  std::vector<int> region;
+  for (const int seed : by_facing) {
+    if (reached[seed]) continue;
+    ++report.ambiguous_regions;
+    reached[seed] = 1;
+    region.assign(1, seed);
+    double votes = 0.0, weak = 0.0;
+    for (std::size_t next = 0; next < region.size(); ++next) {
+      const int from = region[next];
+      const Eigen::Vector3f parent = normals[from].getNormalVector3fMap();
+      for (int k = degree[from]; k < degree[from + 1]; ++k) {
+        const int to = adjacent[k];
+        if (confident[to]) {
+          votes += normals[to].getNormalVector3fMap().dot(parent) < 0.0f ? -1.0 : 1.0;
+          continue;
+        }
+        if (reached[to]) continue;
+        reached[to] = 1;
+        if (normals[to].getNormalVector3fMap().dot(parent) < 0.0f) flip(to);
+        region.push_back(to);
+      }
+    }
+    for (const int i : region) weak += facing[i];
+    if (votes < 0.0 || (votes == 0.0 && weak < 0.0)) {
+      for (const int i : region) flip(i);
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    report.flipped_points += turned[i];
+    if (!confident[i]) report.propagated_flips += turned[i];
+  }
+  return report;
+}
+
+/**
  * The minimum spanning forest of the graph (Kruskal; weights 1 - |n_a . n_b| bucketed to 16
  * bits by a stable counting sort, so that the order, and the result, do not depend on threads),
  * then each tree walked from its highest point.
@@ -82,6 +168,10 @@ ConsistentOrientationReport orientAlongSpanningForest(const pcl::PointCloud<pcl:
   for (const auto& [a, b] : tree) {
     adjacent[fill[a]++] = b;
     adjacent[fill[b]++] = a;
+  }
+
+  if (options.viewpoint || options.up) {
+    return orientByReference(cloud, normals, usable, degree, adjacent, sets, options);
   }
 
   // Seeds: the first point of a tree met in this order. Up: from the highest point down. Facing

@@ -31,13 +31,17 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
   if (options.radius > 0.0) {
     estimator.setRadiusSearch(options.radius);
     estimator.setRadiusSearchMaxNeighbours(options.max_neighbours);
+    estimator.setRadiusSearchMinNeighbours(options.min_neighbours);
   } else {
     estimator.setKSearch(options.k);
   }
   // The orientation by default, and the spanning tree's seeds' or the faces' fallback.
   const Eigen::Vector3f v = options.viewpoint.value_or(Eigen::Vector3d::Zero()).cast<float>();
   estimator.setViewPoint(v.x(), v.y(), v.z());
-  if (options.orientation == NormalOrientation::SpanningTree) {
+  if (options.up) estimator.setUpDirection(options.up->x(), options.up->y(), options.up->z());
+  if (options.orientation == NormalOrientation::Up) {
+    estimator.setOrientationUp();
+  } else if (options.orientation == NormalOrientation::SpanningTree) {
     // Over the mesh's rings when there is a mesh, else the estimator's own neighbourhoods (the
     // grid's steps, or the nearest points in space).
     estimator.setOrientationSpanningTree(
@@ -47,6 +51,14 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
     estimator.setOrientationMesh(topology);
   }
   estimator.setNumberOfThreads(options.threads);
+}
+
+/** Turns every normal to n . up >= 0 (the grid path, which orients towards the sensor). */
+void orientUp(pcl::PointCloud<pcl::Normal>& normals, const std::optional<Eigen::Vector3d>& up) {
+  const Eigen::Vector3f u = up.value_or(Eigen::Vector3d::UnitZ()).cast<float>();
+  for (pcl::Normal& n : normals) {
+    if (n.getNormalVector3fMap().dot(u) < 0.0f) n.getNormalVector3fMap() *= -1.0f;
+  }
 }
 
 }  // namespace
@@ -84,10 +96,13 @@ LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
     OrganizedNormalResult normals = computeOrganizedPCANormals(cloud, grid);
     result.normals = std::move(normals.normals);
     result.failed_points = normals.failed_points;
+    if (options.orientation == NormalOrientation::Up) orientUp(result.normals, options.up);
     if (options.orientation == NormalOrientation::SpanningTree) {
       ConsistentOrientationOptions tree;
       if (options.seed_facing_viewpoint)
         tree.viewpoint = grid.viewpoint.value_or(cloud->sensor_origin_.head<3>().cast<double>());
+      else
+        tree.up = options.up;
       tree.threads = options.threads;
       result.orientation = orientNormalsConsistently(*normals.grid, result.normals, tree);
     }

@@ -45,8 +45,11 @@ PlaneFit fitPlane(const Eigen::Vector3d& centroid, const Eigen::Matrix3d& covari
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
   solver.computeDirect(covariance);
   fit.eigenvalues = solver.eigenvalues().cwiseMax(0.0);
-  // All points on one line (or one point): no plane.
-  if (!(fit.eigenvalues[1] > 1e-12 * fit.eigenvalues[2])) return fit;
+  // All points on one line (or one point): no plane. Measured as the variance off the principal
+  // line, trace - l2 = l0 + l1: the largest eigenvalue is accurate to rounding, while the closed
+  // form's l1 is off by about sqrt(eps) l2 when l0 = l1 = 0 (a double root), which let a quarter
+  // of random lines rounded to double through as planes.
+  if (!(covariance.trace() - fit.eigenvalues[2] > 1e-12 * fit.eigenvalues[2])) return fit;
   fit.normal = solver.eigenvectors().col(0).normalized();
   fit.tangent1 = solver.eigenvectors().col(2).normalized();
   fit.tangent2 = fit.normal.cross(fit.tangent1);
@@ -75,7 +78,7 @@ PlaneNormal fitPlaneNormal(const Eigen::Matrix3d& covariance) {
   const double cos_phi = std::cos(phi), sin_phi = std::sqrt(std::max(0.0, 1.0 - cos_phi * cos_phi));
   const double x0 = -cos_phi - std::sqrt(3.0) * sin_phi;  // 2 cos(phi + 2 pi / 3)
   const double l0 = mean + p * x0, l2 = mean + 2.0 * p * cos_phi, l1 = 3.0 * mean - l0 - l2;
-  if (!(l1 > 1e-12 * l2)) return result;  // all on one line, as in fitPlane
+  if (!(l0 + l1 > 1e-12 * l2)) return result;  // all on one line, as in fitPlane
   // The eigenvector: the longest cross product of two rows of a - l0 I (the best conditioned).
   b.diagonal().array() -= p * x0;
   const Eigen::Vector3d c01 = b.row(0).cross(b.row(1)), c02 = b.row(0).cross(b.row(2)),

@@ -38,6 +38,16 @@ std::string CloudReport::toJson() const {
   return out.str();
 }
 
+namespace {
+
+// Every digit: UTM coordinates differ in the last places a default stream would drop.
+std::string box(const Eigen::Vector3d& corner) {
+  return "[" + detail::shortestNumber(corner.x()) + " " + detail::shortestNumber(corner.y()) + " " +
+         detail::shortestNumber(corner.z()) + "]";
+}
+
+}  // namespace
+
 std::string CloudReport::toText() const {
   std::ostringstream out;
   out << "points:            " << points << "\n"
@@ -45,8 +55,7 @@ std::string CloudReport::toText() const {
       << (organized() ? " (organized)" : " (unorganized)") << "\n"
       << "NaN points:        " << nan_points << "\n"
       << "duplicate points:  " << duplicate_points << "\n"
-      << "bounding box:      [" << bounding_box.min.transpose() << "] .. ["
-      << bounding_box.max.transpose() << "]\n";
+      << "bounding box:      " << box(bounding_box.min) << " .. " << box(bounding_box.max) << "\n";
   return out.str();
 }
 

@@ -1,9 +1,7 @@
 #pragma once
 // JSON text for a double: shortest round-trip digits, null for NaN or infinity.
+#include <charconv>
 #include <cmath>
-#include <iomanip>
-#include <limits>
-#include <sstream>
 #include <string>
 
 #include <Eigen/Core>
@@ -11,11 +9,16 @@
 namespace pcl_ddg {
 namespace detail {
 
+/** The shortest decimal text that reads back as v exactly (std::to_chars). */
+inline std::string shortestNumber(double v) {
+  char text[32];
+  const auto end = std::to_chars(text, text + sizeof text, v).ptr;
+  return std::string(text, end);
+}
+
 inline std::string jsonNumber(double v) {
   if (!std::isfinite(v)) return "null";
-  std::ostringstream out;
-  out << std::setprecision(std::numeric_limits<double>::max_digits10) << v;
-  return out.str();
+  return shortestNumber(v);
 }
 
 inline std::string jsonArray(const Eigen::Vector3d& v) {

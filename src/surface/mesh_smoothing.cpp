@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 
@@ -42,6 +43,35 @@ Eigen::Vector3d surfaceCentroid(const MeshTopology& topology, const Eigen::Matri
     area += triangle_area;
   }
   return area > 0.0 ? Eigen::Vector3d(weighted / area) : Eigen::Vector3d(x.rowwise().mean());
+}
+
+/** Throws SurfaceCollapseException when `current` is what is left of a collapsed surface (see
+ *  the header): area, volume (closed meshes: volume_before != 0), or every vertex within h of
+ *  the centroid (h = 0: not checked). */
+void requireNotCollapsed(const MeshTopology& topology, const Eigen::Matrix3Xd& current,
+                         double area_before, double volume_before, double h, int iteration) {
+  constexpr double kCollapsed = 1e-6;
+  std::string what;
+  char ratio[32];
+  const double area = surfaceArea(topology, current);
+  if (area < kCollapsed * area_before) {
+    std::snprintf(ratio, sizeof ratio, "%.3g", area / area_before);
+    what = std::string("its area is ") + ratio + " of the input's";
+  } else if (volume_before != 0.0 &&
+             std::abs(enclosedVolume(topology, current)) < kCollapsed * std::abs(volume_before)) {
+    std::snprintf(ratio, sizeof ratio, "%.3g",
+                  std::abs(enclosedVolume(topology, current) / volume_before));
+    what = std::string("its volume is ") + ratio + " of the input's";
+  } else {
+    const Eigen::Vector3d centre = surfaceCentroid(topology, current);
+    if (((current.colwise() - centre).colwise().norm().array() < h).all())
+      what = "every vertex is within one mean edge length of the centroid";
+  }
+  if (!what.empty()) {
+    throw SurfaceCollapseException("smoothing iteration " + std::to_string(iteration) +
+                                   ": the surface collapsed (" + what +
+                                   "): the time step is too large");
+  }
 }
 
 }  // namespace
@@ -115,10 +145,15 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   const bool closed = isClosedAndOriented(topology);
   MeshSmoothingReport r;
   r.solver = flow.backend();
-  if (report || p.shrinkage == ShrinkageCorrection::PreserveArea)
-    r.area_before = surfaceArea(topology, positions);
-  if (closed && (report || p.shrinkage == ShrinkageCorrection::PreserveVolume))
-    r.volume_before = enclosedVolume(topology, positions);
+  r.area_before = surfaceArea(topology, positions);
+  if (closed) r.volume_before = enclosedVolume(topology, positions);
+  // Collapse to within h of the centroid is only news for a mesh that was larger than that.
+  const double h = meanEdgeLength(topology, positions);
+  const double within =
+      ((positions.colwise() - surfaceCentroid(topology, positions)).colwise().norm().array() >= h)
+              .any()
+          ? h
+          : 0.0;
   if (report) r.quality_before = triangleQuality(topology, positions);
 
   Eigen::Matrix3Xd current = positions;
@@ -145,6 +180,7 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
                                 "smaller time step or the implicit scheme)"
                               : "non-finite positions");
     }
+    requireNotCollapsed(topology, current, r.area_before, r.volume_before, within, iteration);
     if (p.shrinkage != ShrinkageCorrection::None) {
       double scale;
       if (p.shrinkage == ShrinkageCorrection::PreserveVolume) {

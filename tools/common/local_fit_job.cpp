@@ -14,6 +14,7 @@
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/search/point_spacing.h"
 
 namespace pcl_ddg {
 namespace tools {
@@ -82,10 +83,10 @@ RadiusArgument radiusArgument(const ToolArguments& args) {
   return radius;
 }
 
-// -viewpoint x,y,z.
-std::optional<Eigen::Vector3d> viewpointArgument(const ToolArguments& args) {
-  if (!args.has("viewpoint")) return std::nullopt;
-  const std::string text = *args.value("viewpoint");
+// -name x,y,z.
+std::optional<Eigen::Vector3d> vectorArgument(const ToolArguments& args, const char* name) {
+  if (!args.has(name)) return std::nullopt;
+  const std::string text = *args.value(name);
   Eigen::Vector3d v;
   char* at = const_cast<char*>(text.c_str());
   for (int d = 0; d < 3; ++d) {
@@ -93,10 +94,22 @@ std::optional<Eigen::Vector3d> viewpointArgument(const ToolArguments& args) {
     v[d] = std::strtod(at, &end);
     const char expected = d < 2 ? ',' : '\0';
     if (end == at || *end != expected || !std::isfinite(v[d]))
-      throw UsageError("-viewpoint needs x,y,z, not '" + text + "'");
+      throw UsageError(std::string("-") + name + " needs x,y,z, not '" + text + "'");
     at = end + (d < 2 ? 1 : 0);
   }
   return v;
+}
+
+std::optional<Eigen::Vector3d> viewpointArgument(const ToolArguments& args) {
+  return vectorArgument(args, "viewpoint");
+}
+
+// -up x,y,z: a direction, normalised.
+std::optional<Eigen::Vector3d> upArgument(const ToolArguments& args) {
+  const std::optional<Eigen::Vector3d> up = vectorArgument(args, "up");
+  if (up && !(up->norm() > 0.0)) throw UsageError("-up needs a non-zero direction");
+  if (up) return up->normalized();
+  return up;
 }
 
 }  // namespace
@@ -168,6 +181,10 @@ void checkLocalFitArguments(const ToolArguments& args) {
     throw UsageError("-max_nn must be at least 3");
   radiusArgument(args);
   viewpointArgument(args);
+  upArgument(args);
+  if (args.has("min_nn") && !args.has("radius")) throw UsageError("-min_nn needs -radius");
+  if (args.has("min_nn") && args.integer("min_nn", 3) < 3)
+    throw UsageError("-min_nn must be at least 3");
   args.choice("neighbours", {"bfs", "knn", "grid"}, "knn");
   if (args.has("max_depth_jump") && !(args.number("max_depth_jump", 0.0) > 0.0))
     throw UsageError("-max_depth_jump must be > 0 (a relative range change per pixel)");
@@ -203,6 +220,7 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
   }
   options.viewpoint = viewpointArgument(args);
   if (!options.viewpoint) options.viewpoint = input.sensor_pose.origin;
+  options.up = upArgument(args);
   const RadiusArgument radius = radiusArgument(args);
   if (radius.value > 0.0) {
     double spacing = input.spacing;
@@ -214,8 +232,81 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
     options.radius = radius.value * (radius.in_spacings ? spacing : 1.0);
     options.max_neighbours =
         static_cast<unsigned int>(args.integer("max_nn", kDefaultMaxNeighbours));
+    options.min_neighbours = static_cast<unsigned int>(args.integer("min_nn", 0));
   }
   return options;
+}
+
+namespace {
+
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.3g", value);
+  return text;
+}
+
+}  // namespace
+
+PointSpacing warnAboutQuantisation(const char* tool_name,
+                                   const pcl::PointCloud<pcl::PointXYZ>& points) {
+  const PointSpacing spacing = measurePointSpacing(points);
+  if (spacing.quantised()) {
+    warn(tool_name, "the coordinates are rounded to " + number(spacing.quantum) +
+                        " while the points are " + number(spacing.median_spacing) +
+                        " apart (median): neighbourhoods tie and normals snap to the lattice "
+                        "(store the coordinates in double, or relative to an offset)");
+  }
+  return spacing;
+}
+
+SamplingCheck checkSampling(const char* tool_name, const SurfaceInput& input,
+                            const LocalFitOptions& options) {
+  SamplingCheck check;
+  if (input.topology) return check;  // a mesh's faces orient it; its edges are its spacing
+  const pcl::PointCloud<pcl::PointXYZ>& points = *input.points;
+  warnAboutQuantisation(tool_name, points);
+  const bool by_viewpoint =
+      options.orientation == NormalOrientation::Viewpoint ||
+      options.orientation == NormalOrientation::MeshFaces ||
+      (options.orientation == NormalOrientation::SpanningTree && options.seed_facing_viewpoint);
+  const BoundingBox box = boundingBox(input.positions);
+  const Eigen::Vector3d viewpoint = options.viewpoint.value_or(Eigen::Vector3d::Zero());
+  const double diagonal = (box.max - box.min).norm();
+  const double distance =
+      (viewpoint - viewpoint.cwiseMax(box.min).cwiseMin(box.max)).norm();  // to the box
+  if (by_viewpoint && distance > 10.0 * diagonal) {
+    char where[128];
+    std::snprintf(where, sizeof where, "(%.6g, %.6g, %.6g)", viewpoint.x(), viewpoint.y(),
+                  viewpoint.z());
+    warn(tool_name, std::string("the viewpoint ") + where + " is " + number(distance / diagonal) +
+                        " times the data's extent away: normals facing it are oriented almost "
+                        "at random (give the sensor position with -viewpoint x,y,z, or use "
+                        "-orient up for aerial data)");
+  }
+  if (options.radius > 0.0) {
+    const int wanted = options.min_neighbours > 0 ? static_cast<int>(options.min_neighbours) : 3;
+    check.radius_counts = countRadiusNeighbours(points, options.radius, wanted);
+    const RadiusNeighbourCounts& c = *check.radius_counts;
+    std::fprintf(stderr,
+                 "%s: points in a ball of radius %s (of %lld sampled): min %lld, median %lld, "
+                 "%.1f %% under 3\n",
+                 tool_name, number(options.radius).c_str(), static_cast<long long>(c.sampled),
+                 static_cast<long long>(c.min), static_cast<long long>(c.median),
+                 100.0 * c.share_under_3);
+  }
+  return check;
+}
+
+void warnAboutRadius(const char* tool_name, const SamplingCheck& check,
+                     const LocalFitOptions& options, const LocalFitResult& result) {
+  if (!check.radius_counts || result.failed_points == 0) return;
+  const int wanted = options.min_neighbours > 0 ? static_cast<int>(options.min_neighbours) : 3;
+  warn(
+      tool_name,
+      "-radius " + number(check.radius_counts->radius_for_min_neighbours) +
+          " would give 90 % of the points at least " + std::to_string(wanted) + " neighbours" +
+          (options.min_neighbours == 0 ? " (or -min_nn N: the N nearest where the ball holds fewer)"
+                                       : ""));
 }
 
 LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod method) {
@@ -227,6 +318,11 @@ LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod 
   options.neighbourhood = NeighbourhoodKind::KdTree;
   options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20 : 16);
   options.viewpoint = viewpointArgument(args);
+  options.up = upArgument(args);
+  if (args.has("min_nn"))
+    throw UsageError(
+        "-min_nn is not available with -memory (a tile's halo is certified for the "
+        "ball)");
   const RadiusArgument radius = radiusArgument(args);
   if (radius.in_spacings)
     throw UsageError("with -memory, -radius is a length (a multiple of h needs the whole cloud)");

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "common/tool_common.h"
@@ -16,6 +17,7 @@
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/search/point_spacing.h"
 #include "pcl_ddg/tiling/out_of_core_fit.h"
 
 namespace pcl_ddg {
@@ -57,8 +59,9 @@ void checkLocalFitArguments(const ToolArguments& args);
 
 /** -neighbours bfs|knn (bfs is the default on meshes and impossible on clouds), -k N (at most the
  *  input's point count), and -radius r, where r is a length or a multiple of the input's spacing
- *  written like 2.5h, with at most -max_nn N neighbours (default 64, Open3D's hybrid search);
- *  -viewpoint x,y,z orients cloud normals (default: the file's VIEWPOINT). */
+ *  written like 2.5h, with at most -max_nn N neighbours (default 64, Open3D's hybrid search) and,
+ *  with -min_nn N, the N nearest where the ball holds fewer; -viewpoint x,y,z orients cloud
+ *  normals (default: the file's VIEWPOINT); -up x,y,z is the up direction of -orient up and mst. */
 LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput& input,
                                   LocalFitMethod method);
 
@@ -102,6 +105,30 @@ class QuietPCLWarnings {
  private:
   int level_;
 };
+
+/** Warns when the cloud's coordinate quantum exceeds half its median spacing (point_spacing.h,
+ *  as PCL's float points see them); returns both. */
+PointSpacing warnAboutQuantisation(const char* tool_name,
+                                   const pcl::PointCloud<pcl::PointXYZ>& points);
+
+/** What checkSampling measured that a warning after the fit needs. */
+struct SamplingCheck {
+  std::optional<RadiusNeighbourCounts> radius_counts;  ///< with -radius
+};
+
+/**
+ * Before a fit on a cloud (point_spacing.h): warns when its coordinates are quantised coarser
+ * than half its spacing, and when the viewpoint that orients the normals is farther from the
+ * data than 10 times its bounding box's diagonal; with -radius, prints how many points the ball
+ * holds (min, median, share under 3). Meshes: nothing.
+ */
+SamplingCheck checkSampling(const char* tool_name, const SurfaceInput& input,
+                            const LocalFitOptions& options);
+
+/** After a radius fit that left points without an estimate: the radius that would give 90 % of
+ *  the points -min_nn (or 3) neighbours. */
+void warnAboutRadius(const char* tool_name, const SamplingCheck& check,
+                     const LocalFitOptions& options, const LocalFitResult& result);
 
 /** Warns about points the estimator could not handle or fitted by the fallback. */
 void warnAboutLocalFit(const char* tool_name, const LocalFitResult& result);

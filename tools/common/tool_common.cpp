@@ -176,6 +176,28 @@ std::vector<std::string> batchInputs(const std::string& folder) {
 
 }  // namespace
 
+void checkOutputFile(const std::string& output, const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  std::error_code error;
+  // Identity, not spelling: equivalent() compares device and inode after following symbolic
+  // links, so hard links and other spellings of an input are caught too.
+  if (fs::exists(output, error)) {
+    for (const std::string& input : inputs) {
+      if (fs::equivalent(input, output, error))
+        throw UsageError("the output " + output + " is the input " + input +
+                         " (it would be replaced): choose another output name");
+    }
+    if (fs::is_directory(output, error)) throw UsageError("the output " + output + " is a folder");
+  }
+  fs::path folder = fs::path(output).parent_path();
+  if (folder.empty()) folder = ".";
+  if (!fs::is_directory(folder, error))
+    throw std::runtime_error("the output folder " + folder.string() + " does not exist");
+  // The output is written to a temporary file there and renamed: the folder must be writable.
+  if (access(folder.c_str(), W_OK | X_OK) != 0)
+    throw std::runtime_error("the output folder " + folder.string() + " is not writable");
+}
+
 int forEachInput(const ToolArguments& args, const char* tool_name,
                  const std::vector<std::string>& output_extensions,
                  const std::function<void(const std::string&, const std::string&)>& process) {
@@ -185,11 +207,13 @@ int forEachInput(const ToolArguments& args, const char* tool_name,
     const std::size_t expected = writes ? 2 : 1;
     if (args.positional().size() != expected)
       throw UsageError(writes ? "expected an input and an output file" : "expected one input file");
+    const std::string& input = args.positional()[0];
     const std::string output = writes ? args.positional()[1] : "";
     if (writes && std::find(output_extensions.begin(), output_extensions.end(),
                             fileExtension(output)) == output_extensions.end())
       throw UsageError("the output must be " + extensionList(output_extensions));
-    process(args.positional()[0], output);
+    if (writes) checkOutputFile(output, {input});
+    process(input, output);
     return 0;
   }
   if (!args.positional().empty())
@@ -202,18 +226,27 @@ int forEachInput(const ToolArguments& args, const char* tool_name,
   if (writes && std::filesystem::equivalent(input_dir, output_dir, error))
     throw UsageError("-output_dir must differ from -input_dir (the inputs would be overwritten)");
   const std::vector<std::string> inputs = batchInputs(input_dir.string());
-  if (writes) std::filesystem::create_directories(output_dir);
-
-  std::vector<std::string> failed;
-  for (const std::string& input : inputs) {
-    std::string output;
-    if (writes) {
-      const std::string ext = fileExtension(input);
+  std::vector<std::string> outputs(inputs.size());
+  if (writes) {
+    std::filesystem::create_directories(output_dir);
+    std::map<std::string, std::string> written_by;
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      const std::string ext = fileExtension(inputs[i]);
       const bool kept = std::find(output_extensions.begin(), output_extensions.end(), ext) !=
                         output_extensions.end();
-      const std::filesystem::path name = std::filesystem::path(input).stem();
-      output = (output_dir / name).string() + "." + (kept ? ext : output_extensions.front());
+      const std::filesystem::path name = std::filesystem::path(inputs[i]).stem();
+      outputs[i] = (output_dir / name).string() + "." + (kept ? ext : output_extensions.front());
+      const auto [it, fresh] = written_by.emplace(outputs[i], inputs[i]);
+      if (!fresh)
+        throw UsageError(it->second + " and " + inputs[i] + " would both write " + outputs[i]);
+      checkOutputFile(outputs[i], inputs);
     }
+  }
+
+  std::vector<std::string> failed;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    const std::string& input = inputs[i];
+    const std::string& output = outputs[i];
     try {
       process(input, output);
     } catch (const std::exception& e) {
@@ -245,8 +278,7 @@ int runTool(const char* name, const char* description, const char* syntax,
     std::cout << name << " " << PCL_DDG_VERSION_STRING << "\n";
     return 0;
   } catch (const UsageError& e) {
-    printError(name, e.what());
-    std::cerr << description << "\nSyntax is: " << name << " " << syntax << "\n";
+    printError(name, std::string(e.what()) + " (see -help)");
     return 2;
   } catch (const pcl::BadArgumentException& e) {
     printError(name, errorDescription(e));

@@ -66,8 +66,16 @@ int forEachInput(
     const std::function<void(const std::string& input, const std::string& output)>& process);
 
 /**
- * Runs a tool body: prints the one-line description and syntax on -h or a usage error, and turns
- * every exception into one line on stderr and an exit code.
+ * Refuses, before anything is read, an output that would destroy an input or could not be
+ * written: the same file as one of `inputs` (by device and inode, whatever the spelling, links
+ * included; a UsageError), a folder, or one whose folder is missing or not writable
+ * (std::runtime_error). forEachInput calls it for every output it is given.
+ */
+void checkOutputFile(const std::string& output, const std::vector<std::string>& inputs);
+
+/**
+ * Runs a tool body: prints the description and syntax on -h, and turns every exception into one
+ * line on stderr and an exit code (a usage error: the line ends "(see -help)", exit 2).
  */
 int runTool(const char* name, const char* description, const char* syntax,
             const std::function<int()>& body);

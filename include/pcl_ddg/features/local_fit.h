@@ -31,7 +31,9 @@ struct LocalFitOptions {
   int k = 16;                       ///< neighbours, when radius is 0
   double radius = 0.0;              ///< > 0: a radius search instead of k nearest
   unsigned int max_neighbours = 0;  ///< with radius: keep at most this many, the nearest (0: all)
-  unsigned int threads = 0;         ///< 0: all cores
+  /** With radius: fewer in the ball than this, the nearest this many instead (0: the ball). */
+  unsigned int min_neighbours = 0;
+  unsigned int threads = 0;  ///< 0: all cores
   /** Grid: the relative range change per pixel that cuts the grid (OrganizedGridSearch). */
   double max_depth_jump = 0.02;
   /** Clouds: normals are turned towards this point (a PCD's VIEWPOINT); unset: the origin, as
@@ -41,8 +43,11 @@ struct LocalFitOptions {
    *  towards the viewpoint. SpanningTree propagates over the mesh's edges, the pixel grid, or
    *  the 10 nearest points, as consistent_orientation.h. */
   NormalOrientation orientation = NormalOrientation::MeshFaces;
-  /** SpanningTree: each tree's seed faces the viewpoint; false: up (+z) at its highest point. */
+  /** SpanningTree: the viewpoint decides the signs it can (consistent_orientation.h); false: up
+   *  does if set, else each tree's highest point faces +z. */
   bool seed_facing_viewpoint = false;
+  /** Up: n . up >= 0 (unset: +z); SpanningTree without seed_facing_viewpoint: the reference. */
+  std::optional<Eigen::Vector3d> up;
 };
 
 struct LocalFitResult {

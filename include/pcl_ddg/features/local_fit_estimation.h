@@ -6,7 +6,8 @@
 //
 // Orientation (see normal_orientation.h): by the viewpoint, as PCL does, unless the search method
 // is a MeshRingSearch (or setOrientationMesh was called), in which case by the mesh's faces.
-// setViewPoint chooses the viewpoint explicitly. setOrientationSpanningTree makes the normals
+// The viewpoint is the input cloud's sensor_origin_, as in pcl::NormalEstimation, unless
+// setViewPoint chooses one. setOrientationSpanningTree makes the normals
 // consistent along a minimum spanning tree of each point's nearest neighbours from the search
 // method (mesh rings, pixel grid or kd-tree: the graph follows the neighbourhood), for clouds
 // without a single viewpoint; the quadric's curvatures change sign with their normals.
@@ -18,6 +19,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/normal_orientation.h"
@@ -30,17 +32,37 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
  public:
   using PointCloudOut = typename pcl::Feature<PointInT, PointOutT>::PointCloudOut;
 
-  /** Orients normals towards this point (PCL's semantics; the default viewpoint is the origin). */
+  /** Orients normals towards this point (PCL's semantics), instead of the input cloud's
+   *  sensor_origin_. */
   void setViewPoint(float vx, float vy, float vz) {
     viewpoint_ = Eigen::Vector3d(vx, vy, vz);
+    use_sensor_origin_ = false;
     orientation_ = NormalOrientation::Viewpoint;
     orientation_chosen_ = true;
   }
+  /** The viewpoint: the one set, or the input cloud's sensor_origin_ (PCL's default; the origin
+   *  before a cloud is set). */
   void getViewPoint(float& vx, float& vy, float& vz) const {
-    vx = static_cast<float>(viewpoint_.x());
-    vy = static_cast<float>(viewpoint_.y());
-    vz = static_cast<float>(viewpoint_.z());
+    const Eigen::Vector3d v = currentViewPoint();
+    vx = static_cast<float>(v.x());
+    vy = static_cast<float>(v.y());
+    vz = static_cast<float>(v.z());
   }
+  /** Orients normals towards the input cloud's sensor_origin_, read at compute() (the default,
+   *  as pcl::NormalEstimation's useSensorOriginAsViewPoint; undoes setViewPoint). */
+  void useSensorOriginAsViewPoint() {
+    use_sensor_origin_ = true;
+    orientation_ = NormalOrientation::Viewpoint;
+    orientation_chosen_ = true;
+  }
+  /** Orients normals up: n . up >= 0, up = (ux, uy, uz) (setUpDirection; default +z). */
+  void setOrientationUp() {
+    orientation_ = NormalOrientation::Up;
+    orientation_chosen_ = true;
+  }
+  /** The up direction of setOrientationUp, and the reference of a spanning tree not seeded
+   *  facing the viewpoint (consistent_orientation.h). Unset: +z for Up, none for the tree. */
+  void setUpDirection(float ux, float uy, float uz) { up_ = Eigen::Vector3d(ux, uy, uz); }
   /** Orients normals like the faces of this mesh (its vertices are the input cloud's points). */
   void setOrientationMesh(std::shared_ptr<const MeshTopology> topology) {
     orientation_mesh_ = std::move(topology);
@@ -50,7 +72,8 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   /** Orients normals consistently along a minimum spanning tree over each point's `neighbours`
    *  nearest (consistent_orientation.h) from `graph` (a search over the same input; null: the
    *  search method); each tree is seeded facing the viewpoint (setViewPoint before this) if
-   *  seed_facing_viewpoint, else up at its highest point. Only the points being estimated (the
+   *  seed_facing_viewpoint, else by the up direction where it decides (setUpDirection), else up
+   *  at its highest point. Only the points being estimated (the
    *  indices) join the graph. */
   void setOrientationSpanningTree(int neighbours = 10, bool seed_facing_viewpoint = false,
                                   typename pcl::search::Search<PointInT>::Ptr graph = nullptr) {
@@ -73,6 +96,13 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
     max_neighbours_ = max_neighbours;
   }
   unsigned int getRadiusSearchMaxNeighbours() const { return max_neighbours_; }
+  /** With setRadiusSearch: a ball holding fewer than this many points (the query included) is
+   *  replaced by the min_neighbours nearest, so sparse parts of an uneven scan still get an
+   *  estimate; 0 (the default, PCL's semantics) keeps the ball. */
+  void setRadiusSearchMinNeighbours(unsigned int min_neighbours) {
+    min_neighbours_ = min_neighbours;
+  }
+  unsigned int getRadiusSearchMinNeighbours() const { return min_neighbours_; }
 
   /** Threads for compute(); 0 = as many as the machine has. */
   void setNumberOfThreads(unsigned int threads) { threads_ = threads; }
@@ -105,10 +135,20 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   virtual void setInvalid(PointOutT& point) const = 0;
 
   unsigned int max_neighbours_ = 0;
+  unsigned int min_neighbours_ = 0;
   std::int64_t fallback_points_ = 0;  ///< counted by fitEachNeighbourhood (FitOutcome::FellBack)
 
  private:
-  Eigen::Vector3d viewpoint_ = Eigen::Vector3d::Zero();
+  /** setViewPoint's point, or the input's sensor origin when use_sensor_origin_. */
+  Eigen::Vector3d currentViewPoint() const {
+    if (use_sensor_origin_ && this->input_)
+      return this->input_->sensor_origin_.template head<3>().template cast<double>();
+    return use_sensor_origin_ ? Eigen::Vector3d::Zero() : viewpoint_;
+  }
+
+  Eigen::Vector3d viewpoint_ = Eigen::Vector3d::Zero();  ///< as used by the current compute()
+  bool use_sensor_origin_ = true;
+  std::optional<Eigen::Vector3d> up_;
   NormalOrientation orientation_ = NormalOrientation::Viewpoint;
   bool orientation_chosen_ = false;  ///< false: by the search method (see above)
   NormalOrientation used_orientation_ = NormalOrientation::Viewpoint;

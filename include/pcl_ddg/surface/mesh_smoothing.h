@@ -27,11 +27,16 @@
 // Errors: InvalidMeshException for an empty mesh or non-finite input; pcl::BadArgumentException for
 // bad parameters (tau <= 0, iterations < 1, volume correction on an open mesh, a correction with a
 // fixed boundary); pcl::ComputeFailedException when an iteration produces a non-finite position
-// or a singular system, naming the iteration. The input is never modified.
+// or a singular system, naming the iteration; SurfaceCollapseException when a step collapses the
+// surface (before any correction): area or enclosed volume below 1e-6 of the input's, or every
+// vertex within one mean edge length h of the input of the centroid. A correction would only
+// blow such a remnant up again. The input is never modified.
 #include <pcl/PolygonMesh.h>
+#include <pcl/exceptions.h>
 
 #include <Eigen/Core>
 #include <functional>
+#include <string>
 
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
@@ -41,6 +46,13 @@
 #include "pcl_ddg/surface/implicit_solver.h"
 
 namespace pcl_ddg {
+
+/** A step too large for the surface: it collapsed to (nearly) a point, curve or sliver. */
+class SurfaceCollapseException : public pcl::ComputeFailedException {
+ public:
+  explicit SurfaceCollapseException(const std::string& description)
+      : pcl::ComputeFailedException(description) {}
+};
 
 enum class SmoothingScheme { Explicit, Implicit };
 /** What of the operator follows the moving surface: nothing (Frozen), the mass only

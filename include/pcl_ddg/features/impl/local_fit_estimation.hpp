@@ -19,6 +19,7 @@ namespace pcl_ddg {
 template <typename PointInT, typename PointOutT>
 bool LocalFitEstimation<PointInT, PointOutT>::initCompute() {
   if (!pcl::Feature<PointInT, PointOutT>::initCompute()) return false;
+  viewpoint_ = currentViewPoint();
   std::shared_ptr<const MeshTopology> mesh = orientation_mesh_;
   used_orientation_ = orientation_;
   if (!orientation_chosen_) {
@@ -106,7 +107,10 @@ void LocalFitEstimation<PointInT, PointOutT>::makeOrientationConsistent(PointClo
   }
   edges.erase(std::remove(edges.begin(), edges.end(), std::pair<int, int>(-1, -1)), edges.end());
   ConsistentOrientationOptions options;
-  if (seed_facing_viewpoint_) options.viewpoint = viewpoint_;
+  if (seed_facing_viewpoint_)
+    options.viewpoint = viewpoint_;
+  else
+    options.up = up_;
   orientation_report_ = orientNormalsConsistently(points, normals, edges, options);
   for (int i = 0; i < count; ++i) {
     const Eigen::Vector3f before(output[i].normal_x, output[i].normal_y, output[i].normal_z);
@@ -122,6 +126,10 @@ template <typename PointInT, typename PointOutT>
 bool LocalFitEstimation<PointInT, PointOutT>::orient(Eigen::Vector3d& n, pcl::index_t index,
                                                      const Eigen::Vector3d& p) const {
   double agreement = 0.0;
+  if (used_orientation_ == NormalOrientation::Up ||
+      (used_orientation_ == NormalOrientation::SpanningTree && up_ && !seed_facing_viewpoint_)) {
+    agreement = n.dot(up_.value_or(Eigen::Vector3d::UnitZ()));
+  }
   if (reference_normals_.cols() > 0) agreement = n.dot(reference_normals_.col(index));
   if (agreement == 0.0) agreement = n.dot(viewpoint_ - p);  // no face normal there
   if (agreement >= 0.0) return false;
@@ -159,13 +167,18 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut
       const PointInT& query = (*this->input_)[indices[i]];
       FitOutcome outcome = FitOutcome::Failed;
       const bool capped_radius = this->search_radius_ > 0.0 && max_neighbours_ > 0;
-      const int found =
-          !pcl::isXYZFinite(query) ? 0
-          : capped_radius
-              ? this->tree_->radiusSearch(*this->input_, indices[i], this->search_radius_,
-                                          neighbours, squared_distances, max_neighbours_)
-              : this->searchForNeighbors(indices[i], this->search_parameter_, neighbours,
-                                         squared_distances);
+      int found = !pcl::isXYZFinite(query) ? 0
+                  : capped_radius
+                      ? this->tree_->radiusSearch(*this->input_, indices[i], this->search_radius_,
+                                                  neighbours, squared_distances, max_neighbours_)
+                      : this->searchForNeighbors(indices[i], this->search_parameter_, neighbours,
+                                                 squared_distances);
+      if (this->search_radius_ > 0.0 && pcl::isXYZFinite(query) &&
+          found < static_cast<int>(min_neighbours_)) {
+        found = this->tree_->nearestKSearch(*this->input_, indices[i],
+                                            static_cast<int>(min_neighbours_), neighbours,
+                                            squared_distances);
+      }
       if (found > 0) {
         const Eigen::Vector3d origin = query.getVector3fMap().template cast<double>();
         if (local.cols() < static_cast<Eigen::Index>(neighbours.size()))

@@ -1,0 +1,117 @@
+#include "pcl_ddg/search/point_spacing.h"
+
+#include <pcl/common/point_tests.h>
+#include <pcl/exceptions.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "pcl_ddg/search/point_kd_tree.h"
+
+namespace pcl_ddg {
+namespace {
+
+std::vector<pcl::index_t> finitePoints(const pcl::PointCloud<pcl::PointXYZ>& cloud) {
+  std::vector<pcl::index_t> finite;
+  finite.reserve(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (pcl::isXYZFinite(cloud[i])) finite.push_back(static_cast<pcl::index_t>(i));
+  return finite;
+}
+
+detail::PointKdTree treeOf(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                           std::vector<pcl::index_t> finite) {
+  std::vector<float> xyz;
+  xyz.reserve(3 * finite.size());
+  for (const pcl::index_t i : finite) xyz.insert(xyz.end(), {cloud[i].x, cloud[i].y, cloud[i].z});
+  return detail::PointKdTree(std::move(xyz), std::move(finite));
+}
+
+/** Every stride-th of the finite points, about `samples` of them. */
+std::vector<pcl::index_t> sample(const std::vector<pcl::index_t>& finite, int samples) {
+  const std::size_t stride = std::max<std::size_t>(1, finite.size() / std::max(1, samples));
+  std::vector<pcl::index_t> chosen;
+  for (std::size_t i = 0; i < finite.size(); i += stride) chosen.push_back(finite[i]);
+  return chosen;
+}
+
+template <typename T>
+T median(std::vector<T> values) {
+  if (values.empty()) return T(0);
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+PointSpacing measurePointSpacing(const pcl::PointCloud<pcl::PointXYZ>& cloud, int samples) {
+  PointSpacing result;
+  const std::vector<pcl::index_t> finite = finitePoints(cloud);
+  if (finite.size() < 2) return result;
+  double diagonal_squared = 0.0;
+  for (int d = 0; d < 3; ++d) {
+    std::vector<float> values(finite.size());
+    for (std::size_t i = 0; i < finite.size(); ++i) values[i] = cloud[finite[i]].data[d];
+    std::sort(values.begin(), values.end());
+    double smallest = 0.0;
+    for (std::size_t i = 1; i < values.size(); ++i) {
+      const double gap = static_cast<double>(values[i]) - values[i - 1];
+      if (gap > 0.0 && (smallest == 0.0 || gap < smallest)) smallest = gap;
+    }
+    result.quantum = std::max(result.quantum, smallest);
+    const double extent = static_cast<double>(values.back()) - values.front();
+    diagonal_squared += extent * extent;
+  }
+  if (!(result.quantum >= 1e-5 * std::sqrt(diagonal_squared))) return result;
+
+  const detail::PointKdTree tree = treeOf(cloud, finite);
+  std::vector<double> nearest;
+  pcl::Indices found;
+  std::vector<float> distances;
+  for (const pcl::index_t i : sample(finite, samples)) {
+    // Exact duplicates are skipped: the spacing is between distinct samples.
+    tree.nearestK(cloud[i].data, 16, found, distances);
+    for (const float d : distances) {
+      if (d > 0.0f) {
+        nearest.push_back(std::sqrt(static_cast<double>(d)));
+        break;
+      }
+    }
+  }
+  result.median_spacing = median(std::move(nearest));
+  return result;
+}
+
+RadiusNeighbourCounts countRadiusNeighbours(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                            double radius, int min_neighbours, int samples) {
+  if (!(radius > 0.0) || !std::isfinite(radius) || min_neighbours < 1)
+    throw pcl::BadArgumentException("countRadiusNeighbours: radius > 0 and min_neighbours >= 1");
+  RadiusNeighbourCounts result;
+  const std::vector<pcl::index_t> finite = finitePoints(cloud);
+  if (finite.empty()) return result;
+  const detail::PointKdTree tree = treeOf(cloud, finite);
+  std::vector<std::int64_t> counts;
+  std::vector<double> reach;
+  pcl::Indices found;
+  std::vector<float> distances;
+  for (const pcl::index_t i : sample(finite, samples)) {
+    counts.push_back(tree.withinRadius(cloud[i].data, radius, found, distances, 0, false));
+    if (tree.nearestK(cloud[i].data, min_neighbours, found, distances) == min_neighbours)
+      reach.push_back(std::sqrt(static_cast<double>(distances.back())));
+  }
+  result.sampled = static_cast<std::int64_t>(counts.size());
+  result.min = *std::min_element(counts.begin(), counts.end());
+  result.median = median(counts);
+  result.share_under_3 = static_cast<double>(std::count_if(counts.begin(), counts.end(),
+                                                           [](std::int64_t c) { return c < 3; })) /
+                         static_cast<double>(counts.size());
+  if (!reach.empty()) {
+    const std::size_t at = std::min(reach.size() - 1, (reach.size() * 9) / 10);
+    std::nth_element(reach.begin(), reach.begin() + at, reach.end());
+    result.radius_for_min_neighbours = reach[at];
+  }
+  return result;
+}
+
+}  // namespace pcl_ddg
