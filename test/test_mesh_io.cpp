@@ -579,7 +579,7 @@ TEST_F(MeshIOFiles, LoadingInAChildForkedAfterOpenMPFinishes) {
   {}
   const pid_t child = fork();
   if (child == 0) {
-    alarm(20);  // a hang becomes a SIGALRM death
+    alarm(120);  // a hang becomes a SIGALRM death (ample under the sanitizers' -O1)
     const bool loaded = loadMesh(sharedData("meshes/horse.ply")).polygons.size() == 96966 &&
                         loadMesh(path("grid.off")).polygons.size() == 2 * 199 * 199;
     _exit(loaded ? 0 : 1);

@@ -31,18 +31,25 @@ double angleTo(const pcl::Normal& n, const Eigen::Vector3d& truth) {
   return std::acos(std::clamp(v.dot(truth) / v.norm(), -1.0, 1.0));
 }
 
-/** Over the pixels where the surface is seen within 60 degrees of head-on (all, by default). */
+/** Over the pixels where the surface is seen within 60 degrees of head-on (all, by default).
+ *  Pixels without an estimate are counted, and may be at most max_without of those compared. */
 double meanAngleError(const RangeImage& image, const OrganizedNormalResult& result,
-                      bool head_on_only = false) {
+                      bool head_on_only = false, double max_without = 0.0) {
   double sum = 0.0;
-  int count = 0;
+  int count = 0, without = 0;
   for (std::size_t i = 0; i < image.normals.size(); ++i) {
-    if (!std::isfinite(result.normals[i].normal_x)) continue;
+    if (!pcl::isXYZFinite((*image.cloud)[i])) continue;  // no surface seen there
     const Eigen::Vector3d ray = (*image.cloud)[i].getVector3fMap().cast<double>().normalized();
     if (head_on_only && std::abs(ray.dot(image.normals[i])) < 0.5) continue;
+    if (!std::isfinite(result.normals[i].normal_x)) {
+      ++without;
+      continue;
+    }
     sum += angleTo(result.normals[i], image.normals[i]);
     ++count;
   }
+  EXPECT_GT(count, 0);
+  EXPECT_LE(without, max_without * count) << without << " pixels without a normal of " << count;
   return sum / count;
 }
 
@@ -183,10 +190,18 @@ TEST(OrganizedNormals, NoNormalBendsAcrossADepthStep) {
   const OrganizedNormalResult result = computeOrganizedPCANormals(image.cloud);
   EXPECT_GT(result.jump_points, 100);
   double worst = 0.0;
+  int compared = 0, without = 0;
   for (std::size_t i = 0; i < image.normals.size(); ++i) {
-    if (image.pixels_from_step[i] <= 1) continue;  // the 1-pixel rim
+    if (image.pixels_from_step[i] <= 1 || !pcl::isXYZFinite((*image.cloud)[i])) continue;
+    ++compared;  // beyond the 1-pixel rim every seen pixel has a window, hence a normal
+    if (!std::isfinite(result.normals[i].normal_x)) {
+      ++without;
+      continue;
+    }
     worst = std::max(worst, angleTo(result.normals[i], image.normals[i]));
   }
+  EXPECT_GT(compared, 1000);
+  EXPECT_EQ(without, 0);
   EXPECT_LT(worst, 1.0 * kDegree);
 
   // The kd-tree does not know about the step: measured, for the README.
@@ -199,15 +214,18 @@ TEST(OrganizedNormals, NoNormalBendsAcrossADepthStep) {
     ++near_step;
     bent += angleTo(euclidean.normals[i], image.normals[i]) > 1.0 * kDegree;
   }
-  RecordProperty("kd_tree_bent_near_step", bent);
-  RecordProperty("near_step_pixels", near_step);
+  // Documented behaviour (the reason for the grid): the kd-tree's neighbourhoods cross the step.
+  EXPECT_GT(near_step, 100);
+  EXPECT_GT(bent, near_step / 4);
   std::printf("kd-tree (k = 100): %d of %d pixels 2-4 pixels from the step bent by > 1 degree\n",
               bent, near_step);
 }
 
 TEST(OrganizedNormals, AtLeastAsAccurateAsIntegralImageNormalEstimation) {
   const auto image = renderRangeImage(RangeScene::Sphere, PinholeCamera{}.scaled(4.0), 1e-3, 3);
-  const double ours = meanAngleError(image, computeOrganizedPCANormals(image.cloud));
+  // At most 1 in 10^4 seen pixels without a normal: silhouette pixels whose window the depth-jump
+  // cut leaves with fewer than three points (measured: 1 of 164,911).
+  const double ours = meanAngleError(image, computeOrganizedPCANormals(image.cloud), false, 1e-4);
   pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> iine;
   iine.setNormalEstimationMethod(iine.COVARIANCE_MATRIX);
   iine.setNormalSmoothingSize(7.0f);

@@ -3,9 +3,6 @@
 // memory budget.
 #include <gtest/gtest.h>
 #include <pcl/io/pcd_io.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -17,23 +14,9 @@
 #include "test_data.h"
 #include "tool_runner.h"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define PCL_DDG_UNDER_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define PCL_DDG_UNDER_ASAN 1
-#endif
-#endif
-
 namespace pcl_ddg {
 namespace test {
 namespace {
-
-#ifdef PCL_DDG_UNDER_ASAN
-constexpr bool kUnderAddressSanitizer = true;
-#else
-constexpr bool kUnderAddressSanitizer = false;
-#endif
 
 std::string fileBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -133,20 +116,11 @@ TEST_F(OutOfCore, InputsThatCannotBeReadInPiecesAndBadOptionsAreRefused) {
   expectNoScratchLeft();
 }
 
-// Runs the tool in a child and returns its peak resident memory in bytes.
+// Runs the tool and returns its peak resident memory in bytes, as the tool measures itself.
 std::int64_t peakMemory(const std::string& arguments) {
-  const pid_t child = fork();
-  if (child == 0) {
-    execl("/bin/sh", "sh", "-c",
-          (std::string(PCL_DDG_NORMALS_TOOL) + " " + arguments + " >/dev/null 2>&1").c_str(),
-          static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  int status = 0;
-  rusage usage{};
-  wait4(child, &status, 0, &usage);
-  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << arguments;
-  return static_cast<std::int64_t>(usage.ru_maxrss) * 1024;
+  const MeasuredRun run = runToolMeasured(PCL_DDG_NORMALS_TOOL, arguments);
+  EXPECT_EQ(run.exit_code, 0) << arguments;
+  return run.peak_bytes;
 }
 
 TEST_F(OutOfCore, StaysWithinItsBudgetWhereMemoryWouldHoldTheWholeCloud) {

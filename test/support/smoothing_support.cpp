@@ -3,8 +3,7 @@
 #include <Eigen/SparseCholesky>
 
 #include "pcl_ddg/mesh/mesh_geometry.h"
-#include "pcl_ddg/operators/laplacian.h"
-#include "pcl_ddg/operators/mass_matrix.h"
+#include "reference_operators.h"
 
 namespace pcl_ddg {
 namespace test {
@@ -14,17 +13,35 @@ double squaredEdge(const MeshTopology& topology, const Eigen::Matrix3Xd& x) {
   return h * h;
 }
 
-Eigen::Matrix3Xd frozenBackwardEuler(const MeshTopology& topology, const Eigen::Matrix3Xd& x,
-                                     double tau, int steps) {
-  const Eigen::SparseMatrix<double> l = laplacian(topology, x);
-  const Eigen::VectorXd m = lumpedMass(topology, x);
+Eigen::MatrixXd referenceBackwardEuler(const MeshTopology& topology, const Eigen::Matrix3Xd& x,
+                                       const Eigen::MatrixXd& values, double tau, int steps,
+                                       MassType mass) {
+  const Eigen::SparseMatrix<double> l = referenceCotangentLaplacian(topology, x);
+  const Eigen::VectorXd m = referenceMass(topology, x, mass);
   Eigen::SparseMatrix<double> system = -tau * l;
   for (int v = 0; v < topology.numVertices(); ++v) system.coeffRef(v, v) += m[v];
   const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> solver(system);
+  Eigen::MatrixXd result = values;
+  for (int i = 0; i < steps; ++i) {
+    const Eigen::MatrixXd rhs = m.asDiagonal() * result;
+    result = solver.solve(rhs);
+  }
+  return result;
+}
+
+Eigen::Matrix3Xd frozenBackwardEuler(const MeshTopology& topology, const Eigen::Matrix3Xd& x,
+                                     double tau, int steps, MassType mass) {
+  return referenceBackwardEuler(topology, x, x.transpose(), tau, steps, mass).transpose();
+}
+
+Eigen::Matrix3Xd frozenForwardEuler(const MeshTopology& topology, const Eigen::Matrix3Xd& x,
+                                    double tau, int steps) {
+  const Eigen::SparseMatrix<double> l = referenceCotangentLaplacian(topology, x);
+  const Eigen::VectorXd inverse_mass = referenceMass(topology, x).cwiseInverse();
   Eigen::MatrixXd values = x.transpose();
   for (int i = 0; i < steps; ++i) {
-    const Eigen::MatrixXd rhs = m.asDiagonal() * values;
-    values = solver.solve(rhs);
+    const Eigen::MatrixXd lx = l * values;
+    values += tau * (inverse_mass.asDiagonal() * lx);
   }
   return values.transpose();
 }

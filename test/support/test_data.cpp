@@ -4,6 +4,7 @@
 #include <pcl/conversions.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -21,7 +22,9 @@ std::string sharedData(const std::string& relative_path) {
 }
 
 std::string scratchFolder(const std::string& name) {
-  const auto path = std::filesystem::temp_directory_path() / ("pcl_ddg_test_" + name);
+  // The process id keeps concurrent runs (a release and a sanitizer build, two clones) apart.
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("pcl_ddg_test_" + name + "_" + std::to_string(getpid()));
   std::filesystem::remove_all(path);
   std::filesystem::create_directories(path);
   return path.string();

@@ -6,8 +6,23 @@
 #include <string>
 #include <vector>
 
+#if defined(__SANITIZE_ADDRESS__)
+#define PCL_DDG_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define PCL_DDG_UNDER_ASAN 1
+#endif
+#endif
+
 namespace pcl_ddg {
 namespace test {
+
+/** AddressSanitizer's shadow memory and quarantine make memory peaks meaningless. */
+#ifdef PCL_DDG_UNDER_ASAN
+constexpr bool kUnderAddressSanitizer = true;
+#else
+constexpr bool kUnderAddressSanitizer = false;
+#endif
 
 /** Path of a file under the shared data folder; fails the test loudly if the folder is missing. */
 std::string sharedData(const std::string& relative_path);

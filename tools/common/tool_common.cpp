@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <utility>
 
@@ -266,9 +267,25 @@ int forEachInput(const ToolArguments& args, const char* tool_name,
   return failed.empty() ? 0 : 1;
 }
 
-int runTool(const char* name, const char* description, const char* syntax,
+namespace {
+
+/** With PCL_DDG_PEAK_MEMORY_FILE set, writes this process's peak resident memory (VmHWM, in
+ *  KiB) there: what tests and benchmarks measure. A parent's getrusage would not do: Linux
+ *  carries ru_maxrss over an exec, so a forked child starts at the parent's size. */
+void writePeakMemory() {
+  const char* path = std::getenv("PCL_DDG_PEAK_MEMORY_FILE");
+  if (path == nullptr || *path == '\0') return;
+  std::ifstream status("/proc/self/status");
+  for (std::string line; std::getline(status, line);) {
+    if (line.rfind("VmHWM:", 0) == 0) {
+      std::ofstream(path) << std::strtol(line.c_str() + 6, nullptr, 10) << "\n";
+      return;
+    }
+  }
+}
+
+int runBody(const char* name, const char* description, const char* syntax,
             const std::function<int()>& body) {
-  AtomicFile::removeUncommittedFilesOnInterrupt();  // Ctrl-C leaves no temporary behind
   try {
     return body();
   } catch (const HelpRequested&) {
@@ -290,6 +307,16 @@ int runTool(const char* name, const char* description, const char* syntax,
     printError(name, "unknown internal error");
     return 1;
   }
+}
+
+}  // namespace
+
+int runTool(const char* name, const char* description, const char* syntax,
+            const std::function<int()>& body) {
+  AtomicFile::removeUncommittedFilesOnInterrupt();  // Ctrl-C leaves no temporary behind
+  const int code = runBody(name, description, syntax, body);
+  writePeakMemory();
+  return code;
 }
 
 void printError(const char* tool_name, const std::string& message) {

@@ -75,7 +75,9 @@ void checkOutputFile(const std::string& output, const std::vector<std::string>& 
 
 /**
  * Runs a tool body: prints the description and syntax on -h, and turns every exception into one
- * line on stderr and an exit code (a usage error: the line ends "(see -help)", exit 2).
+ * line on stderr and an exit code (a usage error: the line ends "(see -help)", exit 2). With
+ * PCL_DDG_PEAK_MEMORY_FILE set in the environment, the process's peak resident memory (VmHWM,
+ * KiB) is written to that file at the end.
  */
 int runTool(const char* name, const char* description, const char* syntax,
             const std::function<int()>& body);
