@@ -1,11 +1,9 @@
 #include "pcl_ddg/features/pca_normal_estimation.h"
 
-#include "pcl_ddg/point_types.h"
-
+#include "estimator_instantiation.h"
 #include "pcl_ddg/features/impl/pca_normal_estimation.hpp"
 
-// Every input type x every output type of pcl_ddg/point_types.h.
-#define PCL_DDG_INSTANTIATE_PAIR(r, types) \
-  PCL_DDG_INSTANTIATE_PCANormalEstimation(BOOST_PP_SEQ_ELEM(0, types), BOOST_PP_SEQ_ELEM(1, types))
-BOOST_PP_SEQ_FOR_EACH_PRODUCT(PCL_DDG_INSTANTIATE_PAIR,
-                              (PCL_DDG_XYZ_POINT_TYPES)(PCL_DDG_NORMAL_POINT_TYPES))
+// Slice 0 of PCL's input types x every output type (estimator_instantiation.h); the other
+// slices are in the other pca_normal_estimation*.cpp files.
+#define PCL_DDG_INSTANTIATE_ESTIMATOR PCL_DDG_INSTANTIATE_PCANormalEstimation
+PCL_DDG_INSTANTIATE_ESTIMATOR_SLICE(0)

@@ -4,13 +4,19 @@
 // MeshRingSearch for topological neighbourhoods) in double relative to the query point, fits
 // something to them, and orients the resulting normal.
 //
+// The interface of pcl::NormalEstimationOMP, so either estimator replaces it (or
+// pcl::NormalEstimation) in existing code: computePointNormal (both overloads), the viewpoint
+// setters and the protected vpx_, vpy_, vpz_, a constructor taking the number of threads and
+// setNumberOfThreads (0: every core; the default here, where PCL's NormalEstimation uses one),
+// Ptr / ConstPtr of the class itself. See docs/pcl-drop-in.md for what differs.
+//
 // Orientation (see normal_orientation.h): by the viewpoint, as PCL does, unless the search method
 // is a MeshRingSearch (or setOrientationMesh was called), in which case by the mesh's faces.
-// The viewpoint is the input cloud's sensor_origin_, as in pcl::NormalEstimation, unless
-// setViewPoint chooses one. setOrientationSpanningTree makes the normals
-// consistent along a minimum spanning tree of each point's nearest neighbours from the search
-// method (mesh rings, pixel grid or kd-tree: the graph follows the neighbourhood), for clouds
-// without a single viewpoint; the quadric's curvatures change sign with their normals.
+// The viewpoint is the input cloud's sensor_origin_, copied when the cloud is set, as in
+// pcl::NormalEstimation, unless setViewPoint chooses one. setOrientationSpanningTree makes the
+// normals consistent along a minimum spanning tree of each point's nearest neighbours from the
+// search method (mesh rings, pixel grid or kd-tree: the graph follows the neighbourhood), for
+// clouds without a single viewpoint; the quadric's curvatures change sign with their normals.
 //
 // A point that cannot be estimated (non-finite, or too few finite neighbours) gets NaN output
 // and output.is_dense = false; compute() counts them (getFailedPoints) and warns once.
@@ -30,12 +36,24 @@ namespace pcl_ddg {
 template <typename PointInT, typename PointOutT>
 class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
  public:
+  using Ptr = std::shared_ptr<LocalFitEstimation<PointInT, PointOutT>>;
+  using ConstPtr = std::shared_ptr<const LocalFitEstimation<PointInT, PointOutT>>;
   using PointCloudOut = typename pcl::Feature<PointInT, PointOutT>::PointCloudOut;
+  using PointCloudConstPtr = typename pcl::Feature<PointInT, PointOutT>::PointCloudConstPtr;
+
+  /** Sets the input; while the sensor origin is the viewpoint (the default), copies the cloud's
+   *  sensor_origin_ into it, as pcl::NormalEstimation does. */
+  void setInputCloud(const PointCloudConstPtr& cloud) override {
+    pcl::Feature<PointInT, PointOutT>::setInputCloud(cloud);
+    if (use_sensor_origin_) copySensorOrigin();
+  }
 
   /** Orients normals towards this point (PCL's semantics), instead of the input cloud's
    *  sensor_origin_. */
   void setViewPoint(float vx, float vy, float vz) {
-    viewpoint_ = Eigen::Vector3d(vx, vy, vz);
+    vpx_ = vx;
+    vpy_ = vy;
+    vpz_ = vz;
     use_sensor_origin_ = false;
     orientation_ = NormalOrientation::Viewpoint;
     orientation_chosen_ = true;
@@ -43,18 +61,35 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   /** The viewpoint: the one set, or the input cloud's sensor_origin_ (PCL's default; the origin
    *  before a cloud is set). */
   void getViewPoint(float& vx, float& vy, float& vz) const {
-    const Eigen::Vector3d v = currentViewPoint();
-    vx = static_cast<float>(v.x());
-    vy = static_cast<float>(v.y());
-    vz = static_cast<float>(v.z());
+    vx = vpx_;
+    vy = vpy_;
+    vz = vpz_;
   }
-  /** Orients normals towards the input cloud's sensor_origin_, read at compute() (the default,
-   *  as pcl::NormalEstimation's useSensorOriginAsViewPoint; undoes setViewPoint). */
+  /** Orients normals towards the input cloud's sensor_origin_ (the default, as
+   *  pcl::NormalEstimation's useSensorOriginAsViewPoint; undoes setViewPoint). */
   void useSensorOriginAsViewPoint() {
     use_sensor_origin_ = true;
+    copySensorOrigin();
     orientation_ = NormalOrientation::Viewpoint;
     orientation_chosen_ = true;
   }
+
+  /**
+   * The least-squares plane of the finite points `indices` of cloud, as
+   * pcl::NormalEstimation::computePointNormal: plane_parameters = (n, -n . c) with c their
+   * centroid and n the unit eigenvector of the smallest eigenvalue of their covariance
+   * \f$ C = \frac{1}{m} \sum_i (p_i - c)(p_i - c)^T \f$, curvature the surface variation
+   * \f$ \lambda_0 / (\lambda_0 + \lambda_1 + \lambda_2) \f$. n is not oriented (its sign is the
+   * solver's, as PCL's; pcl::flipNormalTowardsViewpoint turns it). Formed in double about the
+   * centroid, so far from the origin it keeps the accuracy PCL's float sums lose.
+   * \return false, with every output NaN, for fewer than 3 finite points or points on one line.
+   */
+  bool computePointNormal(const pcl::PointCloud<PointInT>& cloud, const pcl::Indices& indices,
+                          Eigen::Vector4f& plane_parameters, float& curvature) const;
+  /** The same plane's normal (nx, ny, nz) and surface variation. */
+  bool computePointNormal(const pcl::PointCloud<PointInT>& cloud, const pcl::Indices& indices,
+                          float& nx, float& ny, float& nz, float& curvature) const;
+
   /** Orients normals up: n . up >= 0, up = (ux, uy, uz) (setUpDirection; default +z). */
   void setOrientationUp() {
     orientation_ = NormalOrientation::Up;
@@ -104,8 +139,9 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   }
   unsigned int getRadiusSearchMinNeighbours() const { return min_neighbours_; }
 
-  /** Threads for compute(); 0 = as many as the machine has. */
-  void setNumberOfThreads(unsigned int threads) { threads_ = threads; }
+  /** Threads for compute(), as pcl::NormalEstimationOMP; 0 = as many as the machine has. */
+  void setNumberOfThreads(unsigned int nr_threads = 0) { threads_ = nr_threads; }
+  unsigned int getNumberOfThreads() const { return threads_; }
 
   /** Points given NaN output by the last compute(). */
   std::int64_t getFailedPoints() const { return failed_points_; }
@@ -138,16 +174,24 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   unsigned int min_neighbours_ = 0;
   std::int64_t fallback_points_ = 0;  ///< counted by fitEachNeighbourhood (FitOutcome::FellBack)
 
+  /** The viewpoint, named and kept as in pcl::NormalEstimation (protected there too). */
+  float vpx_ = 0.0f, vpy_ = 0.0f, vpz_ = 0.0f;
+  /** true: vpx_, vpy_, vpz_ follow the input cloud's sensor_origin_. */
+  bool use_sensor_origin_ = true;
+  /** Threads for compute() (0: every core), as pcl::NormalEstimationOMP's. */
+  unsigned int threads_ = 0;
+
  private:
-  /** setViewPoint's point, or the input's sensor origin when use_sensor_origin_. */
-  Eigen::Vector3d currentViewPoint() const {
-    if (use_sensor_origin_ && this->input_)
-      return this->input_->sensor_origin_.template head<3>().template cast<double>();
-    return use_sensor_origin_ ? Eigen::Vector3d::Zero() : viewpoint_;
+  /** The input's sensor origin into vpx_, vpy_, vpz_; the origin without an input. */
+  void copySensorOrigin() {
+    const Eigen::Vector4f origin =
+        this->input_ ? this->input_->sensor_origin_ : Eigen::Vector4f::Zero();
+    vpx_ = origin.x();
+    vpy_ = origin.y();
+    vpz_ = origin.z();
   }
 
   Eigen::Vector3d viewpoint_ = Eigen::Vector3d::Zero();  ///< as used by the current compute()
-  bool use_sensor_origin_ = true;
   std::optional<Eigen::Vector3d> up_;
   NormalOrientation orientation_ = NormalOrientation::Viewpoint;
   bool orientation_chosen_ = false;  ///< false: by the search method (see above)
@@ -158,7 +202,6 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   typename pcl::search::Search<PointInT>::Ptr spanning_tree_graph_;  ///< null: tree_
   bool seed_facing_viewpoint_ = false;
   ConsistentOrientationReport orientation_report_;
-  unsigned int threads_ = 0;
   std::int64_t failed_points_ = 0;
 };
 

@@ -21,9 +21,14 @@ template <typename PointInT, typename PointOutT>
 class PCANormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
  public:
   using Ptr = std::shared_ptr<PCANormalEstimation<PointInT, PointOutT>>;
+  using ConstPtr = std::shared_ptr<const PCANormalEstimation<PointInT, PointOutT>>;
   using PointCloudOut = typename LocalFitEstimation<PointInT, PointOutT>::PointCloudOut;
 
-  PCANormalEstimation() { this->feature_name_ = "PCANormalEstimation"; }
+  /** nr_threads for compute(), as pcl::NormalEstimationOMP's constructor (0: every core). */
+  explicit PCANormalEstimation(unsigned int nr_threads = 0) {
+    this->feature_name_ = "PCANormalEstimation";
+    this->setNumberOfThreads(nr_threads);
+  }
 
  protected:
   void computeFeature(PointCloudOut& output) override;

@@ -29,10 +29,15 @@ template <typename PointInT, typename PointOutT>
 class QuadricNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
  public:
   using Ptr = std::shared_ptr<QuadricNormalEstimation<PointInT, PointOutT>>;
+  using ConstPtr = std::shared_ptr<const QuadricNormalEstimation<PointInT, PointOutT>>;
   using PointCloudOut = typename LocalFitEstimation<PointInT, PointOutT>::PointCloudOut;
   using CurvatureCloud = pcl::PointCloud<pcl::PrincipalCurvatures>;
 
-  QuadricNormalEstimation() { this->feature_name_ = "QuadricNormalEstimation"; }
+  /** nr_threads for compute(), as pcl::NormalEstimationOMP's constructor (0: every core). */
+  explicit QuadricNormalEstimation(unsigned int nr_threads = 0) {
+    this->feature_name_ = "QuadricNormalEstimation";
+    this->setNumberOfThreads(nr_threads);
+  }
 
   /** compute(normals), also filling curvatures (one per output point) in the same pass. */
   void computeWithCurvatures(PointCloudOut& normals, CurvatureCloud& curvatures);

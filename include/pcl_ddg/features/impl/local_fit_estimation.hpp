@@ -2,11 +2,13 @@
 #include <pcl/common/point_tests.h>
 
 #include <algorithm>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "pcl_ddg/features/local_fit_estimation.h"
+#include "pcl_ddg/features/plane_fit.h"
 #include "pcl_ddg/features/spatial_order.h"
 #include "pcl_ddg/search/mesh_ring_search.h"
 
@@ -17,9 +19,49 @@
 namespace pcl_ddg {
 
 template <typename PointInT, typename PointOutT>
+bool LocalFitEstimation<PointInT, PointOutT>::computePointNormal(
+    const pcl::PointCloud<PointInT>& cloud, const pcl::Indices& indices,
+    Eigen::Vector4f& plane_parameters, float& curvature) const {
+  constexpr float nan = std::numeric_limits<float>::quiet_NaN();
+  // About the first finite point, in double: fitPlane then centres exactly.
+  Eigen::Matrix3Xd points(3, indices.size());
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  int count = 0;
+  for (const pcl::index_t j : indices) {
+    if (!pcl::isXYZFinite(cloud[j])) continue;
+    const Eigen::Vector3d p = cloud[j].getVector3fMap().template cast<double>();
+    if (count == 0) shift = p;
+    points.col(count++) = p - shift;
+  }
+  const PlaneFit plane = count >= 3 ? fitPlane(points, count) : PlaneFit();
+  if (!plane.valid) {
+    plane_parameters.setConstant(nan);
+    curvature = nan;
+    return false;
+  }
+  const Eigen::Vector3d centroid = plane.centroid + shift;
+  plane_parameters << plane.normal.template cast<float>(),
+      static_cast<float>(-plane.normal.dot(centroid));
+  curvature = static_cast<float>(plane.surface_variation);
+  return true;
+}
+
+template <typename PointInT, typename PointOutT>
+bool LocalFitEstimation<PointInT, PointOutT>::computePointNormal(
+    const pcl::PointCloud<PointInT>& cloud, const pcl::Indices& indices, float& nx, float& ny,
+    float& nz, float& curvature) const {
+  Eigen::Vector4f plane;
+  const bool valid = computePointNormal(cloud, indices, plane, curvature);
+  nx = plane.x();
+  ny = plane.y();
+  nz = plane.z();
+  return valid;
+}
+
+template <typename PointInT, typename PointOutT>
 bool LocalFitEstimation<PointInT, PointOutT>::initCompute() {
   if (!pcl::Feature<PointInT, PointOutT>::initCompute()) return false;
-  viewpoint_ = currentViewPoint();
+  viewpoint_ = Eigen::Vector3d(vpx_, vpy_, vpz_);
   std::shared_ptr<const MeshTopology> mesh = orientation_mesh_;
   used_orientation_ = orientation_;
   if (!orientation_chosen_) {
@@ -97,9 +139,12 @@ void LocalFitEstimation<PointInT, PointOutT>::makeOrientationConsistent(PointClo
 #pragma omp for schedule(dynamic, 1024)
     for (int i = 0; i < count; ++i) {
       if (!pcl::isNormalFinite(normals[i]) || !pcl::isXYZFinite(points[i])) continue;
-      graph.nearestKSearch(*this->input_, indices[i], k + 1, found, distances);
+      found.resize(k + 1);  // searches may fill without resizing, as PCL's allow
+      distances.resize(k + 1);
+      const int answered = graph.nearestKSearch(*this->input_, indices[i], k + 1, found, distances);
       int filled = 0;
-      for (const pcl::index_t j : found) {
+      for (int n = 0; n < std::min(answered, static_cast<int>(found.size())); ++n) {
+        const pcl::index_t j = found[n];
         if (filled == k || slot[j] < 0 || slot[j] == i) continue;
         edges[static_cast<std::size_t>(i) * k + filled++] = {i, slot[j]};
       }
@@ -167,6 +212,13 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut
       const PointInT& query = (*this->input_)[indices[i]];
       FitOutcome outcome = FitOutcome::Failed;
       const bool capped_radius = this->search_radius_ > 0.0 && max_neighbours_ > 0;
+      // Sized to k before every search, as pcl::NormalEstimationOMP does: a search may write its
+      // answer into them without resizing (PCL's own tests rely on it).
+      const auto presize = [&](int size) {
+        neighbours.resize(std::max(size, 0));
+        squared_distances.resize(std::max(size, 0));
+      };
+      presize(this->k_);
       int found = !pcl::isXYZFinite(query) ? 0
                   : capped_radius
                       ? this->tree_->radiusSearch(*this->input_, indices[i], this->search_radius_,
@@ -175,16 +227,18 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(PointCloudOut
                                                  squared_distances);
       if (this->search_radius_ > 0.0 && pcl::isXYZFinite(query) &&
           found < static_cast<int>(min_neighbours_)) {
+        presize(static_cast<int>(min_neighbours_));
         found = this->tree_->nearestKSearch(*this->input_, indices[i],
                                             static_cast<int>(min_neighbours_), neighbours,
                                             squared_distances);
       }
+      found = std::min(found, static_cast<int>(neighbours.size()));
       if (found > 0) {
         const Eigen::Vector3d origin = query.getVector3fMap().template cast<double>();
-        if (local.cols() < static_cast<Eigen::Index>(neighbours.size()))
-          local.resize(3, neighbours.size());
+        if (local.cols() < found) local.resize(3, found);
         int count = 0;
-        for (const pcl::index_t j : neighbours) {
+        for (int n = 0; n < found; ++n) {
+          const pcl::index_t j = neighbours[n];
           if (pcl::isXYZFinite(surface[j])) {
             local.col(count++) = surface[j].getVector3fMap().template cast<double>() - origin;
           }
