@@ -1,4 +1,4 @@
-// Curvatures against exact values, Gauss-Bonnet, and the convergence orders of ACCURACY.md.
+// Curvatures against exact values, Gauss-Bonnet, and the convergence orders of docs/accuracy.md.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -115,7 +115,7 @@ TEST(Curvature, GaussBonnetOnRealScans) {
   EXPECT_EQ(skipped, 1);
 }
 
-// ACCURACY.md: unit icosphere, mixed Voronoi: max |K - 1| 8.9e-5 at level 6, order 2; and
+// docs/accuracy.md: unit icosphere, mixed Voronoi: max |K - 1| 8.9e-5 at level 6, order 2; and
 // n . (-M^-1 L x) / 2 = 1 exactly with the exact normal n on any sphere-inscribed mesh (because
 // x_i . (x_i - x_j) = |x_i - x_j|^2 / 2 turns the normal part of L x into the Voronoi area).
 // Our H = |M^-1 L x| / 2 also holds the small tangential part of L x, so it converges at order 2
@@ -136,7 +136,7 @@ TEST(Curvature, IcosphereConvergesAtOrderTwo) {
         "n.Hn max %.2e rms %.2e\n",
         level, static_cast<long>(s.points.cols()), k.max, k.rms, h.max, h.rms, exact.max,
         exact.rms);
-    EXPECT_LT(exact.max, 3e-12);  // ACCURACY.md: 1.4e-12
+    EXPECT_LT(exact.max, 3e-12);  // docs/accuracy.md: 1.4e-12
     if (level >= 3) {
       EXPECT_NEAR(std::log2(previous_k.max / k.max), 2.0, 0.25) << "level " << level;
       EXPECT_NEAR(std::log2(previous_h.max / h.max), 2.0, 0.25) << "level " << level;
@@ -168,7 +168,7 @@ TEST(Curvature, BarycentricAreaDoesNotConverge) {
   EXPECT_GT(e6, 0.8 * e4);
 }
 
-// ACCURACY.md: regular torus R=1, r=0.4 at 131,072 V: max |K-K*| 2.7e-4, max |H-H*| 5.2e-5,
+// docs/accuracy.md: regular torus R=1, r=0.4 at 131,072 V: max |K-K*| 2.7e-4, max |H-H*| 5.2e-5,
 // both order 2.
 TEST(Curvature, RegularTorusConvergesAtOrderTwo) {
   Errors previous_k, previous_h;
@@ -195,7 +195,7 @@ TEST(Curvature, RegularTorusConvergesAtOrderTwo) {
 }
 
 // On irregular (scan-like) meshes the pointwise cotangent curvatures do not converge: with 0.1h
-// jitter the error stays at the level ACCURACY.md measured (documented, not a failure).
+// jitter the error stays at the level docs/accuracy.md measured (documented, not a failure).
 TEST(Curvature, JitteredMeshesDoNotConvergePointwise) {
   const SurfaceSample coarse = makeIcosphere(4, 1.0, 0.1), fine = makeIcosphere(6, 1.0, 0.1);
   const VertexCurvatures cc = computeCurvatures(topologyOf(coarse), coarse.points);
@@ -205,8 +205,8 @@ TEST(Curvature, JitteredMeshesDoNotConvergePointwise) {
   const Errors hf = errors(cf.mean_curvature, fine.mean_curvature);
   std::printf("jittered icosphere: K rms level 4 %.2e, level 6 %.2e; H rms level 6 %.2e\n", kc.rms,
               kf.rms, hf.rms);
-  // ACCURACY.md measured K rms 1.0e-2 and max 0.286 at level 6: no decrease worth the name with
-  // 16x the vertices, and an error of that size.
+  // docs/accuracy.md measured K rms 1.0e-2 and max 0.286 at level 6: no decrease worth the name
+  // with 16x the vertices, and an error of that size.
   EXPECT_GT(kf.rms, 0.5 * kc.rms);
   EXPECT_GT(kf.rms, 3e-3);
   EXPECT_LT(kf.rms, 3e-2);
@@ -218,7 +218,7 @@ TEST(Curvature, JitteredMeshesDoNotConvergePointwise) {
                            torus_f.mean_curvature);
   std::printf("jittered torus: H rms %.2e -> %.2e\n", tc.rms, tf.rms);
   EXPECT_GT(tf.rms, 0.5 * tc.rms);
-  EXPECT_NEAR(tf.rms, 0.071, 0.02);  // ACCURACY.md: 0.071 at 131,072 V
+  EXPECT_NEAR(tf.rms, 0.071, 0.02);  // docs/accuracy.md: 0.071 at 131,072 V
 }
 
 TEST(Curvature, PrincipalCurvaturesOfCylinderAndSphere) {

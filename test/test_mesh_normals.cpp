@@ -216,7 +216,7 @@ TEST(MeshNormals, EveryWeightingMatchesTheExactNormalOnRegularMeshes) {
 
 // On irregular meshes the face-based weightings stay within a few degrees, while the
 // mean-curvature direction inherits the pointwise non-convergence of the cotangent Laplacian
-// (ACCURACY.md): where |H| is moderate its tangential noise tilts the normal by many degrees.
+// (docs/accuracy.md): where |H| is moderate its tangential noise tilts the normal by many degrees.
 TEST(MeshNormals, JitteredMeshesFaceWeightingsStayCloseMeanCurvatureDoesNot) {
   const SurfaceSample s = makeTorus({128, 0.1, 1}).rotateAndShiftFar();
   const MeshTopology t = topologyOf(s);

@@ -4,6 +4,9 @@
 #include <array>
 #include <filesystem>
 #include <limits>
+#include <vector>
+
+#include <stb_image.h>
 
 #include "analytic_surfaces.h"
 #include "pcl_ddg/io/color_map.h"
@@ -74,13 +77,33 @@ TEST(MeshRender, CloudsAreSplatsShadedByTheirNormalsAndNaNPointsAreSkipped) {
   EXPECT_LT(pixel(renderPoints(points, grazing, c, o), 50, 50)[0], pixel(lit, 50, 50)[0]);
 }
 
+// The PNG decodes (stb_image, not the writer) to the rendered bytes; the folder holds nothing
+// else; a write that fails leaves the file that was there whole.
 TEST(MeshRender, SavesAPngAtomically) {
   const SurfaceSample sphere = makeIcosphere(2);
   Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> c(3, sphere.points.cols());
   c.setConstant(200);
   const std::string dir = scratchFolder("render");
-  savePNG(dir + "/sphere.png", renderMesh(sphere.points, sphere.triangles, c));
-  EXPECT_GT(std::filesystem::file_size(dir + "/sphere.png"), 1000u);
+  const std::string path = dir + "/sphere.png";
+  const Image image = renderMesh(sphere.points, sphere.triangles, c);
+  savePNG(path, image);
+  int width = 0, height = 0, channels = 0;
+  const auto decode = [&] {
+    std::uint8_t* pixels = stbi_load(path.c_str(), &width, &height, &channels, 3);
+    std::vector<std::uint8_t> bytes;
+    if (pixels) bytes.assign(pixels, pixels + 3 * width * height);
+    stbi_image_free(pixels);
+    return bytes;
+  };
+  EXPECT_EQ(decode(), image.rgb);
+  EXPECT_EQ(width, image.width);
+  EXPECT_EQ(height, image.height);
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) files += entry.exists();
+  EXPECT_EQ(files, 1) << "a temporary file was left beside the picture";
+
+  EXPECT_THROW(savePNG(path, Image{}), std::exception);  // nothing to encode
+  EXPECT_EQ(decode(), image.rgb);
   EXPECT_THROW(savePNG(dir + "/missing/sphere.png", Image{}), std::exception);
 }
 
@@ -92,6 +115,19 @@ TEST(ColorMap, DivergingIsSymmetricAboutZeroAndNaNIsGrey) {
   EXPECT_GT(rgb(0, 4), rgb(2, 4));  // positive: red
   EXPECT_EQ(rgb(0, 1), rgb(2, 1));  // zero: neutral
   EXPECT_EQ(rgb.col(3), (Eigen::Matrix<std::uint8_t, 3, 1>(128, 128, 128)));
+  // Symmetric: the range is [-m, m], m the largest magnitude, so -1 among {-1, 3} is a third of
+  // the way from neutral to blue, not the blue end; -3 is the blue end as 3 is the red one.
+  Eigen::VectorXd skewed(4);
+  skewed << -1, 3, 0, -3;
+  const ColorRange range = colorRange(skewed.head(2), ColorMap::Diverging, {0.0, 100.0});
+  EXPECT_EQ(range.low, -3.0);
+  EXPECT_EQ(range.high, 3.0);
+  const auto ends = colorize((Eigen::VectorXd(2) << -3, 3).finished(), ColorMap::Diverging);
+  const auto mixed = colorize(skewed, ColorMap::Diverging, {0.0, 100.0});
+  EXPECT_EQ(mixed.col(3), ends.col(0));
+  EXPECT_EQ(mixed.col(1), ends.col(1));
+  EXPECT_NE(mixed.col(0), ends.col(0));
+  EXPECT_EQ(mixed.col(2), rgb.col(1));  // zero stays neutral whatever the range
 }
 
 TEST(ColorMap, PercentilesClampOutliers) {

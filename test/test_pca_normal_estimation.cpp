@@ -59,9 +59,9 @@ SurfaceSample scaled(SurfaceSample s, double factor) {
 }
 
 TEST(PCANormals, ConvergeAtFirstOrderOnAJitteredTorusCloud) {
-  // ACCURACY.md: torus R = 1, r = 0.4, jittered samples, k = 20: PCA mean error 1.57, 0.78, 0.39,
-  // 0.19 degrees at 2k, 8k, 32k, 131k points. Ours, with 0.1-spacing parameter jitter: 1.41, 0.67,
-  // 0.34, 0.17.
+  // docs/accuracy.md: torus R = 1, r = 0.4, jittered samples, k = 20: PCA mean error 1.57, 0.78,
+  // 0.39, 0.19 degrees at 2k, 8k, 32k, 131k points. Ours, with 0.1-spacing parameter jitter: 1.41,
+  // 0.67, 0.34, 0.17.
   const double reference[] = {1.57, 0.78, 0.39, 0.19};
   double previous = 0.0;
   int level = 0;
@@ -147,7 +147,7 @@ TEST(PCANormals, FarFromTheOriginOursKeepsItsAccuracyAndIsAtLeastAsAccurateAsPCL
   const AngleErrors pcl_far =
       angleErrors(normalsOf(pclNormals(toCloud(far.points), 16)), far.normals, SignMode::Unsigned);
   // Measured: 1.0141 / 1.0122 / 1.0122 deg. (PCL 1.13 shifts its float covariance by a point of
-  // the neighbourhood, so it holds up here too; ACCURACY.md's "degrees" are older PCL's.)
+  // the neighbourhood, so it holds up here too; docs/accuracy.md's "degrees" are older PCL's.)
   std::printf(
       "torus x100: ours near %.4f deg, ours 1e5 away %.4f deg, pcl::NormalEstimation 1e5 away %.4f "
       "deg "

@@ -56,6 +56,7 @@ SurfaceSample scaled(SurfaceSample s, double factor) {
 struct CurvatureErrors {
   double kappa1_rms = 0.0, kappa2_rms = 0.0, mean_rms = 0.0, gauss_rms = 0.0;
   double direction_mean_degrees = 0.0;  ///< between estimated and exact kappa1 directions, as lines
+  int non_finite = 0;                   ///< points without curvatures (left out of the errors)
 };
 
 // Errors against the exact values, in the exact normal's orientation: where the estimate points
@@ -65,7 +66,10 @@ CurvatureErrors curvatureErrors(const QuadricResult& r, const SurfaceSample& s) 
   int n = 0;
   for (std::size_t i = 0; i < r.curvatures.size(); ++i) {
     const pcl::PrincipalCurvatures& c = r.curvatures[i];
-    if (!std::isfinite(c.pc1)) continue;
+    if (!std::isfinite(c.pc1) || !std::isfinite(c.pc2)) {
+      ++e.non_finite;
+      continue;
+    }
     double k1 = c.pc1, k2 = c.pc2;
     if (r.normals[i].getNormalVector3fMap().cast<double>().dot(s.normals.col(i)) < 0.0) {
       k1 = -c.pc2;
@@ -92,9 +96,9 @@ CurvatureErrors curvatureErrors(const QuadricResult& r, const SurfaceSample& s) 
 }
 
 TEST(QuadricNormals, ConvergeAtSecondOrderOnAJitteredTorusCloud) {
-  // ACCURACY.md (torus R = 1, r = 0.4, jittered samples, k = 20): quadric normal mean error 0.42,
-  // 0.098, 0.024, 0.006 degrees; H RMS 8.1e-2, 2.3e-2, 8.0e-3, 3.6e-3; K RMS 0.16, 0.056, 0.024,
-  // 0.012.
+  // docs/accuracy.md (torus R = 1, r = 0.4, jittered samples, k = 20): quadric normal mean error
+  // 0.42, 0.098, 0.024, 0.006 degrees; H RMS 8.1e-2, 2.3e-2, 8.0e-3, 3.6e-3; K RMS 0.16, 0.056,
+  // 0.024, 0.012.
   const double normal_reference[] = {0.42, 0.098, 0.024, 0.006};
   const double mean_reference[] = {8.1e-2, 2.3e-2, 8.0e-3, 3.6e-3};
   const double gauss_reference[] = {0.16, 0.056, 0.024, 0.012};
@@ -105,6 +109,7 @@ TEST(QuadricNormals, ConvergeAtSecondOrderOnAJitteredTorusCloud) {
     const QuadricResult r = estimate(torus.points, kdTree(), 20);
     const AngleErrors e = angleErrors(normalsOf(r.normals), torus.normals, SignMode::Unsigned);
     const CurvatureErrors c = curvatureErrors(r, torus);
+    EXPECT_EQ(c.non_finite, 0);
     std::printf(
         "quadric torus %6ld points: normal mean %.4f max %.4f deg; H RMS %.2e, K RMS %.2e, k1 RMS "
         "%.2e, "
@@ -223,6 +228,7 @@ TEST(QuadricNormals, PrincipalCurvaturesAndDirectionsOnMeshesConverge) {
       }
       EXPECT_EQ(flipped, 0) << c.name << ": oriented like the faces";
       const CurvatureErrors e = curvatureErrors(r, s);
+      EXPECT_EQ(e.non_finite, 0) << c.name;
       std::printf(
           "quadric %-8s %6ld vertices: k1 RMS %.2e, k2 RMS %.2e, H RMS %.2e, K RMS %.2e, direction "
           "%.3f deg\n",
@@ -231,8 +237,8 @@ TEST(QuadricNormals, PrincipalCurvaturesAndDirectionsOnMeshesConverge) {
       kappa_error[i] = std::max(e.kappa1_rms, e.kappa2_rms);
       direction_error[i] = e.direction_mean_degrees;
     }
-    EXPECT_LT(kappa_error[1], kappa_error[0]) << c.name;
-    EXPECT_LT(kappa_error[1], 0.05) << c.name;
+    // h halves: a consistent estimate's error at least halves (measured 0.24-0.40).
+    EXPECT_LT(kappa_error[1], 0.5 * kappa_error[0]) << c.name;
     if (!c.umbilic) {
       EXPECT_LT(direction_error[1], direction_error[0]) << c.name;
       EXPECT_LT(direction_error[1], 2.0) << c.name;

@@ -334,13 +334,17 @@ TEST_F(Viewer, FiftyKeyPressesDuringAFitAreAllApplied) {
   window.runUntilIdle(0.01);  // the quadric fit starts; the presses arrive while it runs
   ViewerState expected = window.state();
   viewer::applyAction(expected, model->capabilities(), "method=quadric");
+  int during_fit = 0;
   for (int i = 0; i < 50; ++i) {  // up and down, ending a few steps above where it began
     const bool up = i % 2 == 0 || i >= 46;
+    during_fit += window.computing();
     pressKey(window, up ? "bracketright" : "bracketleft", up ? ']' : '[');
     viewer::applyAction(expected, model->capabilities(), up ? "k+" : "k-");
     window.runUntilIdle(0.002);
   }
+  EXPECT_GT(during_fit, 0) << "no press arrived while a fit was running";
   ASSERT_TRUE(window.runUntilIdle(300.0));
+  EXPECT_FALSE(window.computing());
   EXPECT_EQ(window.state(), expected);
   EXPECT_EQ(window.state().k, expected.k);
   EXPECT_TRUE(window.errors().empty());

@@ -183,6 +183,13 @@ Image renderPoints(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xd& no
 }
 
 void savePNG(const std::string& path, const Image& image) {
+  // stb encodes a 0 x 0 image into a file no reader opens: refused before the file is touched.
+  if (image.width <= 0 || image.height <= 0 ||
+      image.rgb.size() != 3 * static_cast<std::size_t>(image.width) * image.height) {
+    throw FileFormatException(path + ": no PNG of a " + std::to_string(image.width) + " x " +
+                              std::to_string(image.height) + " image with " +
+                              std::to_string(image.rgb.size()) + " bytes");
+  }
   // Encoded in memory and written by writeBytes: stb's own file writer ignores write errors.
   std::string png;
   const auto append = [](void* context, void* data, int size) {

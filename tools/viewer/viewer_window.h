@@ -43,6 +43,8 @@ class ViewerWindow {
   /** The state of the frame on screen. */
   const ViewerState& state() const { return shown_.state; }
   const Frame& frame() const { return shown_; }
+  /** Whether a computation (a fit, a smoothing step) is running in the background. */
+  bool computing() const { return computing_.valid(); }
   /** Messages of refused actions, in order. */
   const std::vector<std::string>& errors() const { return errors_; }
   vtkRenderWindowInteractor* interactor();

@@ -2,7 +2,7 @@
 // Lumped (diagonal) mass matrices: the area each vertex stands for.
 //
 //  Barycentric   one third of every incident triangle. Always positive, but not a consistent
-//                 area: curvature densities over it do not converge (ACCURACY.md).
+//                 area: curvature densities over it do not converge (docs/accuracy.md).
 //  Voronoi        circumcentric cells, (|e_ij|^2 cot(k) + |e_ik|^2 cot(j)) / 8 per corner i.
 //                 NEGATIVE contributions on obtuse triangles; exact for well-centred meshes.
 //  MixedVoronoi   Meyer, Desbrun, Schroeder and Barr 2003: Voronoi on non-obtuse triangles;
