@@ -3,26 +3,47 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <numeric>
 #include <vector>
 
 namespace pcl_ddg {
 
 double meanEdgeLength(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
-  // Summed in fixed blocks, then the block sums in order: parallel, and the same last bit
-  // whatever the thread count.
-  constexpr Eigen::Index kBlock = 1 << 16;
-  const Eigen::Matrix2Xi& edges = topology.edgeVertices();
-  const Eigen::Index blocks = (edges.cols() + kBlock - 1) / kBlock;
+  // Each edge once, from its smaller end, in the order of edge ids (smaller, then larger vertex),
+  // read from the neighbour rows: the edge map is not needed. Summed in fixed blocks of that order,
+  // then the block sums in order: parallel, and the same last bit whatever the thread count.
+  constexpr std::int64_t kBlock = 1 << 16;
+  const int n = topology.numVertices();
+  std::vector<std::int64_t> first_edge(static_cast<std::size_t>(n) + 1, 0);
+#pragma omp parallel for schedule(static)
+  for (int v = 0; v < n; ++v) {
+    const IndexSpan row = topology.neighbours(v);
+    first_edge[v + 1] = row.end() - std::upper_bound(row.begin(), row.end(), v);
+  }
+  std::partial_sum(first_edge.begin(), first_edge.end(), first_edge.begin());
+  const std::int64_t edges = first_edge.back();
+  const std::int64_t blocks = (edges + kBlock - 1) / kBlock;
   std::vector<double> block_sum(static_cast<std::size_t>(blocks), 0.0);
-  Eigen::Index count = 0;
+  std::int64_t count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : count)
-  for (Eigen::Index b = 0; b < blocks; ++b) {
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    std::int64_t e = b * kBlock;
+    const std::int64_t end = std::min(edges, e + kBlock);
     double sum = 0.0;
-    for (Eigen::Index e = b * kBlock; e < std::min(edges.cols(), (b + 1) * kBlock); ++e) {
-      const double length = (positions.col(edges(0, e)) - positions.col(edges(1, e))).norm();
-      if (!std::isfinite(length)) continue;
-      sum += length;
-      ++count;
+    // The vertex whose larger neighbours hold edge e, then on along the rows.
+    int v = static_cast<int>(std::upper_bound(first_edge.begin(), first_edge.end(), e) -
+                             first_edge.begin() - 1);
+    for (; e < end; ++v) {
+      const IndexSpan row = topology.neighbours(v);
+      const int smaller = row.size() - static_cast<int>(first_edge[v + 1] - first_edge[v]);
+      for (int i = smaller + static_cast<int>(e - first_edge[v]); i < row.size() && e < end;
+           ++i, ++e) {
+        const double length = (positions.col(v) - positions.col(row[i])).norm();
+        if (!std::isfinite(length)) continue;
+        sum += length;
+        ++count;
+      }
     }
     block_sum[static_cast<std::size_t>(b)] = sum;
   }

@@ -21,11 +21,6 @@ std::vector<pcl::Vertices> trianglesAsPolygons(const Eigen::Matrix3Xi& triangles
   return polygons;
 }
 
-bool isPlainTriangle(const pcl::Indices& corners) {
-  return corners.size() == 3 && corners[0] != corners[1] && corners[1] != corners[2] &&
-         corners[0] != corners[2];
-}
-
 bool hasRepeatedCorner(const pcl::Indices& corners) {
   for (std::size_t i = 0; i < corners.size(); ++i) {
     for (std::size_t j = i + 1; j < corners.size(); ++j) {
@@ -56,23 +51,23 @@ MeshTopology::MeshTopology(int num_vertices, const Eigen::Matrix3Xi& triangles,
 
 void MeshTopology::build(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy) {
   if (num_vertices_ <= 0) throw InvalidMeshException("mesh has no vertices");
-  triangulate(polygons, policy);
+  std::vector<std::pair<int, int>> boundary_edges;
   {
-    const Wedges wedges = buildVertexTriangles(polygons);
+    const PolygonKinds kinds = triangulate(polygons, policy);
+    const Wedges wedges = buildVertexTriangles(kinds.plain);
     buildVertexNeighbours(wedges);
-    buildEdges(wedges);
-    classifyEdgesAndVertices();
-    findBowTieVertices(wedges);
-    countDuplicatePolygons(polygons, wedges);
+    boundary_edges = classifyVertices(wedges);
+    countDuplicatePolygons(polygons, kinds.others, wedges);
   }
   findComponents();
-  // A consistently oriented mesh is orientable; only an inconsistent one needs the search.
+  // A consistently oriented mesh is orientable; only an inconsistent one needs the search (and
+  // the edge map).
   if (!counts_.consistently_oriented) checkOrientability();
-  countBoundaryLoops();
+  countBoundaryLoops(boundary_edges);
 }
 
-void MeshTopology::triangulate(const std::vector<pcl::Vertices>& polygons,
-                               OutOfRangeFacePolicy policy) {
+MeshTopology::PolygonKinds MeshTopology::triangulate(const std::vector<pcl::Vertices>& polygons,
+                                                     OutOfRangeFacePolicy policy) {
   auto invalid = [&](pcl::index_t i) { return i < 0 || i >= num_vertices_; };
   auto out_of_range = [&](const pcl::Vertices& p) {
     return std::any_of(p.vertices.begin(), p.vertices.end(), invalid);
@@ -105,16 +100,22 @@ void MeshTopology::triangulate(const std::vector<pcl::Vertices>& polygons,
   triangles_.resize(3, static_cast<Eigen::Index>(num_triangles));
   triangle_source_.clear();
   triangle_source_.reserve(num_triangles);
+  PolygonKinds kinds;
+  kinds.plain.reserve(num_triangles);
   Eigen::Index t = 0;
   for (std::size_t i = 0; i < polygons.size(); ++i) {
     const auto& c = polygons[i].vertices;
     if (first_bad >= 0 && out_of_range(polygons[i])) continue;
-    if (c.size() < 3 || hasRepeatedCorner(c)) ++counts_.repeated_index_polygons;
+    const bool repeated = c.size() < 3 || hasRepeatedCorner(c);
+    if (repeated) ++counts_.repeated_index_polygons;
     if (c.size() > 3) ++counts_.triangulated_polygons;
+    const bool plain = c.size() == 3 && !repeated;
+    if (!plain && c.size() >= 3) kinds.others.push_back(static_cast<int>(i));
     for (std::size_t k = 1; k + 1 < c.size(); ++k) {
       if (c[0] == c[k] || c[k] == c[k + 1] || c[0] == c[k + 1]) continue;
       triangles_.col(t++) << c[0], c[k], c[k + 1];
       triangle_source_.push_back(static_cast<int>(i));
+      kinds.plain.push_back(plain);
     }
   }
   triangles_.conservativeResize(3, t);
@@ -122,9 +123,11 @@ void MeshTopology::triangulate(const std::vector<pcl::Vertices>& polygons,
   bool identity = static_cast<std::size_t>(t) == polygons.size();
   for (Eigen::Index i = 0; identity && i < t; ++i) identity = triangle_source_[i] == i;
   if (identity) std::vector<int>().swap(triangle_source_);
+  return kinds;
 }
 
 void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons,
+                                          const std::vector<int>& others_ids,
                                           const Wedges& wedges) {
   // Two polygons are duplicates when they have the same corners (as a multiset). Plain triangles,
   // nearly every polygon of a scan, are compared at their smallest corner by the other two, which
@@ -151,16 +154,11 @@ void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& poly
     }
   }
 
-  const auto valid = [&](const pcl::Vertices& p) {
-    return p.vertices.size() >= 3 &&
-           std::all_of(p.vertices.begin(), p.vertices.end(),
-                       [&](pcl::index_t i) { return i >= 0 && i < num_vertices_; });
-  };
   std::vector<std::pair<int, int>> others;  // (smallest corner, polygon)
-  for (std::size_t i = 0; i < polygons.size(); ++i) {
+  others.reserve(others_ids.size());
+  for (const int i : others_ids) {
     const pcl::Indices& corners = polygons[i].vertices;
-    if (isPlainTriangle(corners) || !valid(polygons[i])) continue;
-    others.emplace_back(*std::min_element(corners.begin(), corners.end()), static_cast<int>(i));
+    others.emplace_back(*std::min_element(corners.begin(), corners.end()), i);
   }
   std::sort(others.begin(), others.end());
   std::vector<std::vector<pcl::index_t>> bucket;
@@ -181,8 +179,7 @@ void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& poly
   counts_.duplicate_polygons = duplicates;
 }
 
-MeshTopology::Wedges MeshTopology::buildVertexTriangles(
-    const std::vector<pcl::Vertices>& polygons) {
+MeshTopology::Wedges MeshTopology::buildVertexTriangles(const std::vector<char>& plain) {
   const Eigen::Index num_triangles = triangles_.cols();
   vt_offsets_.assign(num_vertices_ + 1, 0);
   detail::forEachVertexRange(num_vertices_, [&](int first, int last) {
@@ -192,13 +189,6 @@ MeshTopology::Wedges MeshTopology::buildVertexTriangles(
     }
   });
   std::partial_sum(vt_offsets_.begin(), vt_offsets_.end(), vt_offsets_.begin());
-
-  // A triangle is a plain input triangle when its source polygon is; sources ascend with t.
-  std::vector<char> plain(num_triangles);
-#pragma omp parallel for schedule(static)
-  for (Eigen::Index t = 0; t < num_triangles; ++t) {
-    plain[t] = isPlainTriangle(polygons[triangleSource(static_cast<int>(t))].vertices);
-  }
 
   const auto incidences = static_cast<std::size_t>(vt_offsets_.back());
   vt_triangles_.resize(incidences);
@@ -228,7 +218,8 @@ void MeshTopology::buildVertexNeighbours(const Wedges& wedges) {
   const std::unique_ptr<int[]> scratch(
       new int[2 * vt_triangles_.size()]);  // first touched in parallel
   std::vector<int> row_size(num_vertices_, 0);
-#pragma omp parallel for schedule(static)
+  std::int64_t edges = 0;  // each counted at its smaller end
+#pragma omp parallel for schedule(static) reduction(+ : edges)
   for (int v = 0; v < num_vertices_; ++v) {
     int* out = scratch.get() + 2 * vt_offsets_[v];
     int n = 0;
@@ -238,7 +229,9 @@ void MeshTopology::buildVertexNeighbours(const Wedges& wedges) {
     }
     std::sort(out, out + n);
     row_size[v] = static_cast<int>(std::unique(out, out + n) - out);
+    edges += out + row_size[v] - std::upper_bound(out, out + row_size[v], v);
   }
+  num_edges_ = static_cast<int>(edges);
   vv_offsets_.assign(num_vertices_ + 1, 0);
   for (int v = 0; v < num_vertices_; ++v) vv_offsets_[v + 1] = vv_offsets_[v] + row_size[v];
   vv_neighbours_.resize(vv_offsets_.back());
@@ -253,10 +246,17 @@ int MeshTopology::findEdge(int a, int b) const {
   const IndexSpan row_a = neighbours(a);
   const int* it = std::lower_bound(row_a.begin(), row_a.end(), b);
   if (it == row_a.end() || *it != b) return -1;
-  return vv_edges_[vv_offsets_[a] + static_cast<int>(it - row_a.begin())];
+  return edgeMap().vv_edges[vv_offsets_[a] + static_cast<int>(it - row_a.begin())];
 }
 
-void MeshTopology::buildEdges(const Wedges& wedges) {
+void MeshTopology::buildEdgeMapOnce() const {
+  std::call_once(edge_map_->once, [this] {
+    edge_map_->map = buildEdgeMap();
+    edge_map_->built.store(true, std::memory_order_release);
+  });
+}
+
+MeshTopology::EdgeMap MeshTopology::buildEdgeMap() const {
   // Edge ids in order of (smaller vertex, larger vertex), from a prefix sum over each row's count
   // of larger neighbours (rows are sorted). Edge (v, w), v < w, belongs to v's row; w's row lists
   // its smaller neighbours first and in ascending order, so visiting v in ascending order and
@@ -269,10 +269,10 @@ void MeshTopology::buildEdges(const Wedges& wedges) {
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < num_vertices_; ++v) first_edge[v + 1] = neighbours(v).size() - firstLarger(v);
   std::partial_sum(first_edge.begin(), first_edge.end(), first_edge.begin());
-  const int num_edges = first_edge.back();
 
-  vv_edges_.resize(vv_neighbours_.size());
-  edge_vertices_.resize(2, num_edges);
+  EdgeMap map;
+  map.vv_edges.resize(vv_neighbours_.size());
+  map.edge_vertices.resize(2, num_edges_);
   std::vector<int> smaller_filled(vv_offsets_.begin(), vv_offsets_.end() - 1);
   detail::forEachVertexRange(num_vertices_, [&](int first, int last) {
     for (int v = 0; v < num_vertices_; ++v) {
@@ -281,106 +281,89 @@ void MeshTopology::buildEdges(const Wedges& wedges) {
       for (int i = row.size() - larger; i < row.size(); ++i) {
         const int w = row[i], e = first_edge[v] + i - (row.size() - larger);
         if (v >= first && v < last) {
-          vv_edges_[vv_offsets_[v] + i] = e;
-          edge_vertices_.col(e) << v, w;
+          map.vv_edges[vv_offsets_[v] + i] = e;
+          map.edge_vertices.col(e) << v, w;
         }
-        if (w >= first && w < last) vv_edges_[smaller_filled[w]++] = e;
+        if (w >= first && w < last) map.vv_edges[smaller_filled[w]++] = e;
       }
     }
   });
 
   // Sides (v, next) and (v, previous) of each triangle at v, written when v is their smaller end:
-  // side (v, next) is opposite corner k + 2 and runs forward (from the smaller vertex), side
-  // (v, previous) is opposite corner k + 1 and runs backward. Consistently oriented: every edge of
-  // two triangles is run once each way.
-  triangle_edges_.resize(3, triangles_.cols());
-  edge_triangle_count_.assign(num_edges, 0);
-  std::vector<std::uint8_t> forward_sides(num_edges, 0);
+  // side (v, next) is opposite corner k + 2, side (v, previous) opposite corner k + 1.
+  map.triangle_edges.resize(3, triangles_.cols());
+  map.triangle_count.assign(num_edges_, 0);
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < num_vertices_; ++v) {
     const IndexSpan row = neighbours(v);
     const auto edgeTo = [&](int w) {
       const int at = static_cast<int>(std::lower_bound(row.begin(), row.end(), w) - row.begin());
-      return vv_edges_[vv_offsets_[v] + at];
+      return map.vv_edges[vv_offsets_[v] + at];
     };
-    for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
-      const int t = vt_triangles_[i], k = wedges.corner[i] & 3;
-      if (wedges.next[i] > v) {
-        const int e = edgeTo(wedges.next[i]);
-        triangle_edges_((k + 2) % 3, t) = e;
-        ++edge_triangle_count_[e];
-        forward_sides[e] = static_cast<std::uint8_t>(std::min(forward_sides[e] + 1, 255));
+    for (const int t : incidentTriangles(v)) {
+      const int k = triangles_(0, t) == v ? 0 : triangles_(1, t) == v ? 1 : 2;
+      const int next = triangles_((k + 1) % 3, t), previous = triangles_((k + 2) % 3, t);
+      if (next > v) {
+        const int e = edgeTo(next);
+        map.triangle_edges((k + 2) % 3, t) = e;
+        ++map.triangle_count[e];
       }
-      if (wedges.previous[i] > v) {
-        const int e = edgeTo(wedges.previous[i]);
-        triangle_edges_((k + 1) % 3, t) = e;
-        ++edge_triangle_count_[e];
+      if (previous > v) {
+        const int e = edgeTo(previous);
+        map.triangle_edges((k + 1) % 3, t) = e;
+        ++map.triangle_count[e];
       }
     }
   }
-  bool consistent = true;
-#pragma omp parallel for schedule(static) reduction(&& : consistent)
-  for (int e = 0; e < num_edges; ++e) {
-    consistent = consistent && (edge_triangle_count_[e] != 2 || forward_sides[e] == 1);
-  }
-  counts_.consistently_oriented = consistent;
+  return map;
 }
 
-void MeshTopology::classifyEdgesAndVertices() {
-  vertex_flags_.assign(num_vertices_, 0);
-  for (int e = 0; e < numEdges(); ++e) {
-    const int count = edge_triangle_count_[e];
-    VertexFlag flag;
-    if (count == 1) {
-      ++counts_.boundary_edges;
-      flag = VertexFlag::Boundary;
-    } else if (count > 2) {
-      ++counts_.nonmanifold_edges;
-      flag = VertexFlag::NonManifoldEdge;
-    } else {
-      continue;
-    }
-    vertex_flags_[edge_vertices_(0, e)] |= static_cast<std::uint8_t>(flag);
-    vertex_flags_[edge_vertices_(1, e)] |= static_cast<std::uint8_t>(flag);
-  }
-  for (int v = 0; v < num_vertices_; ++v) {
-    if (vt_offsets_[v] == vt_offsets_[v + 1]) {
-      vertex_flags_[v] |= static_cast<std::uint8_t>(VertexFlag::Isolated);
-      ++counts_.unreferenced_vertices;
-    }
-  }
-}
-
-void MeshTopology::findBowTieVertices(const Wedges& wedges) {
-  // The triangles around v form fans: two are in one fan when they share an edge at v.
-  // More than one fan means the surface is pinched at v.
+std::vector<std::pair<int, int>> MeshTopology::classifyVertices(const Wedges& wedges) {
+  // Each vertex reads only its own wedges and ring and writes only its own flag, so the pass is
+  // parallel without atomics. Per ring slot (neighbour w): the triangles on edge {v, w} and how
+  // many of them run v -> w. An edge is counted at its smaller end; there, with two triangles, it
+  // is consistently oriented when one runs each way. The triangles around v form fans: two are in
+  // one fan when they share an edge at v; more than one fan means the surface is pinched at v.
   int max_valence = 0;
   for (int v = 0; v < num_vertices_; ++v) {
     max_valence = std::max(max_valence, vt_offsets_[v + 1] - vt_offsets_[v]);
   }
-  std::int64_t bow_ties = 0;
-#pragma omp parallel reduction(+ : bow_ties)
+  vertex_flags_.assign(num_vertices_, 0);
+  std::vector<std::pair<int, int>> boundary_edges;
+  std::int64_t boundary = 0, nonmanifold = 0, bow_ties = 0, unreferenced = 0;
+  bool consistent = true;
+#pragma omp parallel reduction(+ : boundary, nonmanifold, bow_ties, unreferenced) \
+    reduction(&& : consistent)
   {
     std::vector<int> parent(max_valence);
     std::vector<int> first_triangle_at_neighbour(max_valence * 2);
+    std::vector<int> triangles_at_neighbour(max_valence * 2), forward_at_neighbour(max_valence * 2);
+    std::vector<std::pair<int, int>> my_boundary_edges;
     auto find = [&](int x) {
       while (parent[x] != x) x = parent[x] = parent[parent[x]];
       return x;
     };
-#pragma omp for schedule(static)
+#pragma omp for schedule(static) nowait
     for (int v = 0; v < num_vertices_; ++v) {
-      const IndexSpan tris = incidentTriangles(v);
       const IndexSpan ring = neighbours(v);
-      if (tris.size() < 2) continue;
-      std::iota(parent.begin(), parent.begin() + tris.size(), 0);
-      std::fill(first_triangle_at_neighbour.begin(),
-                first_triangle_at_neighbour.begin() + ring.size(), -1);
-      int fans = tris.size();
-      for (int i = 0; i < tris.size(); ++i) {
+      const int valence = vt_offsets_[v + 1] - vt_offsets_[v];
+      if (valence == 0) {
+        vertex_flags_[v] = static_cast<std::uint8_t>(VertexFlag::Isolated);
+        ++unreferenced;
+        continue;
+      }
+      std::iota(parent.begin(), parent.begin() + valence, 0);
+      std::fill_n(first_triangle_at_neighbour.begin(), ring.size(), -1);
+      std::fill_n(triangles_at_neighbour.begin(), ring.size(), 0);
+      std::fill_n(forward_at_neighbour.begin(), ring.size(), 0);
+      int fans = valence;
+      for (int i = 0; i < valence; ++i) {
         const int wedge = vt_offsets_[v] + i;
         for (const int w : {wedges.next[wedge], wedges.previous[wedge]}) {
           const int slot =
               static_cast<int>(std::lower_bound(ring.begin(), ring.end(), w) - ring.begin());
+          ++triangles_at_neighbour[slot];
+          forward_at_neighbour[slot] += w == wedges.next[wedge];
           int& first = first_triangle_at_neighbour[slot];
           if (first < 0) {
             first = i;
@@ -393,13 +376,36 @@ void MeshTopology::findBowTieVertices(const Wedges& wedges) {
           }
         }
       }
+      std::uint8_t flags = 0;
       if (fans > 1) {
-        vertex_flags_[v] |= static_cast<std::uint8_t>(VertexFlag::NonManifoldVertex);
+        flags |= static_cast<std::uint8_t>(VertexFlag::NonManifoldVertex);
         ++bow_ties;
       }
+      for (int slot = 0; slot < ring.size(); ++slot) {
+        const int count = triangles_at_neighbour[slot];
+        const bool smaller_end = ring[slot] > v;
+        if (count == 1) {
+          flags |= static_cast<std::uint8_t>(VertexFlag::Boundary);
+          if (smaller_end) my_boundary_edges.emplace_back(v, ring[slot]);
+        } else if (count > 2) {
+          flags |= static_cast<std::uint8_t>(VertexFlag::NonManifoldEdge);
+          nonmanifold += smaller_end;
+        } else if (smaller_end) {
+          consistent = consistent && forward_at_neighbour[slot] == 1;
+        }
+      }
+      vertex_flags_[v] = flags;
     }
+    boundary += static_cast<std::int64_t>(my_boundary_edges.size());
+#pragma omp critical(pcl_ddg_boundary_edges)
+    boundary_edges.insert(boundary_edges.end(), my_boundary_edges.begin(), my_boundary_edges.end());
   }
+  counts_.boundary_edges = boundary;
+  counts_.nonmanifold_edges = nonmanifold;
   counts_.nonmanifold_vertices = bow_ties;
+  counts_.unreferenced_vertices = unreferenced;
+  counts_.consistently_oriented = consistent;
+  return boundary_edges;
 }
 
 void MeshTopology::findComponents() {
@@ -425,12 +431,14 @@ void MeshTopology::checkOrientability() {
   // manifold edge traversed the same way by both of its triangles asks for a relative flip; a
   // contradiction means the component is not orientable.
   detail::ParityDisjointSets sets(numTriangles());
+  const std::vector<int>& edge_triangle_count = edgeTriangleCount();
+  const Eigen::Matrix3Xi& triangle_edges = triangleEdges();
   std::vector<int> first_triangle(numEdges(), -1);
   std::vector<char> first_forward(numEdges(), 0);
   for (int t = 0; t < numTriangles(); ++t) {
     for (int k = 0; k < 3; ++k) {
-      const int e = triangle_edges_(k, t);
-      if (edge_triangle_count_[e] != 2) continue;
+      const int e = triangle_edges(k, t);
+      if (edge_triangle_count[e] != 2) continue;
       const char forward = triangles_((k + 1) % 3, t) < triangles_((k + 2) % 3, t);
       if (first_triangle[e] < 0) {
         first_triangle[e] = t;
@@ -443,17 +451,14 @@ void MeshTopology::checkOrientability() {
   }
 }
 
-void MeshTopology::countBoundaryLoops() {
+void MeshTopology::countBoundaryLoops(const std::vector<std::pair<int, int>>& boundary_edges) {
   // Each connected piece of the boundary-edge graph holds E - V + 1 independent cycles (at least
   // one): a simple hole is one loop, two holes touching at a vertex are two.
+  if (boundary_edges.empty()) return;
   detail::DisjointSets sets(num_vertices_);
-  for (int e = 0; e < numEdges(); ++e) {
-    if (edge_triangle_count_[e] == 1) sets.unite(edge_vertices_(0, e), edge_vertices_(1, e));
-  }
+  for (const auto& [a, b] : boundary_edges) sets.unite(a, b);
   std::vector<std::int64_t> edges_of_root(num_vertices_, 0), vertices_of_root(num_vertices_, 0);
-  for (int e = 0; e < numEdges(); ++e) {
-    if (edge_triangle_count_[e] == 1) ++edges_of_root[sets.find(edge_vertices_(0, e))];
-  }
+  for (const auto& edge : boundary_edges) ++edges_of_root[sets.find(edge.first)];
   for (int v = 0; v < num_vertices_; ++v) {
     if (isBoundary(v)) ++vertices_of_root[sets.find(v)];
   }

@@ -4,14 +4,19 @@
 // The input vertex numbering is kept, so per-vertex results align with the input cloud. Polygons
 // are fan-triangulated (corner 0 with every consecutive pair); triangles keep the input winding.
 // Triangle corner k faces edge k: edge k of triangle t joins corners k+1 and k+2 (mod 3).
-// Adjacency is stored in compressed rows (CSR): vertex -> sorted neighbours (with the edge id of
-// each), vertex -> incident triangles.
+// Adjacency is stored in compressed rows (CSR): vertex -> sorted neighbours, vertex -> incident
+// triangles. Edge ids (the edge map: ids, ends, triangle counts, the edges of each triangle) are
+// built on the first call that asks for one: face normals, ring searches and the defect counts need
+// only the rows, and the map costs as much as the rows again.
 #include <pcl/PolygonMesh.h>
 #include <pcl/Vertices.h>
 
 #include <Eigen/Core>
+#include <atomic>
 #include <cstdint>
 #include <memory>
+#include <mutex>
+#include <utility>
 #include <vector>
 
 namespace pcl_ddg {
@@ -78,23 +83,25 @@ class MeshTopology {
 
   int numVertices() const { return num_vertices_; }
   int numTriangles() const { return static_cast<int>(triangles_.cols()); }
-  int numEdges() const { return static_cast<int>(edge_vertices_.cols()); }
+  int numEdges() const { return num_edges_; }
 
   /** 3 x T corner indices. */
   const Eigen::Matrix3Xi& triangles() const { return triangles_; }
   /** The input polygon triangle t comes from (sources ascend with t). */
   int triangleSource(int t) const { return triangle_source_.empty() ? t : triangle_source_[t]; }
-  /** 3 x T edge ids; entry (k, t) is the edge opposite corner k. */
-  const Eigen::Matrix3Xi& triangleEdges() const { return triangle_edges_; }
+  /** 3 x T edge ids; entry (k, t) is the edge opposite corner k. Edge ids ascend with (smaller,
+   *  larger) vertex. This and the other edge-id accessors build the edge map on first use (once,
+   *  thread-safe). */
+  const Eigen::Matrix3Xi& triangleEdges() const { return edgeMap().triangle_edges; }
   /** 2 x E vertex pairs, first < second. */
-  const Eigen::Matrix2Xi& edgeVertices() const { return edge_vertices_; }
+  const Eigen::Matrix2Xi& edgeVertices() const { return edgeMap().edge_vertices; }
   /** Number of triangles on each edge (1: boundary, 2: manifold interior, >2: non-manifold). */
-  const std::vector<int>& edgeTriangleCount() const { return edge_triangle_count_; }
+  const std::vector<int>& edgeTriangleCount() const { return edgeMap().triangle_count; }
 
   /** Sorted distinct neighbours of v. */
   IndexSpan neighbours(int v) const { return row(vv_offsets_, vv_neighbours_, v); }
   /** Edge ids parallel to neighbours(v). */
-  IndexSpan neighbourEdges(int v) const { return row(vv_offsets_, vv_edges_, v); }
+  IndexSpan neighbourEdges(int v) const { return row(vv_offsets_, edgeMap().vv_edges, v); }
   /** Triangles having v as a corner (a triangle repeats only if the input repeats it). */
   IndexSpan incidentTriangles(int v) const { return row(vt_offsets_, vt_triangles_, v); }
   /** The id of edge {a, b}, or -1 if no triangle has it. */
@@ -125,7 +132,12 @@ class MeshTopology {
     return {data.data() + offsets[v], data.data() + offsets[v + 1]};
   }
   void build(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
-  void triangulate(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
+  /** What triangulate learns of each polygon on its one pass over them, for the later passes. */
+  struct PolygonKinds {
+    std::vector<char> plain;  ///< per triangle: a whole input triangle (three distinct corners)
+    std::vector<int> others;  ///< polygons in range with 3+ corners that are not plain triangles
+  };
+  PolygonKinds triangulate(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
   /** Per incidence of a vertex in a triangle (parallel to vt_triangles_): the triangle's next and
    *  previous corners after the vertex, and the vertex's corner index plus kPlainTriangle when the
    *  triangle is a whole input polygon. Built once, so that every later per-vertex pass reads its
@@ -136,23 +148,41 @@ class MeshTopology {
     std::unique_ptr<int[]> next, previous;
     std::unique_ptr<std::uint8_t[]> corner;
   };
-  Wedges buildVertexTriangles(const std::vector<pcl::Vertices>& polygons);
+  Wedges buildVertexTriangles(const std::vector<char>& plain);
   void buildVertexNeighbours(const Wedges& wedges);
-  void buildEdges(const Wedges& wedges);
-  void classifyEdgesAndVertices();
-  void findBowTieVertices(const Wedges& wedges);
-  void countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons, const Wedges& wedges);
+  /** Flags and edge counts from each vertex's own wedges and ring; returns the boundary edges. */
+  std::vector<std::pair<int, int>> classifyVertices(const Wedges& wedges);
+  void countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons,
+                              const std::vector<int>& others, const Wedges& wedges);
   void findComponents();
   void checkOrientability();
-  void countBoundaryLoops();
+  void countBoundaryLoops(const std::vector<std::pair<int, int>>& boundary_edges);
+
+  struct EdgeMap {
+    Eigen::Matrix3Xi triangle_edges;
+    Eigen::Matrix2Xi edge_vertices;
+    std::vector<int> triangle_count;
+    std::vector<int> vv_edges;  ///< parallel to vv_neighbours_
+  };
+  /** Built at most once, by the first caller; shared by copies, which have the same rows. */
+  struct LazyEdgeMap {
+    std::once_flag once;
+    std::atomic<bool> built{false};  ///< the inline check: no call once the map is there
+    EdgeMap map;
+  };
+  const EdgeMap& edgeMap() const {
+    if (!edge_map_->built.load(std::memory_order_acquire)) buildEdgeMapOnce();
+    return edge_map_->map;
+  }
+  void buildEdgeMapOnce() const;
+  EdgeMap buildEdgeMap() const;
 
   int num_vertices_ = 0;
   Eigen::Matrix3Xi triangles_;
   std::vector<int> triangle_source_;  ///< empty when triangle t is polygon t for all t
-  Eigen::Matrix3Xi triangle_edges_;
-  Eigen::Matrix2Xi edge_vertices_;
-  std::vector<int> edge_triangle_count_;
-  std::vector<int> vv_offsets_, vv_neighbours_, vv_edges_;
+  int num_edges_ = 0;
+  std::shared_ptr<LazyEdgeMap> edge_map_ = std::make_shared<LazyEdgeMap>();
+  std::vector<int> vv_offsets_, vv_neighbours_;
   std::vector<int> vt_offsets_, vt_triangles_;
   std::vector<std::uint8_t> vertex_flags_;
   std::vector<int> vertex_component_;
