@@ -139,6 +139,7 @@ BENCHMARK_CAPTURE(refactorise, analysed_again, false)
 }  // namespace pcl_ddg
 
 int main(int argc, char** argv) {
+  pcl_ddg::tuneCholmodForLargeSystems();  // as the tools do
   pcl_ddg::bench::addRatio("ours/later_step", "ours/implicit_step");
   return pcl_ddg::bench::runWithRatios(argc, argv);
 }

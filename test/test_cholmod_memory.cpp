@@ -1,6 +1,6 @@
-// The allocator SparseCholesky installs into SuiteSparse: large blocks mapped and populated, small
-// ones from malloc, each function accepting the others' blocks (and malloc's), and installed only
-// over the C library's own functions.
+// The allocator tuneCholmodForLargeSystems installs into SuiteSparse: large blocks mapped and
+// populated, small ones from malloc, each function accepting the others' blocks (and malloc's), and
+// installed only over the C library's own functions.
 #include <gtest/gtest.h>
 
 #include <SuiteSparse_config.h>
@@ -71,13 +71,22 @@ TEST(CholmodMemory, CallocIsZeroAndFreeTakesEveryKindOfBlock) {
   detail::populatedFree(kept);
 }
 
-TEST(CholmodMemory, SparseCholeskyInstallsItOverTheDefaults) {
-  const SparseCholesky solver(CholeskyBackend::Cholmod);
+// Process-wide state is the host program's: a solver leaves it alone until asked to tune it.
+TEST(CholmodMemory, InstalledOverTheDefaultsOnlyWhenTuningIsAskedFor) {
+  SparseCholesky solver(CholeskyBackend::Cholmod);
+  solver.compute(Eigen::SparseMatrix<double>(Eigen::MatrixXd::Identity(3, 3).sparseView()));
+  if (!cholmodTunedForLargeSystems()) {
+    EXPECT_EQ(SuiteSparse_config.malloc_func, &std::malloc);
+    EXPECT_EQ(SuiteSparse_config.free_func, &std::free);
+  }
+  tuneCholmodForLargeSystems();
+  EXPECT_TRUE(cholmodTunedForLargeSystems());
   EXPECT_EQ(SuiteSparse_config.malloc_func, &detail::populatedMalloc);
   EXPECT_EQ(SuiteSparse_config.free_func, &detail::populatedFree);
 }
 
 TEST(CholmodMemory, AFactorInAStaticObjectIsFreedAtExit) {
+  tuneCholmodForLargeSystems();
   // The 5-point Laplacian of a 300 x 300 grid plus the identity: a factor of several MiB.
   const int side = 300, n = side * side;
   std::vector<Eigen::Triplet<double>> entries;

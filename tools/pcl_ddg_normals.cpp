@@ -18,7 +18,7 @@ constexpr const char* kDescription =
     "mean_curvature) or by fitting a plane (pca) or a quadric to each point's neighbours, found "
     "on\n"
     "the mesh (bfs rings), on an organized cloud's pixel grid (grid: never across a depth jump;\n"
-    "pca there averages the smallest square window of k pixels from integral images) or in space\n"
+    "pca there fits the smallest square window of k pixels from its running window sums) or in space\n"
     "(knn, kd-tree). An organized cloud stays organized. Writes nx ny nz (.ply) or normal_x "
     "normal_y\n"
     "normal_z curvature (.pcd; for mesh methods the curvature is PCL's surface variation over\n"

@@ -3,6 +3,7 @@
 #include <pcl/exceptions.h>
 
 #include <Eigen/SparseCholesky>
+#include <atomic>
 #include <string>
 
 #ifdef PCL_DDG_HAVE_CHOLMOD
@@ -18,23 +19,28 @@
 namespace pcl_ddg {
 namespace {
 
-/// While alive, OpenMP parallel regions opened by this thread run on this thread alone.
-/// CHOLMOD 3 opens a team of a compiled-in four threads for every descendant update with more
-/// than 64 rows, only to build a relative row map: on a 1.15M-vertex mesh that is ~120,000 team
-/// wake-ups, which cost more than the maps (factorisation 4.0 s -> 2.8 s on two cores). The dense
+std::atomic<bool> tuned_for_large_systems{false};
+
+/// While alive, and only when tuneCholmodForLargeSystems() was called, OpenMP parallel regions
+/// opened by this thread run on this thread alone. CHOLMOD 3 opens a team of a compiled-in four
+/// threads for every descendant update with more than 64 rows, only to build a relative row map:
+/// on a 1.15M-vertex mesh that is ~120,000 team wake-ups, which cost more than the maps. The dense
 /// BLAS calls, where the flops are, keep their own threads.
 class SerialOpenMpRegions {
  public:
 #ifdef _OPENMP
-  SerialOpenMpRegions() : saved_levels_(omp_get_max_active_levels()) {
+  SerialOpenMpRegions() : active_(tuned_for_large_systems.load()) {
+    if (!active_) return;
+    saved_levels_ = omp_get_max_active_levels();
     omp_set_max_active_levels(0);
   }
   ~SerialOpenMpRegions() {
-    omp_set_max_active_levels(saved_levels_);
+    if (active_) omp_set_max_active_levels(saved_levels_);
   }
 
  private:
-  int saved_levels_;
+  bool active_;
+  int saved_levels_ = 0;
 #endif
 };
 
@@ -48,6 +54,17 @@ struct SparseCholesky::Backend {
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholmod;
 #endif
 };
+
+void tuneCholmodForLargeSystems() {
+  tuned_for_large_systems = true;
+#ifdef PCL_DDG_HAVE_CHOLMOD
+  detail::populateCholmodAllocations();
+#endif
+}
+
+bool cholmodTunedForLargeSystems() {
+  return tuned_for_large_systems;
+}
 
 bool cholmodAvailable() {
 #ifdef PCL_DDG_HAVE_CHOLMOD
@@ -79,7 +96,6 @@ SparseCholesky::SparseCholesky(CholeskyBackend backend)
         "pcl_ddg was built without CHOLMOD (install libsuitesparse-dev)");
   }
 #ifdef PCL_DDG_HAVE_CHOLMOD
-  if (backend_ == CholeskyBackend::Cholmod) detail::populateCholmodAllocations();
   // A matrix that is not positive definite is reported by exception, not printed by CHOLMOD.
   cholmod_common& common = impl_->cholmod.cholmod();
   common.print = 0;

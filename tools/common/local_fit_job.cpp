@@ -162,7 +162,7 @@ std::string describeNeighbourhood(const LocalFitOptions& options) {
       options.radius == 0.0) {
     const int side = 2 * gridWindowRadius(options.k) + 1;
     return "pixel grid, " + std::to_string(side) + " x " + std::to_string(side) +
-           " window, integral images";
+           " window, running window sums";
   }
   const char* kind = options.neighbourhood == NeighbourhoodKind::MeshRings ? "mesh rings"
                      : options.neighbourhood == NeighbourhoodKind::Grid    ? "pixel grid"

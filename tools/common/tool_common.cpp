@@ -16,6 +16,7 @@
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
 #include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/operators/sparse_cholesky.h"
 #include "pcl_ddg/version.h"
 
 namespace pcl_ddg {
@@ -314,6 +315,7 @@ int runBody(const char* name, const char* description, const char* syntax,
 int runTool(const char* name, const char* description, const char* syntax,
             const std::function<int()>& body) {
   AtomicFile::removeUncommittedFilesOnInterrupt();  // Ctrl-C leaves no temporary behind
+  tuneCholmodForLargeSystems();  // a tool is the whole process: its global state is ours
   const int code = runBody(name, description, syntax, body);
   writePeakMemory();
   return code;

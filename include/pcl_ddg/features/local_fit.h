@@ -61,7 +61,7 @@ struct LocalFitResult {
 
 /**
  * Runs PCANormalEstimation or QuadricNormalEstimation on cloud. PCA on the grid of a whole
- * organized cloud takes the integral-image path (computeOrganizedPCANormals) over the smallest
+ * organized cloud takes the window-sum path (computeOrganizedPCANormals) over the smallest
  * square window of at least k pixels, and keeps the cloud's width x height. With a topology (one
  * vertex per point) normals are oriented like its faces, whichever neighbourhood is used, so that
  * the two neighbourhoods can be compared point by point; without one, towards the viewpoint (the

@@ -23,7 +23,7 @@ struct PlaneFit {
 PlaneFit fitPlane(const Eigen::Matrix3Xd& points, int count);
 
 /** The plane of a neighbourhood given by its centroid and covariance (about the centroid, divided
- *  by the number of points): how windowed sums (integral images) are turned into a plane. */
+ *  by the number of points): how window sums (window_sums.h) are turned into a plane. */
 PlaneFit fitPlane(const Eigen::Vector3d& centroid, const Eigen::Matrix3d& covariance);
 
 /** Only the normal and the surface variation of a plane fit, for per-pixel fits at frame rate. */

@@ -24,6 +24,24 @@ bool cholmodAvailable();
 
 const char* toString(CholeskyBackend backend);
 
+/**
+ * Opt-in process-wide tuning of CHOLMOD for large systems (a million unknowns and more), which the
+ * pcl_ddg tools turn on and a library user may: it changes state the host program shares, so it
+ * is off by default.
+ *  - CHOLMOD's allocations of 1 MiB or more are mapped with their pages populated in one call
+ *    (SuiteSparse's allocator is one global, SuiteSparse_config, used by every SuiteSparse user in
+ *    the process; a program that installed its own allocator keeps it): the first factorisation of
+ *    a 1.15M-vertex mesh 3.4 -> 2.8 s.
+ *  - During this library's CHOLMOD factorisations and solves, OpenMP regions run on the calling
+ *    thread alone (omp_set_max_active_levels(0), restored after; libgomp keeps it process-wide):
+ *    CHOLMOD otherwise wakes a team of four threads ~120,000 times to build relative row maps
+ *    (factorisation 4.0 -> 2.8 s on two cores). The BLAS keeps its own threads.
+ * Without CHOLMOD in the build it does nothing.
+ */
+void tuneCholmodForLargeSystems();
+/** Whether tuneCholmodForLargeSystems() was called. */
+bool cholmodTunedForLargeSystems();
+
 class SparseCholesky {
  public:
   explicit SparseCholesky(CholeskyBackend backend = CholeskyBackend::Automatic);

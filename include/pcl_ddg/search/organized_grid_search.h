@@ -20,7 +20,7 @@
 //                             sorted by distance if setSortedResults(true); max_nn keeps the
 //                             nearest max_nn.
 //  windowSearch(index, w)     the pixels reached without leaving the (2w+1)^2 window: the
-//                             neighbourhood the integral-image normals (organized_normals.h)
+//                             neighbourhood the window-sum normals (organized_normals.h)
 //                             average over.
 //
 // Distances are squared and in float, as PCL returns them. Queries are pixel indices of the input
