@@ -9,8 +9,8 @@
 #include <stb_image.h>
 
 #include "analytic_surfaces.h"
-#include "pcl_ddg/io/color_map.h"
-#include "pcl_ddg/io/mesh_render.h"
+#include "pcl_ddg/render/color_map.h"
+#include "pcl_ddg/render/mesh_render.h"
 #include "test_data.h"
 
 namespace pcl_ddg {

@@ -26,9 +26,9 @@
 
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
-#include "pcl_ddg/io/color_map.h"
+#include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/io/mesh_io.h"
-#include "pcl_ddg/io/mesh_render.h"
+#include "pcl_ddg/render/mesh_render.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/mesh/vertex_positions.h"

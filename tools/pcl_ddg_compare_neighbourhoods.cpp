@@ -7,7 +7,7 @@
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
-#include "pcl_ddg/io/color_map.h"
+#include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/io/mesh_io.h"
 
 namespace {

@@ -4,7 +4,7 @@
 #include "common/local_fit_job.h"
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
-#include "pcl_ddg/io/color_map.h"
+#include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/operators/curvature.h"

@@ -6,7 +6,7 @@
 #include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/ring_surface_variation.h"
 #include "pcl_ddg/io/mesh_io.h"
-#include "pcl_ddg/io/mesh_render.h"
+#include "pcl_ddg/render/mesh_render.h"
 #include "pcl_ddg/surface/mesh_normals.h"
 #include "pcl_ddg/tiling/out_of_core_fit.h"
 

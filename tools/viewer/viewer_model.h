@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "common/local_fit_job.h"
-#include "pcl_ddg/io/color_map.h"
+#include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "viewer/viewer_state.h"
 

@@ -1,4 +1,4 @@
-#include "pcl_ddg/io/color_map.h"
+#include "pcl_ddg/render/color_map.h"
 
 #include <algorithm>
 #include <array>

@@ -1,4 +1,4 @@
-#include "pcl_ddg/io/mesh_render.h"
+#include "pcl_ddg/render/mesh_render.h"
 
 #include <stb_image_write.h>
 
