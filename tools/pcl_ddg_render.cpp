@@ -4,11 +4,11 @@
 #include <array>
 
 #include "common/tool_common.h"
-#include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/io/mesh_io.h"
-#include "pcl_ddg/render/mesh_render.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/render/color_map.h"
+#include "pcl_ddg/render/mesh_render.h"
 
 namespace {
 

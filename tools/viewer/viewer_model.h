@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "common/local_fit_job.h"
-#include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/io/vertex_fields.h"
+#include "pcl_ddg/render/color_map.h"
 #include "viewer/viewer_state.h"
 
 namespace pcl_ddg {
