@@ -1,7 +1,9 @@
 #pragma once
-// The PCL point types the library's templates are compiled for: what scan users have (LiDAR
-// intensity, Kinect RGBA, clouds with normals). Any other point type with x, y, z works by
-// defining PCL_NO_PRECOMPILE before including pcl_ddg's headers, as with PCL itself.
+/** \file
+ * The PCL point types the library's templates are compiled for: what scan users have (LiDAR
+ * intensity, Kinect RGBA, clouds with normals). Any other point type with x, y, z works by
+ * defining PCL_NO_PRECOMPILE before including pcl_ddg's headers, as with PCL itself.
+ */
 #include <pcl/point_types.h>
 
 #include <boost/preprocessor/seq/elem.hpp>

@@ -1,21 +1,23 @@
 #pragma once
-// Consistent normal orientation without a single viewpoint (Hoppe et al. 1992), for merged or
-// multi-view clouds: a minimum spanning tree over a neighbour graph weighted by 1 - |n_i . n_j|
-// (nearly parallel normals first), and each normal is flipped to agree with its parent in the
-// tree. Without a reference, each connected component is seeded at its highest point (largest z),
-// whose normal is turned up (+z); a component is oriented on its own.
-//
-// With a reference (a viewpoint, or an up direction for aerial data) the reference decides every
-// point it can: a point is confident when |n . d| >= confidence, d the unit direction to the
-// viewpoint (or up), and its normal is turned to n . d >= 0 whatever the tree says, because
-// propagation over a tree flips whole regions across trees, walls and thin parts. The tree only
-// fills in the ambiguous points: each connected region of them (over tree edges) is made
-// consistent from its most confident point, and takes the sign that the majority of its tree
-// edges to confident points agree with (none: the sign of sum n . d over the region).
-//
-// The graph is the k nearest neighbours in space, or the mesh's edges, or an organized cloud's
-// jump-free pixel steps (OrganizedGridSearch), or one the caller gives. Points with a non-finite
-// coordinate or normal take no part and keep their normal.
+/** \file
+ * Consistent normal orientation without a single viewpoint (Hoppe et al. 1992), for merged or
+ * multi-view clouds: a minimum spanning tree over a neighbour graph weighted by 1 - |n_i . n_j|
+ * (nearly parallel normals first), and each normal is flipped to agree with its parent in the
+ * tree. Without a reference, each connected component is seeded at its highest point (largest z),
+ * whose normal is turned up (+z); a component is oriented on its own.
+ *
+ * With a reference (a viewpoint, or an up direction for aerial data) the reference decides every
+ * point it can: a point is confident when |n . d| >= confidence, d the unit direction to the
+ * viewpoint (or up), and its normal is turned to n . d >= 0 whatever the tree says, because
+ * propagation over a tree flips whole regions across trees, walls and thin parts. The tree only
+ * fills in the ambiguous points: each connected region of them (over tree edges) is made
+ * consistent from its most confident point, and takes the sign that the majority of its tree
+ * edges to confident points agree with (none: the sign of sum n . d over the region).
+ *
+ * The graph is the k nearest neighbours in space, or the mesh's edges, or an organized cloud's
+ * jump-free pixel steps (OrganizedGridSearch), or one the caller gives. Points with a non-finite
+ * coordinate or normal take no part and keep their normal.
+ */
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 

@@ -1,7 +1,9 @@
 #pragma once
-// One call for the fitted estimators on a plain xyz cloud, with either kind of neighbourhood:
-// what the tools and the neighbourhood comparison use. (The estimators themselves take any PCL
-// search method; this only chooses between the two this library is about.)
+/** \file
+ * One call for the fitted estimators on a plain xyz cloud, with either kind of neighbourhood:
+ * what the tools and the neighbourhood comparison use. (The estimators themselves take any PCL
+ * search method; this only chooses between the two this library is about.)
+ */
 #include <pcl/pcl_base.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>

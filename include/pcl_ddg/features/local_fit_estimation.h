@@ -1,25 +1,27 @@
 #pragma once
-// What PCANormalEstimation and QuadricNormalEstimation share: a pcl::Feature that, for every
-// query point, gathers its neighbours (from whatever search method is set: a kd-tree, or
-// MeshRingSearch for topological neighbourhoods) in double relative to the query point, fits
-// something to them, and orients the resulting normal.
-//
-// The interface of pcl::NormalEstimationOMP, so either estimator replaces it (or
-// pcl::NormalEstimation) in existing code: computePointNormal (both overloads), the viewpoint
-// setters and the protected vpx_, vpy_, vpz_, a constructor taking the number of threads and
-// setNumberOfThreads (0: every core; the default here, where PCL's NormalEstimation uses one),
-// Ptr / ConstPtr of the class itself. See docs/pcl-drop-in.md for what differs.
-//
-// Orientation (see normal_orientation.h): by the viewpoint, as PCL does, unless the search method
-// is a MeshRingSearch (or setOrientationMesh was called), in which case by the mesh's faces.
-// The viewpoint is the input cloud's sensor_origin_, copied when the cloud is set, as in
-// pcl::NormalEstimation, unless setViewPoint chooses one. setOrientationSpanningTree makes the
-// normals consistent along a minimum spanning tree of each point's nearest neighbours from the
-// search method (mesh rings, pixel grid or kd-tree: the graph follows the neighbourhood), for
-// clouds without a single viewpoint; the quadric's curvatures change sign with their normals.
-//
-// A point that cannot be estimated (non-finite, or too few finite neighbours) gets NaN output
-// and output.is_dense = false; compute() counts them (getFailedPoints) and warns once.
+/** \file
+ * What PCANormalEstimation and QuadricNormalEstimation share: a pcl::Feature that, for every
+ * query point, gathers its neighbours (from whatever search method is set: a kd-tree, or
+ * MeshRingSearch for topological neighbourhoods) in double relative to the query point, fits
+ * something to them, and orients the resulting normal.
+ *
+ * The interface of pcl::NormalEstimationOMP, so either estimator replaces it (or
+ * pcl::NormalEstimation) in existing code: computePointNormal (both overloads), the viewpoint
+ * setters and the protected vpx_, vpy_, vpz_, a constructor taking the number of threads and
+ * setNumberOfThreads (0: every core; the default here, where PCL's NormalEstimation uses one),
+ * Ptr / ConstPtr of the class itself. See docs/pcl-drop-in.md for what differs.
+ *
+ * Orientation (see normal_orientation.h): by the viewpoint, as PCL does, unless the search method
+ * is a MeshRingSearch (or setOrientationMesh was called), in which case by the mesh's faces.
+ * The viewpoint is the input cloud's sensor_origin_, copied when the cloud is set, as in
+ * pcl::NormalEstimation, unless setViewPoint chooses one. setOrientationSpanningTree makes the
+ * normals consistent along a minimum spanning tree of each point's nearest neighbours from the
+ * search method (mesh rings, pixel grid or kd-tree: the graph follows the neighbourhood), for
+ * clouds without a single viewpoint; the quadric's curvatures change sign with their normals.
+ *
+ * A point that cannot be estimated (non-finite, or too few finite neighbours) gets NaN output
+ * and output.is_dense = false; compute() counts them (getFailedPoints) and warns once.
+ */
 #include <pcl/features/feature.h>
 
 #include <Eigen/Core>

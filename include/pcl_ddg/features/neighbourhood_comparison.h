@@ -1,8 +1,10 @@
 #pragma once
-// The same estimator run with topological neighbourhoods (mesh rings, or an organized cloud's
-// pixel grid) and Euclidean ones (kd-tree), and how much the two differ at every point: where a
-// scan's surface passes close to another part of itself (thin walls, folds, fingers), or a frame
-// has a depth jump, Euclidean neighbourhoods mix both sides.
+/** \file
+ * The same estimator run with topological neighbourhoods (mesh rings, or an organized cloud's
+ * pixel grid) and Euclidean ones (kd-tree), and how much the two differ at every point: where a
+ * scan's surface passes close to another part of itself (thin walls, folds, fingers), or a frame
+ * has a depth jump, Euclidean neighbourhoods mix both sides.
+ */
 #include <Eigen/Core>
 #include <cstdint>
 

@@ -1,19 +1,21 @@
 #pragma once
-// PCA normals of an organized cloud (an RGB-D frame, a range image) at frame rate: each pixel's
-// plane is fitted to the finite points of the (2w+1)^2 pixel window around it, from windowed sums
-// of x, y, z and their products, so that no pixel needs a search. A tile's rows are summed across
-// the window once and then down it (direct sums, no summed-area tables), and a row's eigenpairs are
-// found together in the CPU's vector lanes (fitPlaneNormals).
-//
-// Far from the origin the sums of squares would cancel the covariance away: the sums are formed
-// per 64 x 64 tile on coordinates relative to the tile's mean, so that a window's covariance is
-// as exact as the two-pass PCA of its points (1e-9 relative or better).
-//
-// Across a depth jump a window would mix two surfaces. Where the window holds a point that
-// OrganizedGridSearch::windowSearch does not reach from its centre (a jump, or a hole, lies
-// between them), that pixel's plane is fitted to the points it reaches instead: the same PCA on
-// fewer points, never across the jump. Pixels without a finite point keep NaN; holes are never
-// filled.
+/** \file
+ * PCA normals of an organized cloud (an RGB-D frame, a range image) at frame rate: each pixel's
+ * plane is fitted to the finite points of the (2w+1)^2 pixel window around it, from windowed sums
+ * of x, y, z and their products, so that no pixel needs a search. A tile's rows are summed across
+ * the window once and then down it (direct sums, no summed-area tables), and a row's eigenpairs are
+ * found together in the CPU's vector lanes (fitPlaneNormals).
+ *
+ * Far from the origin the sums of squares would cancel the covariance away: the sums are formed
+ * per 64 x 64 tile on coordinates relative to the tile's mean, so that a window's covariance is
+ * as exact as the two-pass PCA of its points (1e-9 relative or better).
+ *
+ * Across a depth jump a window would mix two surfaces. Where the window holds a point that
+ * OrganizedGridSearch::windowSearch does not reach from its centre (a jump, or a hole, lies
+ * between them), that pixel's plane is fitted to the points it reaches instead: the same PCA on
+ * fewer points, never across the jump. Pixels without a finite point keep NaN; holes are never
+ * filled.
+ */
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 

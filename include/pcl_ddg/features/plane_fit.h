@@ -1,5 +1,7 @@
 #pragma once
-// Least-squares plane through a neighbourhood: the PCA of its points.
+/** \file
+ * Least-squares plane through a neighbourhood: the PCA of its points.
+ */
 #include <Eigen/Core>
 #include <cstdint>
 

@@ -1,9 +1,11 @@
 #pragma once
-// Height-field quadric through a neighbourhood, in the frame of its fitted plane:
-//   w = f(u, v) = a u^2 + b uv + c v^2 + d u + e v + g   (least squares over the neighbours),
-// with (u, v, w) the coordinates along (tangent1, tangent2, normal) of the plane fit about its
-// centroid. The normal at a point is that of the graph, (-f_u, -f_v, 1) / |.|, at the point's own
-// (u, v); the principal curvatures are the eigenvalues of the graph's shape operator there.
+/** \file
+ * Height-field quadric through a neighbourhood, in the frame of its fitted plane:
+ *   w = f(u, v) = a u^2 + b uv + c v^2 + d u + e v + g   (least squares over the neighbours),
+ * with (u, v, w) the coordinates along (tangent1, tangent2, normal) of the plane fit about its
+ * centroid. The normal at a point is that of the graph, (-f_u, -f_v, 1) / |.|, at the point's own
+ * (u, v); the principal curvatures are the eigenvalues of the graph's shape operator there.
+ */
 #include <Eigen/Core>
 
 #include "pcl_ddg/features/plane_fit.h"

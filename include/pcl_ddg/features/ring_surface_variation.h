@@ -1,7 +1,9 @@
 #pragma once
-// PCL's "curvature" for mesh vertices: the surface variation of each vertex with its 1-ring, so
-// that mesh normals written for PCL (pcl::PointNormal) carry the value pcl::NormalEstimation would
-// give with that neighbourhood.
+/** \file
+ * PCL's "curvature" for mesh vertices: the surface variation of each vertex with its 1-ring, so
+ * that mesh normals written for PCL (pcl::PointNormal) carry the value pcl::NormalEstimation would
+ * give with that neighbourhood.
+ */
 #include <Eigen/Core>
 
 #include "pcl_ddg/mesh/mesh_topology.h"

@@ -1,7 +1,9 @@
 #pragma once
-// Output that appears complete or not at all: data goes to a temporary file in the target's
-// folder (same file system), which commit() renames over the target. A writer that fails or
-// throws leaves no file behind, because the destructor removes an uncommitted temporary.
+/** \file
+ * Output that appears complete or not at all: data goes to a temporary file in the target's
+ * folder (same file system), which commit() renames over the target. A writer that fails or
+ * throws leaves no file behind, because the destructor removes an uncommitted temporary.
+ */
 #include <string>
 #include <string_view>
 

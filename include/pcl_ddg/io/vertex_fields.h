@@ -1,6 +1,8 @@
 #pragma once
-// Named per-vertex values attached to a cloud, written as PLY vertex properties (CloudCompare
-// shows them as scalar fields) or PCD fields; colours as uchar red/green/blue (MeshLab).
+/** \file
+ * Named per-vertex values attached to a cloud, written as PLY vertex properties (CloudCompare
+ * shows them as scalar fields) or PCD fields; colours as uchar red/green/blue (MeshLab).
+ */
 #include <pcl/PCLPointCloud2.h>
 
 #include <Eigen/Core>

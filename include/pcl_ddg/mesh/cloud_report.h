@@ -1,5 +1,7 @@
 #pragma once
-// What a point cloud holds before any estimator runs on it.
+/** \file
+ * What a point cloud holds before any estimator runs on it.
+ */
 #include <pcl/PCLPointCloud2.h>
 
 #include <cstdint>

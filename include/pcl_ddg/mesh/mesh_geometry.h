@@ -1,5 +1,7 @@
 #pragma once
-// Elementary measures of a mesh embedded by vertex positions (3 x N, double).
+/** \file
+ * Elementary measures of a mesh embedded by vertex positions (3 x N, double).
+ */
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>

@@ -1,5 +1,7 @@
 #pragma once
-// Everything worth knowing about a mesh before trusting numbers computed on it.
+/** \file
+ * Everything worth knowing about a mesh before trusting numbers computed on it.
+ */
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>

@@ -1,13 +1,15 @@
 #pragma once
-// Connectivity of a polygon mesh, built once and shared by every operator.
-//
-// The input vertex numbering is kept, so per-vertex results align with the input cloud. Polygons
-// are fan-triangulated (corner 0 with every consecutive pair); triangles keep the input winding.
-// Triangle corner k faces edge k: edge k of triangle t joins corners k+1 and k+2 (mod 3).
-// Adjacency is stored in compressed rows (CSR): vertex -> sorted neighbours, vertex -> incident
-// triangles. Edge ids (the edge map: ids, ends, triangle counts, the edges of each triangle) are
-// built on the first call that asks for one: face normals, ring searches and the defect counts need
-// only the rows, and the map costs as much as the rows again.
+/** \file
+ * Connectivity of a polygon mesh, built once and shared by every operator.
+ *
+ * The input vertex numbering is kept, so per-vertex results align with the input cloud. Polygons
+ * are fan-triangulated (corner 0 with every consecutive pair); triangles keep the input winding.
+ * Triangle corner k faces edge k: edge k of triangle t joins corners k+1 and k+2 (mod 3).
+ * Adjacency is stored in compressed rows (CSR): vertex -> sorted neighbours, vertex -> incident
+ * triangles. Edge ids (the edge map: ids, ends, triangle counts, the edges of each triangle) are
+ * built on the first call that asks for one: face normals, ring searches and the defect counts need
+ * only the rows, and the map costs as much as the rows again.
+ */
 #include <pcl/PolygonMesh.h>
 #include <pcl/Vertices.h>
 

@@ -1,5 +1,7 @@
 #pragma once
-// Vertex coordinates between PCL clouds (float or double fields) and Eigen (double, 3 x N).
+/** \file
+ * Vertex coordinates between PCL clouds (float or double fields) and Eigen (double, 3 x N).
+ */
 #include <pcl/PCLPointCloud2.h>
 
 #include <Eigen/Core>

@@ -1,19 +1,21 @@
 #pragma once
-// Discrete curvatures at the vertices of a triangle mesh.
-//
-// Sign convention: with the mesh oriented outward, H > 0 and K > 0 on a sphere (kappa > 0 where
-// the surface bends away from the normal).
-//   Gaussian   angle defect: 2 pi - sum of corner angles at an interior vertex, pi - sum at a
-//              boundary vertex (the geodesic turning of the boundary), so that the integrated
-//              values sum to 2 pi chi (Gauss-Bonnet) on every mesh. As a density, divided by the
-//              vertex area (mixed Voronoi by default; barycentric areas do not converge).
-//   Mean       Hn = -1/2 M^-1 L x with the cotangent L; H = |Hn| signed by the area-weighted
-//              vertex normal. On a boundary vertex Hn carries the boundary's curvature too and
-//              is not a surface curvature.
-//   Principal  kappa_{1,2} = H +- sqrt(max(H^2 - K, 0)); vertices where H^2 < K were clamped.
-// Vertices without area (isolated, or only on degenerate triangles) get NaN and valid = 0. Where
-// the incident face normals cancel (a face and its reversed duplicate) H has no sign: mean,
-// kappa1 and kappa2 are NaN, valid = 0 (counted in unoriented_vertices), K is still given.
+/** \file
+ * Discrete curvatures at the vertices of a triangle mesh.
+ *
+ * Sign convention: with the mesh oriented outward, H > 0 and K > 0 on a sphere (kappa > 0 where
+ * the surface bends away from the normal).
+ *   Gaussian   angle defect: 2 pi - sum of corner angles at an interior vertex, pi - sum at a
+ *              boundary vertex (the geodesic turning of the boundary), so that the integrated
+ *              values sum to 2 pi chi (Gauss-Bonnet) on every mesh. As a density, divided by the
+ *              vertex area (mixed Voronoi by default; barycentric areas do not converge).
+ *   Mean       Hn = -1/2 M^-1 L x with the cotangent L; H = |Hn| signed by the area-weighted
+ *              vertex normal. On a boundary vertex Hn carries the boundary's curvature too and
+ *              is not a surface curvature.
+ *   Principal  kappa_{1,2} = H +- sqrt(max(H^2 - K, 0)); vertices where H^2 < K were clamped.
+ * Vertices without area (isolated, or only on degenerate triangles) get NaN and valid = 0. Where
+ * the incident face normals cancel (a face and its reversed duplicate) H has no sign: mean,
+ * kappa1 and kappa2 are NaN, valid = 0 (counted in unoriented_vertices), K is still given.
+ */
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>

@@ -1,18 +1,20 @@
 #pragma once
-// Discrete Laplace-Beltrami operators on a triangle mesh.
-//
-// Convention: L is NEGATIVE semi-definite. Off-diagonal L_ij = w_ij for every mesh edge ij, the
-// diagonal L_ii = -sum_j w_ij, so L * 1 = 0 and (L x)_i = sum_j w_ij (x_j - x_i).
-//   Uniform (umbrella)  w_ij = 1 (diagonal -|N(i)|), purely topological.
-//   Cotangent           w_ij = (cot a_ij + cot b_ij) / 2 over the angles opposite edge ij; a
-//                       boundary edge has one cotangent, a non-manifold edge one per triangle.
-//                       Exact on linear functions over planar meshes (linear precision).
-// Forms:
-//   Summed    L itself: symmetric (the weak / stiffness form used with a mass matrix).
-//   Averaged  M^-1 L (a pointwise Laplacian, M a lumped mass matrix): for the cotangent weights
-//             M^-1 L x approximates the Laplace-Beltrami of the coordinates, -2 H n. Rows of
-//             zero-mass vertices (isolated, or only on degenerate triangles) are zero.
-// Degenerate (zero-area) triangles contribute no weight; isolated vertices have an empty row.
+/** \file
+ * Discrete Laplace-Beltrami operators on a triangle mesh.
+ *
+ * Convention: L is NEGATIVE semi-definite. Off-diagonal L_ij = w_ij for every mesh edge ij, the
+ * diagonal L_ii = -sum_j w_ij, so L * 1 = 0 and (L x)_i = sum_j w_ij (x_j - x_i).
+ *   Uniform (umbrella)  w_ij = 1 (diagonal -|N(i)|), purely topological.
+ *   Cotangent           w_ij = (cot a_ij + cot b_ij) / 2 over the angles opposite edge ij; a
+ *                       boundary edge has one cotangent, a non-manifold edge one per triangle.
+ *                       Exact on linear functions over planar meshes (linear precision).
+ * Forms:
+ *   Summed    L itself: symmetric (the weak / stiffness form used with a mass matrix).
+ *   Averaged  M^-1 L (a pointwise Laplacian, M a lumped mass matrix): for the cotangent weights
+ *             M^-1 L x approximates the Laplace-Beltrami of the coordinates, -2 H n. Rows of
+ *             zero-mass vertices (isolated, or only on degenerate triangles) are zero.
+ * Degenerate (zero-area) triangles contribute no weight; isolated vertices have an empty row.
+ */
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 

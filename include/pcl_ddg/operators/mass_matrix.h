@@ -1,15 +1,17 @@
 #pragma once
-// Lumped (diagonal) mass matrices: the area each vertex stands for.
-//
-//  Barycentric   one third of every incident triangle. Always positive, but not a consistent
-//                 area: curvature densities over it do not converge (docs/accuracy.md).
-//  Voronoi        circumcentric cells, (|e_ij|^2 cot(k) + |e_ik|^2 cot(j)) / 8 per corner i.
-//                 NEGATIVE contributions on obtuse triangles; exact for well-centred meshes.
-//  MixedVoronoi   Meyer, Desbrun, Schroeder and Barr 2003: Voronoi on non-obtuse triangles;
-//                 an obtuse triangle gives half its area to the obtuse corner and a quarter to
-//                 each other. Always non-negative; the default.
-// For every type the masses sum to the total area of the mesh. Isolated vertices and vertices
-// of degenerate triangles only get zero mass.
+/** \file
+ * Lumped (diagonal) mass matrices: the area each vertex stands for.
+ *
+ *  Barycentric   one third of every incident triangle. Always positive, but not a consistent
+ *                 area: curvature densities over it do not converge (docs/accuracy.md).
+ *  Voronoi        circumcentric cells, (|e_ij|^2 cot(k) + |e_ik|^2 cot(j)) / 8 per corner i.
+ *                 NEGATIVE contributions on obtuse triangles; exact for well-centred meshes.
+ *  MixedVoronoi   Meyer, Desbrun, Schroeder and Barr 2003: Voronoi on non-obtuse triangles;
+ *                 an obtuse triangle gives half its area to the obtuse corner and a quarter to
+ *                 each other. Always non-negative; the default.
+ * For every type the masses sum to the total area of the mesh. Isolated vertices and vertices
+ * of degenerate triangles only get zero mass.
+ */
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 

@@ -1,12 +1,14 @@
 #pragma once
-// Sparse Cholesky factorisation of symmetric positive definite systems, for the implicit
-// smoothing steps: CHOLMOD's supernodal LLT (SuiteSparse, through Eigen's CholmodSupport) when the
-// library was built with it, Eigen's SimplicialLDLT otherwise or on request.
-//
-// The ordering and symbolic factorisation depend only on the sparsity pattern: analyzePattern()
-// once, then factorize() for every new matrix with that pattern (the values of L and M change
-// every smoothing step, the pattern does not). solve() takes several right-hand sides at once
-// (x, y, z as three columns).
+/** \file
+ * Sparse Cholesky factorisation of symmetric positive definite systems, for the implicit
+ * smoothing steps: CHOLMOD's supernodal LLT (SuiteSparse, through Eigen's CholmodSupport) when the
+ * library was built with it, Eigen's SimplicialLDLT otherwise or on request.
+ *
+ * The ordering and symbolic factorisation depend only on the sparsity pattern: analyzePattern()
+ * once, then factorize() for every new matrix with that pattern (the values of L and M change
+ * every smoothing step, the pattern does not). solve() takes several right-hand sides at once
+ * (x, y, z as three columns).
+ */
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>

@@ -1,5 +1,7 @@
 #pragma once
-// Scalar fields to colours, for MeshLab (per-vertex RGB) and for pictures.
+/** \file
+ * Scalar fields to colours, for MeshLab (per-vertex RGB) and for pictures.
+ */
 #include <Eigen/Core>
 #include <cstdint>
 

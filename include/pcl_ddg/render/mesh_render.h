@@ -1,8 +1,10 @@
 #pragma once
-// A small software renderer for pictures of results (README figures, quick looks on headless
-// machines): orthographic view, z-buffer, per-vertex colours interpolated across each triangle,
-// Lambert shading by the face normal (two-sided); point clouds as round splats, shaded by their
-// normals when they have them; written as PNG.
+/** \file
+ * A small software renderer for pictures of results (README figures, quick looks on headless
+ * machines): orthographic view, z-buffer, per-vertex colours interpolated across each triangle,
+ * Lambert shading by the face normal (two-sided); point clouds as round splats, shaded by their
+ * normals when they have them; written as PNG.
+ */
 #include <Eigen/Core>
 #include <cstdint>
 #include <string>

@@ -1,11 +1,13 @@
 #pragma once
-// Euclidean neighbourhoods from a FLANN kd-tree, as a PCL search method: the same answers as
-// pcl::search::KdTree (exact k nearest, squared distances in float), without its per-query
-// overhead (see point_kd_tree.h), so estimators that are parallel over points scale.
-//
-// Non-finite points are never indexed nor returned. With indices in setInputCloud only those
-// points are searched, and an index query (nearestKSearch(i, ...)) means the i-th of them, as in
-// PCL. k nearest are sorted by distance; radius results when setSortedResults(true) (the default).
+/** \file
+ * Euclidean neighbourhoods from a FLANN kd-tree, as a PCL search method: the same answers as
+ * pcl::search::KdTree (exact k nearest, squared distances in float), without its per-query
+ * overhead (see point_kd_tree.h), so estimators that are parallel over points scale.
+ *
+ * Non-finite points are never indexed nor returned. With indices in setInputCloud only those
+ * points are searched, and an index query (nearestKSearch(i, ...)) means the i-th of them, as in
+ * PCL. k nearest are sorted by distance; radius results when setSortedResults(true) (the default).
+ */
 #include <pcl/search/search.h>
 
 #include <memory>

@@ -1,22 +1,24 @@
 #pragma once
-// Topological neighbourhoods on a mesh, as a PCL search method, so that any pcl::Feature (and
-// pcl::NormalEstimation unchanged) can use them through setSearchMethod.
-//
-//  nearestKSearch(index, k)     the vertex itself, then its 1-ring, 2-ring, ... by breadth-first
-//                               search over the mesh edges; the ring that would overflow k is
-//                               filled in order of Euclidean distance. Results come in ring order
-//                               (the query first); fewer than k on a component smaller than k.
-//  radiusSearch(index, r)       the vertices reachable from the query along edges without leaving
-//                               the Euclidean ball of radius r: a topological ball, which never
-//                               jumps to another sheet of the surface however close it passes.
-//                               Sorted by distance if setSortedResults(true), else in search
-//                               order (nearest rings first); max_nn keeps the first max_nn.
-//
-// Distances are squared and in float, as PCL returns them. Queries are vertex indices of the
-// input cloud; a bare point (not a vertex) has no place on the mesh and fails with PCL_ERROR.
-// Vertices with a non-finite coordinate are never returned and never searched through; a query at
-// one returns nothing. Thread-safe: concurrent queries (pcl::NormalEstimationOMP) use per-thread
-// visit marks, and a query allocates nothing once its output vectors have grown.
+/** \file
+ * Topological neighbourhoods on a mesh, as a PCL search method, so that any pcl::Feature (and
+ * pcl::NormalEstimation unchanged) can use them through setSearchMethod.
+ *
+ *  nearestKSearch(index, k)     the vertex itself, then its 1-ring, 2-ring, ... by breadth-first
+ *                               search over the mesh edges; the ring that would overflow k is
+ *                               filled in order of Euclidean distance. Results come in ring order
+ *                               (the query first); fewer than k on a component smaller than k.
+ *  radiusSearch(index, r)       the vertices reachable from the query along edges without leaving
+ *                               the Euclidean ball of radius r: a topological ball, which never
+ *                               jumps to another sheet of the surface however close it passes.
+ *                               Sorted by distance if setSortedResults(true), else in search
+ *                               order (nearest rings first); max_nn keeps the first max_nn.
+ *
+ * Distances are squared and in float, as PCL returns them. Queries are vertex indices of the
+ * input cloud; a bare point (not a vertex) has no place on the mesh and fails with PCL_ERROR.
+ * Vertices with a non-finite coordinate are never returned and never searched through; a query at
+ * one returns nothing. Thread-safe: concurrent queries (pcl::NormalEstimationOMP) use per-thread
+ * visit marks, and a query allocates nothing once its output vectors have grown.
+ */
 #include <pcl/search/search.h>
 
 #include <memory>

@@ -1,31 +1,33 @@
 #pragma once
-// Neighbourhoods on an organized cloud's pixel grid (an RGB-D frame, a range image), as a PCL
-// search method: the image-space sibling of MeshRingSearch, usable by any pcl::Feature.
-//
-// The pixels are a graph: two 8-adjacent pixels are joined unless one has no finite point or a
-// depth jump separates them, |r(a) - r(b)| > max_depth_jump * min(r(a), r(b)), with r the range
-// (distance from the cloud's sensor origin). Neighbours are found by breadth-first search over
-// that graph, so they never lie across a jump, however far the other side's points are. The
-// default, 0.02, keeps a surface seen as obliquely as 84 degrees by a 525-pixel focal length (its
-// range grows by tan(angle) / f per pixel, and tan 84.6 deg = 0.02 * 525) and is several times a
-// Kinect-class sensor's depth step (0.3 % of the range at 1 m, 0.9 % at 3 m: Khoshelham and
-// Elberink 2012); a person one metre in front of a wall at 3 m is a 50 % jump.
-//
-//  nearestKSearch(index, k)   the k nearest (Euclidean) of the pixels reached in the fewest
-//                             steps that holds k of them, and of one step more, so that a pixel
-//                             just beyond can still win; the query first. Fewer than k when the
-//                             search reaches maxWindowRadius() steps first.
-//  radiusSearch(index, r)     the pixels reached without leaving the ball of radius r (a
-//                             topological ball on the grid, up to maxWindowRadius() steps);
-//                             sorted by distance if setSortedResults(true); max_nn keeps the
-//                             nearest max_nn.
-//  windowSearch(index, w)     the pixels reached without leaving the (2w+1)^2 window: the
-//                             neighbourhood the window-sum normals (organized_normals.h)
-//                             average over.
-//
-// Distances are squared and in float, as PCL returns them. Queries are pixel indices of the input
-// cloud; a bare point has no pixel and fails with PCL_ERROR. A query at a pixel without a finite
-// point returns nothing. Thread-safe, and a query allocates nothing once its buffers have grown.
+/** \file
+ * Neighbourhoods on an organized cloud's pixel grid (an RGB-D frame, a range image), as a PCL
+ * search method: the image-space sibling of MeshRingSearch, usable by any pcl::Feature.
+ *
+ * The pixels are a graph: two 8-adjacent pixels are joined unless one has no finite point or a
+ * depth jump separates them, |r(a) - r(b)| > max_depth_jump * min(r(a), r(b)), with r the range
+ * (distance from the cloud's sensor origin). Neighbours are found by breadth-first search over
+ * that graph, so they never lie across a jump, however far the other side's points are. The
+ * default, 0.02, keeps a surface seen as obliquely as 84 degrees by a 525-pixel focal length (its
+ * range grows by tan(angle) / f per pixel, and tan 84.6 deg = 0.02 * 525) and is several times a
+ * Kinect-class sensor's depth step (0.3 % of the range at 1 m, 0.9 % at 3 m: Khoshelham and
+ * Elberink 2012); a person one metre in front of a wall at 3 m is a 50 % jump.
+ *
+ *  nearestKSearch(index, k)   the k nearest (Euclidean) of the pixels reached in the fewest
+ *                             steps that holds k of them, and of one step more, so that a pixel
+ *                             just beyond can still win; the query first. Fewer than k when the
+ *                             search reaches maxWindowRadius() steps first.
+ *  radiusSearch(index, r)     the pixels reached without leaving the ball of radius r (a
+ *                             topological ball on the grid, up to maxWindowRadius() steps);
+ *                             sorted by distance if setSortedResults(true); max_nn keeps the
+ *                             nearest max_nn.
+ *  windowSearch(index, w)     the pixels reached without leaving the (2w+1)^2 window: the
+ *                             neighbourhood the window-sum normals (organized_normals.h)
+ *                             average over.
+ *
+ * Distances are squared and in float, as PCL returns them. Queries are pixel indices of the input
+ * cloud; a bare point has no pixel and fails with PCL_ERROR. A query at a pixel without a finite
+ * point returns nothing. Thread-safe, and a query allocates nothing once its buffers have grown.
+ */
 #include <pcl/search/search.h>
 
 #include <algorithm>

@@ -1,11 +1,13 @@
 #pragma once
-// A FLANN kd-tree over 3D points, queried one point at a time without allocating (the core of
-// KdTreeSearch; FLANN itself stays out of the public headers).
-//
-// Why not pcl::KdTreeFLANN: it answers each query through FLANN's batch knnSearch, which opens an
-// OpenMP parallel region per call; inside an estimator that is already parallel over points that
-// costs as much as the search itself. Here each query calls the index's findNeighbors directly
-// with a result set that writes straight into the caller's vectors.
+/** \file
+ * A FLANN kd-tree over 3D points, queried one point at a time without allocating (the core of
+ * KdTreeSearch; FLANN itself stays out of the public headers).
+ *
+ * Why not pcl::KdTreeFLANN: it answers each query through FLANN's batch knnSearch, which opens an
+ * OpenMP parallel region per call; inside an estimator that is already parallel over points that
+ * costs as much as the search itself. Here each query calls the index's findNeighbors directly
+ * with a result set that writes straight into the caller's vectors.
+ */
 #include <pcl/types.h>
 
 #include <memory>

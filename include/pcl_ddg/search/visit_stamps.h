@@ -1,7 +1,9 @@
 #pragma once
-// Per-thread "visited" marks for graph searches: one stamp per vertex, and a query marks a vertex
-// by writing the query's stamp, so starting a query costs nothing (no clearing, no allocation once
-// the array has grown to the mesh size).
+/** \file
+ * Per-thread "visited" marks for graph searches: one stamp per vertex, and a query marks a vertex
+ * by writing the query's stamp, so starting a query costs nothing (no clearing, no allocation once
+ * the array has grown to the mesh size).
+ */
 #include <cstdint>
 #include <vector>
 

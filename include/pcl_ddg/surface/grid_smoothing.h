@@ -1,20 +1,22 @@
 #pragma once
-// Smoothing of organized clouds and depth images: the heat equation on the image grid with the
-// 5-point stencil, applied to each point's range along its viewing ray (so points only move
-// along their rays and the image stays a valid projection).
-//
-// With r the distance of a pixel's point from the sensor origin and tau the time step in
-// pixel^2 units:
-//   explicit  r <- r + tau L r          (stable for tau < 1/4: L's eigenvalues lie in [-8, 0])
-//   implicit  (I - tau L) r' = r        (stable for any tau; one factorisation for all steps, or
-//                                        conjugate gradients: implicit_solver.h)
-// where (L r)_i = sum over coupled 4-neighbours j of (r_j - r_i). Pixels with a non-finite point
-// are holes: missing data, never coupled, never filled; they stay NaN. A point exactly at the
-// sensor origin has no ray: it is not coupled and kept as it is. With no valid pixel at all the
-// result equals the input. Two
-// neighbours are not coupled across a depth jump: |r_i - r_j| > max_depth_jump * min(r_i, r_j)
-// (relative, so the same threshold works at every distance), decided once on the input. The grid
-// border is insulated (no flux), so a constant range is kept exactly.
+/** \file
+ * Smoothing of organized clouds and depth images: the heat equation on the image grid with the
+ * 5-point stencil, applied to each point's range along its viewing ray (so points only move
+ * along their rays and the image stays a valid projection).
+ *
+ * With r the distance of a pixel's point from the sensor origin and tau the time step in
+ * pixel^2 units:
+ *   explicit  r <- r + tau L r          (stable for tau < 1/4: L's eigenvalues lie in [-8, 0])
+ *   implicit  (I - tau L) r' = r        (stable for any tau; one factorisation for all steps, or
+ *                                        conjugate gradients: implicit_solver.h)
+ * where (L r)_i = sum over coupled 4-neighbours j of (r_j - r_i). Pixels with a non-finite point
+ * are holes: missing data, never coupled, never filled; they stay NaN. A point exactly at the
+ * sensor origin has no ray: it is not coupled and kept as it is. With no valid pixel at all the
+ * result equals the input. Two
+ * neighbours are not coupled across a depth jump: |r_i - r_j| > max_depth_jump * min(r_i, r_j)
+ * (relative, so the same threshold works at every distance), decided once on the input. The grid
+ * border is insulated (no flux), so a constant range is kept exactly.
+ */
 #include <pcl/point_cloud.h>
 
 #include <Eigen/Core>

@@ -1,22 +1,24 @@
 #pragma once
-// Per-vertex normals of a triangle mesh, oriented like its faces (input winding).
-//
-//  Uniform        average of the unit normals of the incident triangles (every face counts the
-//                 same, whatever its size).
-//  Area           sum of the triangles' area vectors: large faces weigh more. Exact for the
-//                 gradient of the enclosed volume; the usual default.
-//  Angle          unit face normals weighted by the corner angle at the vertex (Thuermer and
-//                 Wuethrich 1998): independent of how a flat region is triangulated.
-//  MeanCurvature  direction of the mean-curvature normal -M^-1 L x (cotangent Laplacian), turned
-//                 to agree with the area normal. Where |M^-1 L x| (= 2|H|) is below epsilon the
-//                 surface is locally flat, that direction is noise, and the area normal is used
-//                 (counted in fallback_vertices), as on boundary vertices, where -M^-1 L x
-//                 also holds the curvature of the boundary curve. Default epsilon: 0.02 / mean edge
-//                 length, i.e. radii of curvature above 100 mean edge lengths count as flat.
-// Degenerate triangles contribute nothing. Vertices with no non-degenerate triangle (isolated
-// ones included) get a NaN normal and valid = 0; so do vertices whose weighted face normals
-// cancel (a face and its reversed duplicate), where any direction would be rounding noise
-// (counted in cancelled_vertices).
+/** \file
+ * Per-vertex normals of a triangle mesh, oriented like its faces (input winding).
+ *
+ *  Uniform        average of the unit normals of the incident triangles (every face counts the
+ *                 same, whatever its size).
+ *  Area           sum of the triangles' area vectors: large faces weigh more. Exact for the
+ *                 gradient of the enclosed volume; the usual default.
+ *  Angle          unit face normals weighted by the corner angle at the vertex (Thuermer and
+ *                 Wuethrich 1998): independent of how a flat region is triangulated.
+ *  MeanCurvature  direction of the mean-curvature normal -M^-1 L x (cotangent Laplacian), turned
+ *                 to agree with the area normal. Where |M^-1 L x| (= 2|H|) is below epsilon the
+ *                 surface is locally flat, that direction is noise, and the area normal is used
+ *                 (counted in fallback_vertices), as on boundary vertices, where -M^-1 L x
+ *                 also holds the curvature of the boundary curve. Default epsilon: 0.02 / mean edge
+ *                 length, i.e. radii of curvature above 100 mean edge lengths count as flat.
+ * Degenerate triangles contribute nothing. Vertices with no non-degenerate triangle (isolated
+ * ones included) get a NaN normal and valid = 0; so do vertices whose weighted face normals
+ * cancel (a face and its reversed duplicate), where any direction would be rounding noise
+ * (counted in cancelled_vertices).
+ */
 #include <Eigen/Core>
 #include <cstdint>
 #include <vector>

@@ -1,36 +1,38 @@
 #pragma once
-// Laplacian smoothing of a mesh's vertex positions: the mean-curvature-like flow dx/dt = M^-1 L x.
-//
-//   Explicit  x <- x + tau M^-1 L x per iteration (forward Euler). Cheap, but stable only for
-//             tau below about 2 / |lambda_max(M^-1 L)|, i.e. a fraction of h^2 (h = mean edge
-//             length): larger steps make every iteration amplify the finest wrinkles, and the
-//             positions blow up (raised as an exception naming the iteration).
-//   Implicit  (M - tau L) x' = M x (backward Euler, Desbrun et al. 1999): one sparse Cholesky
-//             or conjugate-gradient solve per iteration (implicit_solver.h; by default whichever
-//             costs less for the run), x, y, z as three right-hand sides. Stable for any tau, so
-//             one large step replaces thousands of small ones.
-// L is the summed uniform or cotangent Laplacian (laplacian.h), M the lumped mass of the chosen
-// type. By default L is frozen at the input and M follows the current positions (Kazhdan et al.
-// 2012, "Can mean-curvature flow be modified to be non-singular?"; libigl's smoothing tutorial):
-// rebuilding cotangent weights every iteration is the singular mean-curvature flow, which pinches
-// triangles into slivers within a few large steps. Both can also be rebuilt every iteration or
-// both frozen at the input. With Cholesky the system's pattern is analysed once and refactorised
-// per iteration.
-// The report gives the triangles' angle quality before and after (slivers: a corner under 1 deg).
-//
-// Boundary vertices move (Free, default) or keep their position (Fixed). Vertices without mass
-// (isolated, or only on degenerate triangles) never move. Laplacian flow shrinks a surface; the
-// optional correction rescales the result about its mass-weighted centroid after every iteration
-// so that the enclosed volume (closed, consistently oriented meshes) or the surface area is that
-// of the input.
-//
-// Errors: InvalidMeshException for an empty mesh or non-finite input; pcl::BadArgumentException for
-// bad parameters (tau <= 0, iterations < 1, volume correction on an open mesh, a correction with a
-// fixed boundary); pcl::ComputeFailedException when an iteration produces a non-finite position
-// or a singular system, naming the iteration; SurfaceCollapseException when a step collapses the
-// surface (before any correction): area or enclosed volume below 1e-6 of the input's, or every
-// vertex within one mean edge length h of the input of the centroid. A correction would only
-// blow such a remnant up again. The input is never modified.
+/** \file
+ * Laplacian smoothing of a mesh's vertex positions: the mean-curvature-like flow dx/dt = M^-1 L x.
+ *
+ *   Explicit  x <- x + tau M^-1 L x per iteration (forward Euler). Cheap, but stable only for
+ *             tau below about 2 / |lambda_max(M^-1 L)|, i.e. a fraction of h^2 (h = mean edge
+ *             length): larger steps make every iteration amplify the finest wrinkles, and the
+ *             positions blow up (raised as an exception naming the iteration).
+ *   Implicit  (M - tau L) x' = M x (backward Euler, Desbrun et al. 1999): one sparse Cholesky
+ *             or conjugate-gradient solve per iteration (implicit_solver.h; by default whichever
+ *             costs less for the run), x, y, z as three right-hand sides. Stable for any tau, so
+ *             one large step replaces thousands of small ones.
+ * L is the summed uniform or cotangent Laplacian (laplacian.h), M the lumped mass of the chosen
+ * type. By default L is frozen at the input and M follows the current positions (Kazhdan et al.
+ * 2012, "Can mean-curvature flow be modified to be non-singular?"; libigl's smoothing tutorial):
+ * rebuilding cotangent weights every iteration is the singular mean-curvature flow, which pinches
+ * triangles into slivers within a few large steps. Both can also be rebuilt every iteration or
+ * both frozen at the input. With Cholesky the system's pattern is analysed once and refactorised
+ * per iteration.
+ * The report gives the triangles' angle quality before and after (slivers: a corner under 1 deg).
+ *
+ * Boundary vertices move (Free, default) or keep their position (Fixed). Vertices without mass
+ * (isolated, or only on degenerate triangles) never move. Laplacian flow shrinks a surface; the
+ * optional correction rescales the result about its mass-weighted centroid after every iteration
+ * so that the enclosed volume (closed, consistently oriented meshes) or the surface area is that
+ * of the input.
+ *
+ * Errors: InvalidMeshException for an empty mesh or non-finite input; pcl::BadArgumentException for
+ * bad parameters (tau <= 0, iterations < 1, volume correction on an open mesh, a correction with a
+ * fixed boundary); pcl::ComputeFailedException when an iteration produces a non-finite position
+ * or a singular system, naming the iteration; SurfaceCollapseException when a step collapses the
+ * surface (before any correction): area or enclosed volume below 1e-6 of the input's, or every
+ * vertex within one mean edge length h of the input of the centroid. A correction would only
+ * blow such a remnant up again. The input is never modified.
+ */
 #include <pcl/PolygonMesh.h>
 #include <pcl/exceptions.h>
 

@@ -1,16 +1,18 @@
 #pragma once
-// The fitted estimators on a cloud file larger than memory: the file is read a piece at a time,
-// cut into tiles (tile_plan.h), each tile fitted with its halo (tiled_local_fit.h), and the
-// output written in the input's order with every input field and the new ones, so that the result
-// equals the in-memory one value for value. Memory stays within a budget whatever the file's size:
-//   1. a pass over the file for the bounds, a second for the point histogram the plan is cut from
-//   2. a third writes every finite point (index, x, y, z) into its tile's file in a scratch folder
-//      (beside plan.json: each tile can then be fitted by an independent worker)
-//   3. each tile is gathered from the tile files its halo touches, fitted, and its results are
-//      written at their points' places in a results file
-//   4. a last pass joins the input's pieces and the results into the output
-// Input: an uncompressed binary PCD or a binary PLY cloud (other encodings cannot be read in
-// pieces). Output: binary PCD or binary PLY, by extension.
+/** \file
+ * The fitted estimators on a cloud file larger than memory: the file is read a piece at a time,
+ * cut into tiles (tile_plan.h), each tile fitted with its halo (tiled_local_fit.h), and the
+ * output written in the input's order with every input field and the new ones, so that the result
+ * equals the in-memory one value for value. Memory stays within a budget whatever the file's size:
+ *   1. a pass over the file for the bounds, a second for the point histogram the plan is cut from
+ *   2. a third writes every finite point (index, x, y, z) into its tile's file in a scratch folder
+ *      (beside plan.json: each tile can then be fitted by an independent worker)
+ *   3. each tile is gathered from the tile files its halo touches, fitted, and its results are
+ *      written at their points' places in a results file
+ *   4. a last pass joins the input's pieces and the results into the output
+ * Input: an uncompressed binary PCD or a binary PLY cloud (other encodings cannot be read in
+ * pieces). Output: binary PCD or binary PLY, by extension.
+ */
 #include <pcl/PCLPointCloud2.h>
 
 #include <cstdint>

@@ -1,11 +1,13 @@
 #pragma once
-// Spatial tiles of a point cloud, so that it can be processed piece by piece: out of core, or by
-// independent workers. A plan is cut from a histogram of the points on a regular grid over their
-// bounding box (one streaming pass over a file fills it): boxes of grid cells are halved along
-// their longest side, at the cell boundary nearest the median, until each holds at most the
-// requested number of points. Every finite point belongs to exactly one tile (its cell's); a tile
-// is processed with a halo, the points around it within a margin, for the neighbourhoods of its
-// points near the border.
+/** \file
+ * Spatial tiles of a point cloud, so that it can be processed piece by piece: out of core, or by
+ * independent workers. A plan is cut from a histogram of the points on a regular grid over their
+ * bounding box (one streaming pass over a file fills it): boxes of grid cells are halved along
+ * their longest side, at the cell boundary nearest the median, until each holds at most the
+ * requested number of points. Every finite point belongs to exactly one tile (its cell's); a tile
+ * is processed with a halo, the points around it within a margin, for the neighbourhoods of its
+ * points near the border.
+ */
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <string>

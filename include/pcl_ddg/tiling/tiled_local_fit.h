@@ -1,13 +1,15 @@
 #pragma once
-// The fitted estimators (PCA, quadric) run tile by tile, with the same result as on the whole
-// cloud, bit for bit: each tile is processed with a halo that holds every point's whole
-// neighbourhood, and the kd-tree breaks distance ties by point index, so a tile (indexed in the
-// cloud's order) finds exactly the neighbours, in the order, that the whole cloud does.
-//   k nearest  the halo is set so that (nearly) every own point's k-th neighbour lies inside it,
-//              by a margin above float rounding (a first guess from the tile before, widened when
-//              more than 1% of the points look farther); the few points that look farther still
-//              (outliers, the rim of a dense cluster) are fitted with the points around them alone
-//   radius     the halo is the radius (with max_neighbours too: those are cut from the ball)
+/** \file
+ * The fitted estimators (PCA, quadric) run tile by tile, with the same result as on the whole
+ * cloud, bit for bit: each tile is processed with a halo that holds every point's whole
+ * neighbourhood, and the kd-tree breaks distance ties by point index, so a tile (indexed in the
+ * cloud's order) finds exactly the neighbours, in the order, that the whole cloud does.
+ *   k nearest  the halo is set so that (nearly) every own point's k-th neighbour lies inside it,
+ *              by a margin above float rounding (a first guess from the tile before, widened when
+ *              more than 1% of the points look farther); the few points that look farther still
+ *              (outliers, the rim of a dense cluster) are fitted with the points around them alone
+ *   radius     the halo is the radius (with max_neighbours too: those are cut from the ball)
+ */
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
