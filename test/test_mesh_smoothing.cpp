@@ -22,6 +22,8 @@ namespace pcl_ddg {
 namespace test {
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+
 // Parameters for scheme and weights with a step relative to the mesh: explicit as a fraction of
 // its stability bound, implicit in units of h^2.
 MeshSmoothingParameters relativeStep(SmoothingScheme scheme, LaplacianWeights weights,
@@ -153,6 +155,37 @@ TEST(MeshSmoothing, SmoothingANoisySphereBringsItCloserToTheSphereInTheFirstStep
       EXPECT_LT(after_two, after_one);
     }
   }
+}
+
+// The two measures the preservation rescales by, against closed forms: a box a x b x c (12
+// outward triangles) has volume abc and area 2(ab + bc + ca), wherever it sits; an icosphere of
+// radius r is inscribed in the sphere, so its volume and area lie below 4/3 pi r^3 and 4 pi r^2,
+// within the O(h^2) of the chords (0.3 % and 0.2 % at level 4).
+TEST(MeshSmoothing, VolumeAndAreaOfABoxAndASphereAreTheirClosedForms) {
+  const double a = 2.0, b = 3.0, c = 5.0;
+  Eigen::Matrix3Xd box(3, 8);
+  for (int i = 0; i < 8; ++i) {
+    box.col(i) = Eigen::Vector3d((i & 1) * a, (i >> 1 & 1) * b, (i >> 2 & 1) * c) +
+                 Eigen::Vector3d(1e5, -2e5, 300.0);
+  }
+  // Each face wound counter-clockwise seen from outside.
+  const Eigen::Matrix3Xi faces = (Eigen::Matrix3Xi(3, 12) << 0, 0, 4, 4, 0, 0, 2, 2, 0, 0, 1, 1, 2,
+                                  3, 5, 7, 1, 5, 6, 7, 4, 6, 3, 7,  //
+                                  3, 1, 7, 6, 5, 4, 7, 3, 6, 2, 7, 5)
+                                     .finished();
+  const MeshTopology box_topology(8, faces);
+  ASSERT_EQ(box_topology.counts().boundary_edges, 0);
+  EXPECT_NEAR(enclosedVolume(box_topology, box), a * b * c, 1e-9 * a * b * c);
+  EXPECT_NEAR(surfaceArea(box_topology, box), 2 * (a * b + b * c + c * a), 1e-9);
+
+  const double r = 2.5;
+  const SurfaceSample sphere = makeIcosphere(4, r);
+  const MeshTopology t(static_cast<int>(sphere.points.cols()), sphere.triangles);
+  const double volume = enclosedVolume(t, sphere.points), area = surfaceArea(t, sphere.points);
+  EXPECT_LT(volume, 4.0 / 3.0 * kPi * r * r * r);
+  EXPECT_GT(volume, 0.995 * 4.0 / 3.0 * kPi * r * r * r);
+  EXPECT_LT(area, 4.0 * kPi * r * r);
+  EXPECT_GT(area, 0.995 * 4.0 * kPi * r * r);
 }
 
 TEST(MeshSmoothing, VolumeAndAreaArePreservedWhenAsked) {
