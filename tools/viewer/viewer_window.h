@@ -22,6 +22,7 @@ class vtkProperty;
 class vtkScalarBarActor;
 class vtkTextActor;
 class vtkRenderWindowInteractor;
+class vtkRenderer;
 
 namespace pcl_ddg {
 namespace viewer {
@@ -55,6 +56,8 @@ class ViewerWindow {
   bool culledBackFaces() const;
 
  private:
+  /** The visualizer's renderer (viewer_scene.cpp, with the rest of the scene). */
+  vtkRenderer* sceneRenderer() const;
   void onKey(const pcl::visualization::KeyboardEvent& event);
   /** Dispatches the pending X events and VTK timers, waiting at most kEventWaitMs for one. */
   void processEvents();
