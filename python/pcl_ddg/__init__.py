@@ -1,0 +1,611 @@
+"""pcl_ddg: discrete differential geometry of meshes and point clouds on NumPy arrays.
+
+Free functions on arrays, as libigl and point-cloud-utils users expect:
+
+* meshes take ``V`` (n x 3) and ``F`` (m x 3 int32/int64, or a list of polygons, which are
+  fan-triangulated): :func:`vertex_normals`, :func:`laplacian`, :func:`mass_matrix`,
+  :func:`curvatures`, :func:`mesh_report`, :func:`smooth`, :func:`smooth_field`;
+* clouds take ``points`` (n x 3, or an organized h x w x 3 grid): :func:`estimate_normals`,
+  :func:`principal_curvatures`, :func:`grid_normals`, :func:`orient_normals`,
+  :func:`compare_neighbourhoods`;
+* files: :func:`read` and :func:`write` (PLY, OBJ, OFF, STL, VTK, PCD in; PLY and PCD out).
+
+Conventions, the same as the C++ library and the ``pcl_ddg_*`` tools:
+
+* keyword names and defaults are the tools' flags (``pcl_ddg_normals -method pca -k 16`` is
+  ``estimate_normals(points, method="pca", k=16)``);
+* rows are never dropped: a vertex or point without a result gets NaN, and ``valid`` says which;
+* float64 C-contiguous input is read in place; float32, integer and non-contiguous arrays are
+  converted once; every output is float64; results are bit-identical to the C++ library's;
+* the GIL is released during every computation, so Python threads run in parallel;
+* errors: ``ValueError`` for shapes, dtypes, out-of-range faces and options;
+  :class:`InvalidMeshError` (a ``ValueError``) for meshes the library refuses (empty, NaN vertices);
+  ``OSError`` for files; ``RuntimeError`` for failed computations (:class:`SurfaceCollapseError`
+  when a smoothing step collapses the surface). The library's message is kept.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _pcl_ddg
+from ._pcl_ddg import InvalidMeshError, SurfaceCollapseError
+
+__version__: str = _pcl_ddg.__version__
+
+__all__ = [
+    "InvalidMeshError",
+    "SurfaceCollapseError",
+    "VertexNormals",
+    "Curvatures",
+    "Normals",
+    "PrincipalCurvatures",
+    "OrientedNormals",
+    "NeighbourhoodComparison",
+    "MeshFile",
+    "vertex_normals",
+    "laplacian",
+    "mass_matrix",
+    "curvatures",
+    "mesh_report",
+    "smooth",
+    "smooth_field",
+    "estimate_normals",
+    "principal_curvatures",
+    "grid_normals",
+    "orient_normals",
+    "compare_neighbourhoods",
+    "read",
+    "write",
+]
+
+ArrayLike = Any
+Faces = Union[np.ndarray, Sequence[Sequence[int]]]
+Vector3 = Optional[Sequence[float]]
+
+
+def _array(value: ArrayLike, name: str) -> np.ndarray:
+    """value as an ndarray without a copy when it is one already (the binding converts once)."""
+    if isinstance(value, np.ndarray):
+        return value
+    try:
+        return np.asarray(value)
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"{name} must be an array: {error}") from None
+
+
+def _faces(F: Faces) -> Any:
+    if isinstance(F, np.ndarray):
+        return F
+    if isinstance(F, (list, tuple)):
+        # A rectangular list of lists is an array; ragged polygons stay a list.
+        lengths = {len(p) if hasattr(p, "__len__") else -1 for p in F}
+        if len(lengths) == 1 and -1 not in lengths:
+            array = np.asarray(F)
+            if array.dtype.kind in "iu" or array.size == 0:
+                return array.astype(np.int64, copy=False).reshape(len(F), -1)
+        return list(F)
+    raise ValueError("F must be an (m, 3) integer array or a sequence of polygons")
+
+
+def _vector(value: Vector3, name: str) -> Optional[List[float]]:
+    if value is None:
+        return None
+    v = np.asarray(value, dtype=np.float64).ravel()
+    if v.shape != (3,):
+        raise ValueError(f"{name} must be three numbers x, y, z")
+    return [float(x) for x in v]
+
+
+# ---------------------------------------------------------------------------------------------
+# Meshes
+
+
+class VertexNormals(NamedTuple):
+    """Per-vertex normals: unit rows, NaN where ``valid`` is False."""
+
+    normals: np.ndarray  #: (n, 3) float64
+    valid: np.ndarray  #: (n,) bool
+
+
+def vertex_normals(
+    V: ArrayLike,
+    F: Faces,
+    weighting: str = "area",
+    epsilon: Optional[float] = None,
+    mass: str = "mixed",
+) -> VertexNormals:
+    """Normals of a triangle mesh, oriented like its faces (``pcl_ddg_normals -method ...``).
+
+    weighting:
+        ``"area"`` (sum of the triangles' area vectors; the default), ``"uniform"`` (every face
+        the same), ``"angle"`` (unit face normals weighted by the corner angle), or
+        ``"mean_curvature"`` (the direction of -M^-1 L x, the area normal where the surface is
+        flat (|M^-1 L x| < epsilon) and on the boundary).
+    epsilon:
+        ``mean_curvature`` only: the flatness threshold in 1/length; None: 0.02 / mean edge length.
+    mass:
+        the vertex areas M of ``mean_curvature``: ``"mixed"``, ``"voronoi"``, ``"barycentric"``.
+
+    Vertices with no non-degenerate triangle, or whose face normals cancel, get NaN and
+    ``valid=False``.
+    """
+    normals, valid, _ = _pcl_ddg.vertex_normals(_array(V, "V"), _faces(F), weighting, epsilon, mass)
+    return VertexNormals(normals, valid)
+
+
+def _csr(data: np.ndarray, indices: np.ndarray, indptr: np.ndarray) -> Any:
+    from scipy import sparse
+
+    n = indptr.shape[0] - 1
+    return sparse.csr_matrix((data, indices, indptr), shape=(n, n), copy=False)
+
+
+def laplacian(
+    V: ArrayLike, F: Faces, weights: str = "cotan", form: str = "summed", mass: str = "mixed"
+) -> Any:
+    """The discrete Laplace-Beltrami operator L as a ``scipy.sparse.csr_matrix`` (n x n).
+
+    L is NEGATIVE semi-definite: off-diagonal ``L[i, j] = w_ij`` for every edge ij, diagonal
+    ``L[i, i] = -sum_j w_ij``, so ``L @ ones = 0`` and ``(L x)_i = sum_j w_ij (x_j - x_i)``.
+    (libigl's ``cotmatrix`` uses the same sign; potpourri3d's ``cotan_laplacian`` and
+    robust_laplacian return the POSITIVE semi-definite -L.)
+
+    weights:
+        ``"cotan"``: ``w_ij = (cot a_ij + cot b_ij) / 2`` over the angles opposite edge ij (one
+        cotangent on a boundary edge); ``"uniform"``: ``w_ij = 1``.
+    form:
+        ``"summed"``: L itself, symmetric (the stiffness matrix, used with :func:`mass_matrix`);
+        ``"averaged"``: ``M^-1 L``, a pointwise Laplacian (``M^-1 L x ~ -2 H n`` with cotan
+        weights); rows of zero-mass vertices are zero.
+    mass:
+        M of the averaged form: ``"mixed"``, ``"voronoi"`` or ``"barycentric"``.
+    """
+    data, indices, indptr = _pcl_ddg.laplacian(_array(V, "V"), _faces(F), weights, form, mass)
+    return _csr(data, indices, indptr)
+
+
+def mass_matrix(V: ArrayLike, F: Faces, kind: str = "mixed") -> Any:
+    """The lumped (diagonal) mass matrix M as a ``scipy.sparse.csr_matrix``: vertex areas.
+
+    kind:
+        ``"mixed"`` (Meyer et al. 2003's mixed Voronoi areas, never negative; the default),
+        ``"voronoi"`` (circumcentric cells, negative contributions on obtuse triangles) or
+        ``"barycentric"`` (a third of every incident triangle).
+
+    The masses sum to the total area for every kind.
+    """
+    area = _pcl_ddg.mass_matrix(_array(V, "V"), _faces(F), kind)
+    n = area.shape[0]
+    index = np.arange(n, dtype=np.int32)
+    return _csr(area, index, np.arange(n + 1, dtype=np.int32))
+
+
+class Curvatures(NamedTuple):
+    """Discrete curvatures per vertex (NaN where the vertex has no area or no orientation)."""
+
+    mean: np.ndarray  #: H, > 0 on an outward-oriented sphere
+    gauss: np.ndarray  #: K density: angle defect / vertex area
+    k1: np.ndarray  #: H + sqrt(max(H^2 - K, 0)), k1 >= k2
+    k2: np.ndarray  #: H - sqrt(max(H^2 - K, 0))
+    area: np.ndarray  #: the vertex area used (mixed Voronoi by default)
+
+    @property
+    def valid(self) -> np.ndarray:
+        """Vertices with a curvature (the library's mask: finite H)."""
+        return np.isfinite(self.mean)
+
+
+def curvatures(V: ArrayLike, F: Faces, mass: str = "mixed") -> Curvatures:
+    """Mean, Gaussian and principal curvatures of a mesh (``pcl_ddg_curvature -method cotan``).
+
+    H from the cotangent Laplacian (``Hn = -1/2 M^-1 L x``, signed by the area normal), K from the
+    angle defect (2 pi - sum of angles inside, pi - sum on the boundary) over the vertex area, so
+    that ``sum(gauss * area) = 2 pi chi`` (Gauss-Bonnet). ``mass`` (the ``-area`` flag): ``"mixed"``,
+    ``"voronoi"``, ``"barycentric"``.
+    """
+    mean, gauss, k1, k2, area, _, _ = _pcl_ddg.curvatures(_array(V, "V"), _faces(F), mass)
+    return Curvatures(mean, gauss, k1, k2, area)
+
+
+def mesh_report(V: ArrayLike, F: Faces) -> Dict[str, Any]:
+    """Everything worth knowing about a mesh before trusting numbers computed on it.
+
+    The dict of ``pcl_ddg_info -json``: counts of degenerate, duplicate, out-of-range and
+    triangulated faces, boundary edges and loops, non-manifold edges and vertices, unreferenced
+    and non-finite vertices, components, Euler characteristic, genus, orientability, mean edge
+    length and bounding box. Defects are counted, never refused.
+    """
+    return json.loads(_pcl_ddg.mesh_report(_array(V, "V"), _faces(F)))
+
+
+def smooth(
+    V: ArrayLike,
+    F: Faces,
+    method: str = "implicit",
+    weights: str = "cotan",
+    mass: str = "mixed",
+    lambda_dt: Optional[float] = None,
+    iterations: int = 1,
+    absolute_time: bool = False,
+    freeze_weights: bool = False,
+    rebuild_weights: bool = False,
+    fix_boundary: bool = False,
+    allow_unstable: bool = False,
+    preserve: str = "none",
+    solver: str = "auto",
+) -> np.ndarray:
+    """Laplacian smoothing of the vertex positions (``pcl_ddg_smooth``): dx/dt = M^-1 L x.
+
+    method:
+        ``"implicit"`` (backward Euler, stable for any step) or ``"explicit"`` (forward Euler,
+        stable only below a bound; a larger step raises ValueError unless ``allow_unstable``).
+    lambda_dt:
+        the time step in units of h^2 (h = mean edge length), or in length^2 with
+        ``absolute_time=True``. Default: 1 (implicit), half the stability bound (explicit).
+    freeze_weights / rebuild_weights:
+        by default L is frozen at the input and M follows the surface; ``freeze_weights`` freezes
+        both, ``rebuild_weights`` rebuilds both every iteration (the singular mean-curvature flow).
+    fix_boundary: boundary vertices keep their position.
+    preserve: ``"none"``, ``"volume"`` (closed meshes) or ``"area"``: rescale after every step.
+    solver: ``"auto"``, ``"cholmod"``, ``"ldlt"`` or ``"cg"`` (conjugate gradients).
+
+    Returns the smoothed (n, 3) positions; Ctrl-C interrupts between iterations. A step that
+    collapses the surface raises :class:`SurfaceCollapseError`.
+    """
+    return _pcl_ddg.smooth(
+        _array(V, "V"),
+        _faces(F),
+        method,
+        weights,
+        mass,
+        lambda_dt,
+        int(iterations),
+        bool(absolute_time),
+        bool(freeze_weights),
+        bool(rebuild_weights),
+        bool(fix_boundary),
+        bool(allow_unstable),
+        preserve,
+        solver,
+    )
+
+
+def smooth_field(
+    V: ArrayLike,
+    F: Faces,
+    values: ArrayLike,
+    time: float,
+    method: str = "implicit",
+    weights: str = "cotan",
+    mass: str = "mixed",
+    iterations: int = 1,
+    absolute_time: bool = False,
+    fix_boundary: bool = False,
+    solver: str = "auto",
+) -> np.ndarray:
+    """Heat flow of per-vertex values on the fixed mesh: df/dt = Laplace-Beltrami(f).
+
+    values: (n,) or (n, c) (every column smoothed). time: the diffusion time in units of h^2
+    (as ``pcl_ddg_curvature -smooth t``), or in length^2 with ``absolute_time=True``; detail
+    below a wavelength of about 2 pi sqrt(time) is gone. The mass-weighted sum is conserved on a
+    closed mesh; a free boundary is insulated, a fixed one (``fix_boundary``) keeps its values.
+    """
+    return _pcl_ddg.smooth_field(
+        _array(V, "V"),
+        _faces(F),
+        _array(values, "values"),
+        float(time),
+        method,
+        weights,
+        mass,
+        int(iterations),
+        bool(absolute_time),
+        bool(fix_boundary),
+        solver,
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# Clouds
+
+
+class Normals(NamedTuple):
+    """Fitted normals: NaN rows where ``valid`` is False (too few neighbours, NaN points)."""
+
+    normals: np.ndarray  #: (n, 3), or (h, w, 3) for an organized cloud
+    curvature: np.ndarray  #: PCL's surface variation l0 / (l0 + l1 + l2) (pca)
+    valid: np.ndarray  #: bool
+
+
+def estimate_normals(
+    points: ArrayLike,
+    method: str = "pca",
+    k: Optional[int] = None,
+    radius: Optional[float] = None,
+    max_nn: Optional[int] = None,
+    min_nn: Optional[int] = None,
+    neighbours: Optional[str] = None,
+    faces: Optional[Faces] = None,
+    viewpoint: Vector3 = None,
+    orient: Optional[str] = None,
+    up: Vector3 = None,
+    max_depth_jump: Optional[float] = None,
+    threads: int = 0,
+) -> Normals:
+    """Normals by fitting a plane (``"pca"``) or a quadric (``"quadric"``) to each point's
+    neighbours (``pcl_ddg_normals -method pca|quadric``).
+
+    points: (n, 3), or (h, w, 3) for an organized cloud (kept: the output has its grid).
+    k: neighbours (default 16, quadric 20; at least 3, at most the point count).
+    radius: a radius search instead of k, keeping at most ``max_nn`` (default 64) nearest;
+        ``min_nn``: the min_nn nearest where the ball holds fewer.
+    neighbours: ``"knn"`` (kd-tree; clouds' default), ``"bfs"`` (rings of the mesh ``faces``; the
+        default when faces are given) or ``"grid"`` (an organized cloud's pixels; its default,
+        never across a depth jump above ``max_depth_jump``, default 0.02).
+    viewpoint: the sensor: normals face it (default the origin, as PCL).
+    orient: ``"viewpoint"`` (clouds' default), ``"mesh"`` (like the faces; meshes' default),
+        ``"up"`` (n . up >= 0; ``up`` default +z) or ``"mst"`` (consistent along a minimum
+        spanning tree; the viewpoint or ``up`` decides every sign it can).
+    threads: 0 for every core.
+
+    PCL's point types are float: the points are rounded to float as the tools read them.
+    """
+    normals, curvature, valid, _ = _pcl_ddg.estimate_normals(
+        _array(points, "points"),
+        method,
+        k,
+        radius,
+        max_nn,
+        min_nn,
+        neighbours,
+        None if faces is None else _faces(faces),
+        _vector(viewpoint, "viewpoint"),
+        orient,
+        _vector(up, "up"),
+        max_depth_jump,
+        int(threads),
+    )
+    return Normals(normals, curvature, valid)
+
+
+class PrincipalCurvatures(NamedTuple):
+    """Principal curvatures of a quadric fitted at each point (NaN where ``valid`` is False)."""
+
+    k1: np.ndarray  #: k1 >= k2, signed like the normal
+    k2: np.ndarray
+    direction1: np.ndarray  #: (n, 3) unit direction of k1
+    normals: np.ndarray  #: (n, 3)
+    valid: np.ndarray  #: bool
+
+
+def principal_curvatures(
+    points: ArrayLike,
+    k: Optional[int] = None,
+    radius: Optional[float] = None,
+    max_nn: Optional[int] = None,
+    min_nn: Optional[int] = None,
+    neighbours: Optional[str] = None,
+    faces: Optional[Faces] = None,
+    viewpoint: Vector3 = None,
+    orient: Optional[str] = None,
+    up: Vector3 = None,
+    threads: int = 0,
+) -> PrincipalCurvatures:
+    """k1, k2, the k1 direction and the normal of a quadric fitted to each point's neighbours
+    (``pcl_ddg_curvature -method quadric``; k default 20). Options as :func:`estimate_normals`.
+    Mean curvature is ``(k1 + k2) / 2``, Gaussian ``k1 * k2``.
+    """
+    k1, k2, direction, normals, valid, _ = _pcl_ddg.principal_curvatures(
+        _array(points, "points"),
+        k,
+        radius,
+        max_nn,
+        min_nn,
+        neighbours,
+        None if faces is None else _faces(faces),
+        _vector(viewpoint, "viewpoint"),
+        orient,
+        _vector(up, "up"),
+        int(threads),
+    )
+    return PrincipalCurvatures(k1, k2, direction, normals, valid)
+
+
+def grid_normals(
+    xyz: ArrayLike,
+    k: int = 16,
+    max_depth_jump: Optional[float] = None,
+    viewpoint: Vector3 = None,
+    orient: Optional[str] = None,
+    threads: int = 0,
+) -> Normals:
+    """PCA normals of an organized cloud (an RGB-D frame, a range image) of shape (h, w, 3).
+
+    Each pixel's plane is fitted to the smallest square window of at least k pixels, from
+    windowed sums, never across a depth jump (a range change above ``max_depth_jump``, default
+    0.02, times the range per pixel). NaN pixels stay NaN. The result keeps the (h, w) grid.
+    """
+    xyz = _array(xyz, "xyz")
+    if xyz.ndim != 3 or xyz.shape[-1] != 3:
+        raise ValueError(f"xyz must have shape (h, w, 3), not {xyz.shape}")
+    return estimate_normals(
+        xyz,
+        method="pca",
+        k=k,
+        neighbours="grid",
+        max_depth_jump=max_depth_jump,
+        viewpoint=viewpoint,
+        orient=orient,
+        threads=threads,
+    )
+
+
+class OrientedNormals(NamedTuple):
+    normals: np.ndarray  #: (n, 3), the input's rows, some negated
+    flipped: int  #: how many were turned
+
+
+def orient_normals(
+    points: ArrayLike,
+    normals: ArrayLike,
+    method: str = "mst",
+    viewpoint: Vector3 = None,
+    up: Vector3 = None,
+    k: int = 10,
+    faces: Optional[Faces] = None,
+) -> OrientedNormals:
+    """Turns normals to one consistent side; only signs change (the values are the input's).
+
+    method:
+        ``"mst"``: along a minimum spanning tree of the k-nearest graph (or of the mesh ``faces``),
+        weighted by 1 - |n_i . n_j| (Hoppe et al. 1992); with ``viewpoint`` or ``up`` the reference
+        decides every point it can (|n . d| >= 0.1) and the tree the rest, else each component's
+        highest point faces +z. ``"viewpoint"``: n . (viewpoint - p) >= 0 (default the origin).
+        ``"up"``: n . up >= 0 (default +z).
+    """
+    out, flipped = _pcl_ddg.orient_normals(
+        _array(points, "points"),
+        _array(normals, "normals"),
+        method,
+        _vector(viewpoint, "viewpoint"),
+        _vector(up, "up"),
+        int(k),
+        None if faces is None else _faces(faces),
+    )
+    return OrientedNormals(out, flipped)
+
+
+class NeighbourhoodComparison(NamedTuple):
+    angle_difference: np.ndarray  #: degrees between the two normals, NaN where either failed
+    overlap: np.ndarray  #: Jaccard overlap of the two neighbour sets, in [0, 1]
+    summary: Dict[str, float]  #: compared, mean, median, percentile95, max, share_over_5, ...
+
+
+def compare_neighbourhoods(
+    V: ArrayLike,
+    F: Optional[Faces],
+    method: str = "pca",
+    k: Optional[int] = None,
+    radius: Optional[float] = None,
+    max_nn: Optional[int] = None,
+    threads: int = 0,
+) -> NeighbourhoodComparison:
+    """The same fit with topological (mesh rings; or an organized cloud's pixel grid when F is
+    None) and Euclidean (kd-tree) neighbourhoods, and how much they differ at every vertex
+    (``pcl_ddg_compare_neighbourhoods``; k default 16)."""
+    angle, overlap, summary = _pcl_ddg.compare_neighbourhoods(
+        _array(V, "V"), None if F is None else _faces(F), method, k, radius, max_nn, int(threads)
+    )
+    return NeighbourhoodComparison(angle, overlap, summary)
+
+
+# ---------------------------------------------------------------------------------------------
+# Files
+
+
+class MeshFile:
+    """A file's contents: ``points`` (n, 3) float64 (the file's doubles exactly where it stores
+    doubles), ``faces`` ((m, 3) int32, a list of polygons, or None for a cloud), ``fields`` (every
+    other vertex property by name, in its own dtype; colours as ``"rgb"`` uint8 (n, 3)),
+    ``viewpoint`` (a PCD's VIEWPOINT origin; zeros otherwise), ``orientation`` (its rotation, w x
+    y z), ``organized_shape`` ((h, w) of an organized cloud, else None) and ``precision`` (the
+    declared coordinate type, ``"float"`` or ``"double"``)."""
+
+    __slots__ = ("points", "faces", "fields", "viewpoint", "orientation", "organized_shape", "precision")
+
+    def __init__(
+        self,
+        points: np.ndarray,
+        faces: Optional[Union[np.ndarray, List[np.ndarray]]],
+        fields: Dict[str, np.ndarray],
+        viewpoint: np.ndarray,
+        orientation: np.ndarray,
+        organized_shape: Optional[Tuple[int, int]],
+        precision: str,
+    ) -> None:
+        self.points = points
+        self.faces = faces
+        self.fields = fields
+        self.viewpoint = viewpoint
+        self.orientation = orientation
+        self.organized_shape = organized_shape
+        self.precision = precision
+
+    @property
+    def grid(self) -> np.ndarray:
+        """The points of an organized cloud as an (h, w, 3) view."""
+        if self.organized_shape is None:
+            raise ValueError("not an organized cloud")
+        return self.points.reshape(*self.organized_shape, 3)
+
+    def __repr__(self) -> str:
+        faces = "None" if self.faces is None else str(len(self.faces))
+        return (
+            f"MeshFile(points={self.points.shape[0]}, faces={faces}, fields={sorted(self.fields)}, "
+            f"organized_shape={self.organized_shape})"
+        )
+
+
+def _path(path: Union[str, "os.PathLike[str]"]) -> str:
+    return os.fspath(path)
+
+
+def read(path: Union[str, "os.PathLike[str]"]) -> MeshFile:
+    """Reads a mesh or a cloud: .ply (ascii/binary; face, tristrips, range_grid), .obj, .off
+    (also binary), .stl, .vtk (legacy POLYDATA), .pcd (organized or not). OSError if the file
+    is missing, unknown or malformed."""
+    path = _path(path)
+    if not os.path.exists(path):
+        import errno
+
+        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), path)
+    points, faces, fields, viewpoint, orientation, shape, precision = _pcl_ddg.read(path)
+    return MeshFile(
+        points,
+        faces,
+        fields,
+        np.array(viewpoint, dtype=np.float64),
+        np.array(orientation, dtype=np.float64),
+        shape,
+        precision,
+    )
+
+
+def write(
+    path: Union[str, "os.PathLike[str]"],
+    points: ArrayLike,
+    faces: Optional[Faces] = None,
+    fields: Optional[Dict[str, ArrayLike]] = None,
+    viewpoint: Vector3 = None,
+    precision: Optional[str] = None,
+    encoding: str = "binary",
+    organized_shape: Optional[Tuple[int, int]] = None,
+) -> None:
+    """Writes a .ply (binary, or ``encoding="ascii"``) or a .pcd (binary_compressed; faces are
+    not stored), atomically (a failed write leaves no file).
+
+    fields: per-vertex values by name, (n,) each; ``"normals"`` (n, 3) becomes nx ny nz (PLY) or
+    normal_x normal_y normal_z (PCD); ``"rgb"`` uint8 (n, 3) the colours; another (n, c) array
+    becomes name_0 .. name_{c-1}. precision: ``"float"`` or ``"double"``; None (default) keeps
+    every value exact (double where float would round a float64 value). viewpoint: a PCD's
+    VIEWPOINT. organized_shape: (h, w) of an organized cloud (h * w = n).
+    """
+    points = _array(points, "points")
+    if points.ndim == 3 and organized_shape is None:
+        organized_shape = (points.shape[0], points.shape[1])
+        points = points.reshape(-1, points.shape[-1])
+    _pcl_ddg.write(
+        _path(path),
+        points,
+        None if faces is None else _faces(faces),
+        None if fields is None else dict(fields),
+        _vector(viewpoint, "viewpoint"),
+        precision,
+        encoding,
+        None if organized_shape is None else (int(organized_shape[0]), int(organized_shape[1])),
+    )

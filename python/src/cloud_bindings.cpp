@@ -1,0 +1,402 @@
+// Point cloud functions: fitted normals and curvatures (pca, quadric) with kd-tree, mesh-ring or
+// pixel-grid neighbourhoods, orientation, and the neighbourhood comparison. The points become PCL's
+// float points by the cast the tools make (double -> float), so results equal the tools'.
+#include <pcl/exceptions.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "binding_common.h"
+#include "pcl_ddg/features/consistent_orientation.h"
+#include "pcl_ddg/features/local_fit.h"
+#include "pcl_ddg/features/neighbourhood_comparison.h"
+
+namespace pcl_ddg {
+namespace python {
+
+namespace {
+
+using Cloud = pcl::PointCloud<pcl::PointXYZ>;
+
+template <typename T>
+bool readPoints(const py::array& array, Cloud& cloud) {
+  const py::dtype dtype = py::dtype::of<T>();
+  if (dtype.kind() != array.dtype().kind() || dtype.itemsize() != array.dtype().itemsize())
+    return false;
+  const auto* base = static_cast<const char*>(array.data());
+  const int nd = static_cast<int>(array.ndim());
+  const py::ssize_t s_row = array.strides(nd == 3 ? 1 : 0), s_coord = array.strides(nd - 1);
+  const py::ssize_t s_grid = nd == 3 ? array.strides(0) : 0;
+  const std::size_t width = cloud.width;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const char* row = base + static_cast<py::ssize_t>(i / width) * s_grid +
+                      static_cast<py::ssize_t>(i % width) * s_row;
+    for (int d = 0; d < 3; ++d) {
+      // Through double, as the tools read a file (exact for every type but 64-bit integers).
+      cloud[i].data[d] =
+          static_cast<float>(static_cast<double>(*reinterpret_cast<const T*>(row + d * s_coord)));
+    }
+  }
+  return true;
+}
+
+// (n, 3) or organized (h, w, 3) points as PCL's float points, is_dense when all are finite.
+Cloud::Ptr cloudOf(const py::array& points) {
+  const int nd = static_cast<int>(points.ndim());
+  if ((nd != 2 && nd != 3) || points.shape(nd - 1) != 3)
+    throw py::value_error("points must have shape (n, 3) or (h, w, 3)");
+  const char kind = points.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u')
+    throw py::value_error("points must hold real numbers, not " +
+                          std::string(py::str(points.dtype())));
+  if (points.size() / 3 > std::numeric_limits<int>::max())
+    throw py::value_error("points has more rows than the library indexes");
+  auto cloud = std::make_shared<Cloud>();
+  const auto height = nd == 3 ? static_cast<std::uint32_t>(points.shape(0)) : 1u;
+  const auto width = static_cast<std::uint32_t>(nd == 3 ? points.shape(1) : points.shape(0));
+  cloud->resize(static_cast<std::size_t>(width) * height);
+  cloud->width = width;
+  cloud->height = height;
+  if (cloud->empty()) throw py::value_error("points is empty");
+  py::array source = points;
+  if (points.dtype().byteorder() == '>')
+    source = py::array_t<double, py::array::forcecast>::ensure(points);
+  if (!(readPoints<double>(source, *cloud) || readPoints<float>(source, *cloud) ||
+        readPoints<std::int64_t>(source, *cloud) || readPoints<std::int32_t>(source, *cloud) ||
+        readPoints<std::uint64_t>(source, *cloud) || readPoints<std::uint32_t>(source, *cloud) ||
+        readPoints<std::int16_t>(source, *cloud) || readPoints<std::uint16_t>(source, *cloud) ||
+        readPoints<std::int8_t>(source, *cloud) || readPoints<std::uint8_t>(source, *cloud))) {
+    const auto converted = py::array_t<double, py::array::forcecast>::ensure(points);
+    readPoints<double>(converted, *cloud);
+  }
+  bool dense = true;
+  for (const pcl::PointXYZ& p : *cloud)
+    dense = dense && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+  cloud->is_dense = dense;
+  return cloud;
+}
+
+std::optional<Eigen::Vector3d> vectorOf(const std::optional<std::vector<double>>& v,
+                                        const char* name) {
+  if (!v) return std::nullopt;
+  if (v->size() != 3) throw py::value_error(std::string(name) + " must be three numbers x, y, z");
+  const Eigen::Vector3d out(v->data());
+  if (!out.allFinite()) throw py::value_error(std::string(name) + " must be finite");
+  return out;
+}
+
+std::optional<Eigen::Vector3d> directionOf(const std::optional<std::vector<double>>& v) {
+  std::optional<Eigen::Vector3d> up = vectorOf(v, "up");
+  if (up && !(up->norm() > 0.0)) throw py::value_error("up needs a non-zero direction");
+  if (up) up->normalize();
+  return up;
+}
+
+// The output's shape: (n, c) for an (n, 3) input, (h, w, c) for a grid; c = 0 for (n,) / (h, w).
+std::vector<py::ssize_t> shapeOf(const Cloud& cloud, py::ssize_t columns) {
+  std::vector<py::ssize_t> shape;
+  if (cloud.height > 1) {
+    shape = {static_cast<py::ssize_t>(cloud.height), static_cast<py::ssize_t>(cloud.width)};
+  } else {
+    shape = {static_cast<py::ssize_t>(cloud.size())};
+  }
+  if (columns > 0) shape.push_back(columns);
+  return shape;
+}
+
+py::array_t<double> normalsArray(const Cloud& cloud, const pcl::PointCloud<pcl::Normal>& normals) {
+  py::array_t<double> out(shapeOf(cloud, 3));
+  double* data = out.mutable_data();
+  for (std::size_t i = 0; i < normals.size(); ++i) {
+    for (int d = 0; d < 3; ++d) data[3 * i + d] = static_cast<double>(normals[i].normal[d]);
+  }
+  return out;
+}
+
+struct FitArguments {
+  std::string method = "pca";
+  std::optional<int> k;
+  std::optional<double> radius;
+  std::optional<int> max_nn, min_nn;
+  std::optional<std::string> neighbours;
+  py::object faces = py::none();
+  std::optional<std::vector<double>> viewpoint;
+  std::optional<std::string> orient;
+  std::optional<std::vector<double>> up;
+  std::optional<double> max_depth_jump;
+  unsigned int threads = 0;
+};
+
+// The options of pcl_ddg_normals' in-memory path (localFitArguments), checked the same way.
+LocalFitOptions fitOptions(const FitArguments& a, Cloud& cloud,
+                           std::shared_ptr<const MeshTopology>& topology) {
+  LocalFitOptions options;
+  options.method = choice("method", a.method, {"pca", "quadric"}) == "quadric"
+                       ? LocalFitMethod::Quadric
+                       : LocalFitMethod::PCA;
+  if (a.k && a.radius)
+    throw py::value_error("k and radius exclude each other (use radius with max_nn for both)");
+  if (a.max_nn && !a.radius) throw py::value_error("max_nn needs radius");
+  if (a.min_nn && !a.radius) throw py::value_error("min_nn needs radius");
+  if (a.k && *a.k < 3) throw py::value_error("k must be at least 3");
+  if (a.max_nn && *a.max_nn < 3) throw py::value_error("max_nn must be at least 3");
+  if (a.min_nn && *a.min_nn < 3) throw py::value_error("min_nn must be at least 3");
+  if (a.radius && (!(*a.radius > 0.0) || !std::isfinite(*a.radius)))
+    throw py::value_error("radius must be a positive length");
+  if (a.max_depth_jump && !(*a.max_depth_jump > 0.0))
+    throw py::value_error("max_depth_jump must be > 0 (a relative range change per pixel)");
+  if (!a.faces.is_none()) {
+    if (cloud.height > 1) throw py::value_error("faces need points of shape (n, 3)");
+    for (const pcl::PointXYZ& p : cloud) {
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+        throw py::value_error("a mesh's vertices must be finite (faces were given)");
+    }
+    topology =
+        std::make_shared<const MeshTopology>(topologyOf(static_cast<int>(cloud.size()), a.faces));
+  }
+  const bool organized = !topology && cloud.height > 1;
+  const std::string neighbours = choice("neighbours",
+                                        a.neighbours.value_or(topology    ? "bfs"
+                                                              : organized ? "grid"
+                                                                          : "knn"),
+                                        {"knn", "bfs", "grid"});
+  if (neighbours == "bfs" && !topology)
+    throw py::value_error("neighbours='bfs' needs faces; these points are a cloud (use 'knn')");
+  if (neighbours == "grid" && !organized)
+    throw py::value_error("neighbours='grid' needs an organized cloud of shape (h, w, 3)");
+  if (a.max_depth_jump && neighbours != "grid")
+    throw py::value_error("max_depth_jump applies to neighbours='grid'");
+  options.neighbourhood = neighbours == "bfs"    ? NeighbourhoodKind::MeshRings
+                          : neighbours == "grid" ? NeighbourhoodKind::Grid
+                                                 : NeighbourhoodKind::KdTree;
+  if (a.max_depth_jump) options.max_depth_jump = *a.max_depth_jump;
+  options.k = a.k.value_or(options.method == LocalFitMethod::Quadric ? 20 : 16);
+  if (!a.radius && options.k > static_cast<int>(cloud.size())) {
+    throw py::value_error("k " + std::to_string(options.k) + " is more than the " +
+                          std::to_string(cloud.size()) + " points of the input");
+  }
+  if (a.radius) {
+    options.radius = *a.radius;
+    options.max_neighbours = static_cast<unsigned int>(a.max_nn.value_or(64));
+    options.min_neighbours = static_cast<unsigned int>(a.min_nn.value_or(0));
+  }
+  const std::string orient =
+      a.orient ? choice("orient", *a.orient, {"viewpoint", "up", "mst", "mesh"}) : "";
+  if (orient == "mesh" && !topology)
+    throw py::value_error("orient='mesh' needs faces; these points are a cloud");
+  if (a.up && orient != "up" && orient != "mst")
+    throw py::value_error("up applies to orient='up' and orient='mst'");
+  if (orient == "mst" && a.up && a.viewpoint)
+    throw py::value_error("orient='mst' takes one reference: viewpoint or up");
+  options.orientation = orient == "viewpoint" ? NormalOrientation::Viewpoint
+                        : orient == "up"      ? NormalOrientation::Up
+                        : orient == "mst"     ? NormalOrientation::SpanningTree
+                                              : NormalOrientation::MeshFaces;
+  // As the tool: the viewpoint is the sensor's (a PCD's VIEWPOINT), the origin by default.
+  options.viewpoint = vectorOf(a.viewpoint, "viewpoint").value_or(Eigen::Vector3d::Zero());
+  cloud.sensor_origin_.head<3>() = options.viewpoint->cast<float>();
+  options.up = directionOf(a.up);
+  options.seed_facing_viewpoint = !a.up && (a.viewpoint || cloud.height > 1);
+  options.threads = a.threads;
+  return options;
+}
+
+py::dict fitCounts(const LocalFitResult& result) {
+  py::dict counts;
+  counts["failed_points"] = result.failed_points;
+  counts["fallback_points"] = result.fallback_points;
+  counts["flipped_points"] = result.orientation.flipped_points;
+  return counts;
+}
+
+}  // namespace
+
+void bindClouds(py::module_& m) {
+  const auto fit = [](const py::array& points, const FitArguments& arguments, bool curvatures) {
+    Cloud::Ptr cloud = cloudOf(points);
+    std::shared_ptr<const MeshTopology> topology;
+    const LocalFitOptions options = fitOptions(arguments, *cloud, topology);
+    const LocalFitResult result =
+        compute([&] { return fitLocalSurfaces(cloud, topology, options); });
+    py::array_t<double> normals = normalsArray(*cloud, result.normals);
+    py::array_t<bool> valid(shapeOf(*cloud, 0));
+    bool* ok = valid.mutable_data();
+    const double* n = normals.data();
+    for (std::size_t i = 0; i < cloud->size(); ++i)
+      ok[i] = std::isfinite(n[3 * i]) && std::isfinite(n[3 * i + 1]) && std::isfinite(n[3 * i + 2]);
+    if (!curvatures) {
+      py::array_t<double> curvature(shapeOf(*cloud, 0));
+      double* c = curvature.mutable_data();
+      for (std::size_t i = 0; i < cloud->size(); ++i) c[i] = result.normals[i].curvature;
+      return py::make_tuple(normals, curvature, valid, fitCounts(result));
+    }
+    py::array_t<double> k1(shapeOf(*cloud, 0)), k2(shapeOf(*cloud, 0));
+    py::array_t<double> direction(shapeOf(*cloud, 3));
+    double *pc1 = k1.mutable_data(), *pc2 = k2.mutable_data(), *dir = direction.mutable_data();
+    for (std::size_t i = 0; i < cloud->size(); ++i) {
+      const pcl::PrincipalCurvatures& p = result.curvatures[i];
+      pc1[i] = p.pc1;
+      pc2[i] = p.pc2;
+      dir[3 * i] = p.principal_curvature_x;
+      dir[3 * i + 1] = p.principal_curvature_y;
+      dir[3 * i + 2] = p.principal_curvature_z;
+      ok[i] = ok[i] && std::isfinite(pc1[i]) && std::isfinite(pc2[i]);
+    }
+    return py::make_tuple(k1, k2, direction, normals, valid, fitCounts(result));
+  };
+
+  m.def(
+      "estimate_normals",
+      [fit](const py::array& points, const std::string& method, std::optional<int> k,
+            std::optional<double> radius, std::optional<int> max_nn, std::optional<int> min_nn,
+            std::optional<std::string> neighbours, const py::object& faces,
+            std::optional<std::vector<double>> viewpoint, std::optional<std::string> orient,
+            std::optional<std::vector<double>> up, std::optional<double> max_depth_jump,
+            unsigned int threads) {
+        return fit(points,
+                   {method, k, radius, max_nn, min_nn, neighbours, faces, viewpoint, orient, up,
+                    max_depth_jump, threads},
+                   false);
+      },
+      py::arg("points"), py::arg("method") = "pca", py::arg("k") = py::none(),
+      py::arg("radius") = py::none(), py::arg("max_nn") = py::none(),
+      py::arg("min_nn") = py::none(), py::arg("neighbours") = py::none(),
+      py::arg("faces") = py::none(), py::arg("viewpoint") = py::none(),
+      py::arg("orient") = py::none(), py::arg("up") = py::none(),
+      py::arg("max_depth_jump") = py::none(), py::arg("threads") = 0,
+      "(normals, curvature, valid, counts) of fitLocalSurfaces, as pcl_ddg_normals.");
+
+  m.def(
+      "principal_curvatures",
+      [fit](const py::array& points, std::optional<int> k, std::optional<double> radius,
+            std::optional<int> max_nn, std::optional<int> min_nn,
+            std::optional<std::string> neighbours, const py::object& faces,
+            std::optional<std::vector<double>> viewpoint, std::optional<std::string> orient,
+            std::optional<std::vector<double>> up, unsigned int threads) {
+        return fit(points,
+                   {"quadric", k, radius, max_nn, min_nn, neighbours, faces, viewpoint, orient, up,
+                    std::nullopt, threads},
+                   true);
+      },
+      py::arg("points"), py::arg("k") = py::none(), py::arg("radius") = py::none(),
+      py::arg("max_nn") = py::none(), py::arg("min_nn") = py::none(),
+      py::arg("neighbours") = py::none(), py::arg("faces") = py::none(),
+      py::arg("viewpoint") = py::none(), py::arg("orient") = py::none(), py::arg("up") = py::none(),
+      py::arg("threads") = 0,
+      "(k1, k2, direction1, normals, valid, counts) of the quadric fit, as pcl_ddg_curvature.");
+
+  m.def(
+      "orient_normals",
+      [](const py::array& points, const py::array& normals, const std::string& method,
+         std::optional<std::vector<double>> viewpoint, std::optional<std::vector<double>> up, int k,
+         const py::object& faces) {
+        const std::string how = choice("method", method, {"mst", "viewpoint", "up"});
+        const int n = rowCount(points, "points");
+        if (rowCount(normals, "normals") != n)
+          throw py::value_error("normals must have as many rows as points");
+        if (k < 1) throw py::value_error("k must be at least 1");
+        if (how != "mst" && (k != 10 || !faces.is_none()))
+          throw py::value_error("k and faces apply to method='mst'");
+        if (how == "viewpoint" && up) throw py::value_error("up applies to 'up' and 'mst'");
+        if (how == "up" && viewpoint)
+          throw py::value_error("viewpoint applies to 'viewpoint' and 'mst'");
+        if (how == "mst" && up && viewpoint)
+          throw py::value_error("method='mst' takes one reference: viewpoint or up");
+        const Eigen::Matrix3Xd p = positionsOf(points, "points");
+        Eigen::Matrix3Xd out = positionsOf(normals, "normals");
+        const std::optional<Eigen::Vector3d> vp = vectorOf(viewpoint, "viewpoint");
+        const std::optional<Eigen::Vector3d> u = directionOf(up);
+        std::shared_ptr<const MeshTopology> topology;
+        if (!faces.is_none()) topology = std::make_shared<const MeshTopology>(topologyOf(n, faces));
+        std::int64_t flipped = compute([&] {
+          std::int64_t turned = 0;
+          if (how != "mst") {
+            const Eigen::Vector3d direction = u.value_or(Eigen::Vector3d::UnitZ());
+            const Eigen::Vector3d from = vp.value_or(Eigen::Vector3d::Zero());
+            for (int i = 0; i < n; ++i) {
+              const double side =
+                  how == "up" ? out.col(i).dot(direction) : out.col(i).dot(from - p.col(i));
+              if (side < 0.0) {
+                out.col(i) = -out.col(i);
+                ++turned;
+              }
+            }
+            return turned;
+          }
+          // The library orients PCL's float normals; its decisions are applied to the doubles.
+          pcl::PointCloud<pcl::PointXYZ> cloud;
+          pcl::PointCloud<pcl::Normal> float_normals;
+          cloud.resize(static_cast<std::size_t>(n));
+          float_normals.resize(static_cast<std::size_t>(n));
+          for (int i = 0; i < n; ++i) {
+            cloud[i].getVector3fMap() = p.col(i).cast<float>();
+            float_normals[i].getNormalVector3fMap() = out.col(i).cast<float>();
+          }
+          const pcl::PointCloud<pcl::Normal> before = float_normals;
+          ConsistentOrientationOptions options;
+          options.k = k;
+          options.viewpoint = vp;
+          options.up = u;
+          if (topology) {
+            orientNormalsConsistently(*topology, cloud, float_normals, options);
+          } else {
+            orientNormalsConsistently(cloud, float_normals, options);
+          }
+          for (int i = 0; i < n; ++i) {
+            if (float_normals[i].normal_x != before[i].normal_x ||
+                float_normals[i].normal_y != before[i].normal_y ||
+                float_normals[i].normal_z != before[i].normal_z) {
+              out.col(i) = -out.col(i);
+              ++turned;
+            }
+          }
+          return turned;
+        });
+        return py::make_tuple(rowsArray(std::move(out)), flipped);
+      },
+      py::arg("points"), py::arg("normals"), py::arg("method") = "mst",
+      py::arg("viewpoint") = py::none(), py::arg("up") = py::none(), py::arg("k") = 10,
+      py::arg("faces") = py::none(), "(normals, flipped) oriented as normal_orientation.h.");
+
+  m.def(
+      "compare_neighbourhoods",
+      [](const py::array& V, const py::object& F, const std::string& method, std::optional<int> k,
+         std::optional<double> radius, std::optional<int> max_nn, unsigned int threads) {
+        if (F.is_none() && V.ndim() != 3)
+          throw py::value_error(
+              "compare_neighbourhoods needs faces, or an organized (h, w, 3) cloud");
+        Cloud::Ptr cloud = cloudOf(V);
+        std::shared_ptr<const MeshTopology> topology;
+        FitArguments a;
+        a.method = method;
+        a.k = radius ? k : std::optional<int>(k.value_or(16));  // the tool's default, also quadric
+        a.radius = radius;
+        a.max_nn = max_nn;
+        a.faces = F;
+        a.threads = threads;
+        const LocalFitOptions options = fitOptions(a, *cloud, topology);
+        NeighbourhoodComparison c =
+            compute([&] { return compareNeighbourhoods(cloud, topology, options); });
+        const NeighbourhoodComparison::Summary& s = c.summary;
+        py::dict summary;
+        summary["compared"] = s.compared;
+        summary["mean"] = s.mean;
+        summary["median"] = s.median;
+        summary["percentile95"] = s.percentile95;
+        summary["max"] = s.max;
+        summary["share_over_5"] = s.share_over_5;
+        summary["share_over_30"] = s.share_over_30;
+        summary["mean_overlap"] = s.mean_overlap;
+        return py::make_tuple(vectorArray(std::move(c.angle_difference)),
+                              vectorArray(std::move(c.overlap)), summary);
+      },
+      py::arg("V"), py::arg("F"), py::arg("method") = "pca", py::arg("k") = py::none(),
+      py::arg("radius") = py::none(), py::arg("max_nn") = py::none(), py::arg("threads") = 0,
+      "(angle_difference, overlap, summary) of compareNeighbourhoods.");
+}
+
+}  // namespace python
+}  // namespace pcl_ddg

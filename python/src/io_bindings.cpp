@@ -1,0 +1,261 @@
+// Files: read and write every format the tools handle, through the library's io (mesh_io.h). The
+// coordinates come as the file holds them (double where it stores doubles); every other vertex
+// field in its own type; colours as uint8 (n, 3).
+#include <pcl/PCLPointField.h>
+#include <pcl/PolygonMesh.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <set>
+
+#include "binding_common.h"
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/io/vertex_fields.h"
+
+namespace pcl_ddg {
+namespace python {
+
+namespace {
+
+py::dtype dtypeOf(std::uint8_t datatype) {
+  switch (datatype) {
+    case pcl::PCLPointField::INT8:
+      return py::dtype::of<std::int8_t>();
+    case pcl::PCLPointField::UINT8:
+      return py::dtype::of<std::uint8_t>();
+    case pcl::PCLPointField::INT16:
+      return py::dtype::of<std::int16_t>();
+    case pcl::PCLPointField::UINT16:
+      return py::dtype::of<std::uint16_t>();
+    case pcl::PCLPointField::INT32:
+      return py::dtype::of<std::int32_t>();
+    case pcl::PCLPointField::UINT32:
+      return py::dtype::of<std::uint32_t>();
+    case pcl::PCLPointField::INT64:
+      return py::dtype::of<std::int64_t>();
+    case pcl::PCLPointField::UINT64:
+      return py::dtype::of<std::uint64_t>();
+    case pcl::PCLPointField::FLOAT32:
+      return py::dtype::of<float>();
+    case pcl::PCLPointField::FLOAT64:
+      return py::dtype::of<double>();
+    default:
+      throw std::runtime_error("unknown PCL field type " + std::to_string(datatype));
+  }
+}
+
+// One field of every point as an (n,) or (n, count) array of its own type.
+py::array fieldArray(const pcl::PCLPointCloud2& cloud, const pcl::PCLPointField& field) {
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  const py::dtype dtype = dtypeOf(field.datatype);
+  const auto size = static_cast<std::size_t>(dtype.itemsize());
+  std::vector<py::ssize_t> shape{static_cast<py::ssize_t>(n)};
+  if (field.count > 1) shape.push_back(field.count);
+  py::array out(dtype, shape);
+  auto* dst = static_cast<std::uint8_t*>(out.mutable_data());
+  const std::size_t bytes = size * std::max<std::uint32_t>(field.count, 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t row = i / cloud.width, column = i % cloud.width;
+    std::memcpy(dst + i * bytes,
+                cloud.data.data() + row * cloud.row_step + column * cloud.point_step + field.offset,
+                bytes);
+  }
+  return out;
+}
+
+py::object facesOf(const std::vector<pcl::Vertices>& polygons) {
+  const bool triangles = std::all_of(polygons.begin(), polygons.end(),
+                                     [](const pcl::Vertices& p) { return p.vertices.size() == 3; });
+  if (triangles) {
+    py::array_t<std::int32_t> faces({static_cast<py::ssize_t>(polygons.size()), py::ssize_t{3}});
+    std::int32_t* out = faces.mutable_data();
+    for (std::size_t t = 0; t < polygons.size(); ++t) {
+      for (int c = 0; c < 3; ++c)
+        out[3 * t + c] = static_cast<std::int32_t>(polygons[t].vertices[c]);
+    }
+    return std::move(faces);
+  }
+  py::list faces;
+  for (const pcl::Vertices& p : polygons) {
+    py::array_t<std::int32_t> polygon(static_cast<py::ssize_t>(p.vertices.size()));
+    std::copy(p.vertices.begin(), p.vertices.end(), polygon.mutable_data());
+    faces.append(polygon);
+  }
+  return std::move(faces);
+}
+
+// Every value of a float64 array survives the cast to float (NaN and infinities included).
+bool fitsFloat(const Eigen::Ref<const Eigen::MatrixXd>& values) {
+  for (Eigen::Index i = 0; i < values.size(); ++i) {
+    const double v = values.data()[i];
+    if (!std::isnan(v) && static_cast<double>(static_cast<float>(v)) != v) return false;
+  }
+  return true;
+}
+
+FieldPrecision precisionOf(const std::optional<std::string>& precision, const py::dtype& dtype,
+                           const Eigen::Ref<const Eigen::MatrixXd>& values) {
+  if (precision)
+    return choice("precision", *precision, {"float", "double"}) == "double" ? FieldPrecision::Double
+                                                                            : FieldPrecision::Float;
+  // Unset: lossless, float when it holds every value.
+  return dtype.kind() == 'f' && dtype.itemsize() == 8 && !fitsFloat(values) ? FieldPrecision::Double
+                                                                            : FieldPrecision::Float;
+}
+
+std::vector<pcl::Vertices> polygonsOf(int n, const py::object& faces) {
+  std::vector<pcl::Vertices> polygons;
+  if (faces.is_none()) return polygons;
+  // topologyOf checks every index (ValueError); the polygons themselves are written as given.
+  topologyOf(n, faces);
+  const auto read = [&](const py::handle& polygon) {
+    const auto p = py::array_t<long long, py::array::forcecast>::ensure(polygon);
+    pcl::Vertices v;
+    for (py::ssize_t c = 0; c < p.size(); ++c)
+      v.vertices.push_back(static_cast<std::uint32_t>(p.data()[c]));
+    polygons.push_back(std::move(v));
+  };
+  if (py::isinstance<py::array>(faces)) {
+    const auto f = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(faces);
+    for (py::ssize_t t = 0; t < f.shape(0); ++t) {
+      pcl::Vertices v;
+      for (py::ssize_t c = 0; c < f.shape(1); ++c)
+        v.vertices.push_back(static_cast<std::uint32_t>(f.at(t, c)));
+      polygons.push_back(std::move(v));
+    }
+  } else {
+    for (const py::handle polygon : faces) read(polygon);
+  }
+  return polygons;
+}
+
+}  // namespace
+
+void bindIO(py::module_& m) {
+  m.def(
+      "read",
+      [](const std::string& path) {
+        MeshFile file = [&] {
+          py::gil_scoped_release release;
+          return readMeshFile(path);
+        }();
+        const pcl::PCLPointCloud2& cloud = file.mesh.cloud;
+        py::dict fields;
+        const bool colours = vertexColorLayout(cloud).has_value();
+        const std::set<std::string> coordinates = {"x", "y", "z", "_"};
+        const std::set<std::string> colour_fields = {"rgb",   "rgba", "red",
+                                                     "green", "blue", "alpha"};
+        for (const pcl::PCLPointField& field : cloud.fields) {
+          if (coordinates.count(field.name) != 0) continue;
+          if (colours && colour_fields.count(field.name) != 0) continue;  // as "rgb" (n, 3)
+          fields[py::str(field.name)] = fieldArray(cloud, field);
+        }
+        if (colours) {
+          const VertexColors rgb = vertexColors(cloud);
+          py::array_t<std::uint8_t> array({static_cast<py::ssize_t>(rgb.cols()), py::ssize_t{3}});
+          std::memcpy(array.mutable_data(), rgb.data(), static_cast<std::size_t>(rgb.size()));
+          fields["rgb"] = array;
+        }
+        const py::object faces =
+            file.mesh.polygons.empty() ? py::object(py::none()) : facesOf(file.mesh.polygons);
+        const Eigen::Quaterniond& q = file.sensor_pose.orientation;
+        const py::object shape = cloud.height > 1
+                                     ? py::object(py::make_tuple(cloud.height, cloud.width))
+                                     : py::object(py::none());
+        const Eigen::Vector3d origin = file.sensor_pose.origin;
+        return py::make_tuple(
+            rowsArray(std::move(file.positions)), faces, fields,
+            py::make_tuple(origin.x(), origin.y(), origin.z()),
+            py::make_tuple(q.w(), q.x(), q.y(), q.z()), shape,
+            file.coordinate_precision == FieldPrecision::Double ? "double" : "float");
+      },
+      py::arg("path"),
+      "(points, faces, fields, viewpoint, orientation, organized_shape, precision) of a file.");
+
+  m.def(
+      "write",
+      [](const std::string& path, const py::array& points, const py::object& faces,
+         const std::optional<py::dict>& fields, std::optional<std::vector<double>> viewpoint,
+         std::optional<std::string> precision, const std::string& encoding,
+         std::optional<std::pair<int, int>> organized_shape) {
+        const Eigen::Matrix3Xd positions = positionsOf(points, "points");
+        const int n = static_cast<int>(positions.cols());
+        pcl::PolygonMesh mesh;
+        mesh.cloud.width = static_cast<std::uint32_t>(n);
+        mesh.cloud.height = 1;
+        if (organized_shape) {
+          const auto [h, w] = *organized_shape;
+          if (h < 1 || w < 1 || static_cast<long long>(h) * w != n)
+            throw py::value_error("organized_shape (h, w) must have h * w = the point count");
+          mesh.cloud.height = static_cast<std::uint32_t>(h);
+          mesh.cloud.width = static_cast<std::uint32_t>(w);
+        }
+        mesh.cloud.is_dense = positions.allFinite();
+        setVertexCoordinates(mesh.cloud, positions,
+                             precisionOf(precision, points.dtype(), positions));
+        const std::string extension = fileExtension(path);
+        if (fields) {
+          for (const auto& [key, value] : *fields) {
+            const std::string name = py::str(key);
+            const py::array array = py::array::ensure(value);
+            if (!array || array.ndim() < 1 || array.shape(0) != n)
+              throw py::value_error("field '" + name + "' must have one row per point");
+            if (name == "rgb") {
+              if (array.ndim() != 2 || array.shape(1) != 3 || array.dtype().kind() != 'u' ||
+                  array.dtype().itemsize() != 1)
+                throw py::value_error("field 'rgb' must be uint8 of shape (n, 3)");
+              const auto rgb =
+                  py::array_t<std::uint8_t, py::array::c_style | py::array::forcecast>::ensure(
+                      array);
+              VertexColors colors(3, n);
+              std::memcpy(colors.data(), rgb.data(), static_cast<std::size_t>(3) * n);
+              setVertexColors(mesh.cloud, colors,
+                              extension == "pcd" ? ColorLayout::PackedRGB : ColorLayout::Channels);
+              continue;
+            }
+            const char kind = array.dtype().kind();
+            if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b')
+              throw py::value_error("field '" + name + "' must hold numbers");
+            const auto values =
+                py::array_t<double, py::array::f_style | py::array::forcecast>::ensure(array);
+            const Eigen::Index columns = array.ndim() == 2 ? array.shape(1) : 1;
+            if (array.ndim() > 2)
+              throw py::value_error("field '" + name + "' has more than 2 dimensions");
+            const Eigen::Map<const Eigen::MatrixXd> matrix(values.data(), n, columns);
+            std::vector<std::string> names;
+            if (name == "normals") {
+              if (columns != 3) throw py::value_error("field 'normals' must have shape (n, 3)");
+              names = extension == "pcd"
+                          ? std::vector<std::string>{"normal_x", "normal_y", "normal_z"}
+                          : std::vector<std::string>{"nx", "ny", "nz"};
+            } else if (columns == 1) {
+              names = {name};
+            } else {
+              for (Eigen::Index c = 0; c < columns; ++c)
+                names.push_back(name + "_" + std::to_string(c));
+            }
+            setVertexFields(mesh.cloud, names, matrix.transpose(),
+                            precisionOf(precision, array.dtype(), matrix));
+          }
+        }
+        mesh.polygons = polygonsOf(n, faces);
+        MeshWriteOptions options;
+        options.ply_encoding = choice("encoding", encoding, {"binary", "ascii"}) == "ascii"
+                                   ? PlyEncoding::Ascii
+                                   : PlyEncoding::Binary;
+        if (viewpoint) {
+          if (viewpoint->size() != 3) throw py::value_error("viewpoint must be three numbers");
+          options.sensor_pose.origin = Eigen::Vector3d(viewpoint->data());
+        }
+        py::gil_scoped_release release;
+        saveMesh(path, mesh, options);
+      },
+      py::arg("path"), py::arg("points"), py::arg("faces") = py::none(),
+      py::arg("fields") = py::none(), py::arg("viewpoint") = py::none(),
+      py::arg("precision") = py::none(), py::arg("encoding") = "binary",
+      py::arg("organized_shape") = py::none(), "saveMesh of points, faces and fields.");
+}
+
+}  // namespace python
+}  // namespace pcl_ddg

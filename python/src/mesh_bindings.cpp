@@ -1,0 +1,328 @@
+// Mesh functions: normals, Laplacian, mass, curvatures, report, smoothing. Each builds the topology
+// from F and calls the library as the tools do, with the GIL released.
+#include <pcl/exceptions.h>
+
+#include <Eigen/SparseCore>
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "binding_common.h"
+#include "pcl_ddg/mesh/mesh_geometry.h"
+#include "pcl_ddg/mesh/mesh_report.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/operators/curvature.h"
+#include "pcl_ddg/operators/laplacian.h"
+#include "pcl_ddg/operators/mass_matrix.h"
+#include "pcl_ddg/surface/mesh_normals.h"
+#include "pcl_ddg/surface/mesh_smoothing.h"
+#include "pcl_ddg/surface/scalar_field_smoothing.h"
+
+namespace pcl_ddg {
+namespace python {
+
+namespace {
+
+// V and F as the library takes them; V must be finite (InvalidMeshError naming the vertex).
+struct Mesh {
+  Eigen::Matrix3Xd positions;
+  MeshTopology topology;
+};
+
+Mesh meshOf(const py::array& vertices, const py::object& faces,
+            NonFinitePolicy finite = NonFinitePolicy::Throw,
+            OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw) {
+  Eigen::Matrix3Xd positions = positionsOf(vertices, "V");
+  if (finite == NonFinitePolicy::Throw) {
+    py::gil_scoped_release release;
+    requireFinite(positions);
+  }
+  MeshTopology topology = topologyOf(static_cast<int>(positions.cols()), faces, policy);
+  return {std::move(positions), std::move(topology)};
+}
+
+MassType massOf(const std::string& kind) {
+  const std::string k = choice("mass", kind, {"mixed", "voronoi", "barycentric"});
+  return k == "voronoi"       ? MassType::Voronoi
+         : k == "barycentric" ? MassType::Barycentric
+                              : MassType::MixedVoronoi;
+}
+
+LaplacianWeights weightsOf(const std::string& weights) {
+  return choice("weights", weights, {"cotan", "uniform"}) == "uniform"
+             ? LaplacianWeights::Uniform
+             : LaplacianWeights::Cotangent;
+}
+
+struct SolverChoice {
+  ImplicitSolver method;
+  CholeskyBackend backend;
+};
+
+// -solver auto|cholmod|ldlt|cg, as the tools read it.
+SolverChoice solverOf(const std::string& solver) {
+  const std::string s = choice("solver", solver, {"auto", "cholmod", "ldlt", "cg"});
+  if (s == "cholmod") return {ImplicitSolver::Cholesky, CholeskyBackend::Cholmod};
+  if (s == "ldlt") return {ImplicitSolver::Cholesky, CholeskyBackend::SimplicialLDLT};
+  if (s == "cg") return {ImplicitSolver::ConjugateGradient, CholeskyBackend::Automatic};
+  return {ImplicitSolver::Automatic, CholeskyBackend::Automatic};
+}
+
+SmoothingScheme schemeOf(const std::string& method) {
+  return choice("method", method, {"implicit", "explicit"}) == "explicit"
+             ? SmoothingScheme::Explicit
+             : SmoothingScheme::Implicit;
+}
+
+// Ctrl-C between smoothing steps: the handler runs, and its KeyboardInterrupt unwinds the run.
+void checkSignals(int, int) {
+  py::gil_scoped_acquire acquire;
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+}
+
+// The values of a column-major matrix whose pattern is symmetric (every Laplacian of the library)
+// in row order: row v of L has the pattern of column v, so the CSR arrays are the matrix's own
+// indices and offsets, and only the values move, each found by a binary search in its column.
+// The values are L's, bit for bit.
+std::vector<double> rowOrderValues(const Eigen::SparseMatrix<double>& columns) {
+  const auto n = static_cast<int>(columns.outerSize());
+  const int* outer = columns.outerIndexPtr();
+  const int* inner = columns.innerIndexPtr();
+  const double* values = columns.valuePtr();
+  std::vector<double> row_values(static_cast<std::size_t>(columns.nonZeros()));
+  // Columns in ascending order meet the rows of every column in ascending order too: a cursor per
+  // column finds where entry (row, column) goes in row `row` without a search.
+  std::vector<int> cursor(outer, outer + n);
+  for (int column = 0; column < n; ++column) {
+    for (int k = outer[column]; k < outer[column + 1]; ++k) {
+      const int row = inner[k];
+      const int at = cursor[row]++;
+      if (at >= outer[row + 1] || inner[at] != column)
+        throw std::logic_error("the Laplacian's pattern is not symmetric");
+      row_values[static_cast<std::size_t>(at)] = values[k];
+    }
+  }
+  return row_values;
+}
+
+}  // namespace
+
+void bindMeshes(py::module_& m) {
+  m.def(
+      "vertex_normals",
+      [](const py::array& V, const py::object& F, const std::string& weighting,
+         std::optional<double> epsilon, const std::string& mass) {
+        MeshNormalOptions options;
+        const std::string w =
+            choice("weighting", weighting, {"area", "uniform", "angle", "mean_curvature"});
+        options.weighting = w == "uniform"          ? NormalWeighting::Uniform
+                            : w == "angle"          ? NormalWeighting::Angle
+                            : w == "mean_curvature" ? NormalWeighting::MeanCurvature
+                                                    : NormalWeighting::Area;
+        if (epsilon) {
+          if (w != "mean_curvature")
+            throw py::value_error("epsilon applies to weighting='mean_curvature' only");
+          if (!(*epsilon >= 0.0) || !std::isfinite(*epsilon))
+            throw py::value_error("epsilon must be >= 0");
+          options.epsilon = *epsilon;
+        }
+        options.mass = massOf(mass);
+        Mesh mesh = meshOf(V, F);
+        MeshNormals normals =
+            compute([&] { return computeMeshNormals(mesh.topology, mesh.positions, options); });
+        py::dict counts;
+        counts["invalid_vertices"] = normals.invalid_vertices;
+        counts["cancelled_vertices"] = normals.cancelled_vertices;
+        counts["fallback_vertices"] = normals.fallback_vertices;
+        return py::make_tuple(rowsArray(std::move(normals.normals)), maskArray(normals.valid),
+                              counts);
+      },
+      py::arg("V"), py::arg("F"), py::arg("weighting") = "area", py::arg("epsilon") = py::none(),
+      py::arg("mass") = "mixed", "(normals, valid, counts) of computeMeshNormals.");
+
+  m.def(
+      "laplacian",
+      [](const py::array& V, const py::object& F, const std::string& weights,
+         const std::string& form, const std::string& mass) {
+        const LaplacianWeights w = weightsOf(weights);
+        const LaplacianForm f = choice("form", form, {"summed", "averaged"}) == "averaged"
+                                    ? LaplacianForm::Averaged
+                                    : LaplacianForm::Summed;
+        const MassType type = massOf(mass);
+        Mesh mesh = meshOf(V, F);
+        // The library's time alone; the CSR conversion is the binding's overhead.
+        Eigen::SparseMatrix<double> l =
+            compute([&] { return laplacian(mesh.topology, mesh.positions, w, f, type); });
+        std::vector<double> values = [&] {
+          py::gil_scoped_release release;
+          return rowOrderValues(l);
+        }();
+        // indices and indptr are the matrix's own arrays, kept alive by one capsule.
+        auto* matrix = new Eigen::SparseMatrix<double>(std::move(l));
+        py::capsule owner(matrix,
+                          [](void* p) { delete static_cast<Eigen::SparseMatrix<double>*>(p); });
+        const auto nnz = static_cast<py::ssize_t>(matrix->nonZeros());
+        const auto rows = static_cast<py::ssize_t>(matrix->outerSize());
+        return py::make_tuple(vectorArray(std::move(values)),
+                              py::array_t<int>({nnz}, matrix->innerIndexPtr(), owner),
+                              py::array_t<int>({rows + 1}, matrix->outerIndexPtr(), owner));
+      },
+      py::arg("V"), py::arg("F"), py::arg("weights") = "cotan", py::arg("form") = "summed",
+      py::arg("mass") = "mixed", "(data, indices, indptr) of L in CSR form.");
+
+  m.def(
+      "mass_matrix",
+      [](const py::array& V, const py::object& F, const std::string& kind) {
+        const std::string k = choice("kind", kind, {"mixed", "voronoi", "barycentric"});
+        const MassType type = massOf(k);
+        Mesh mesh = meshOf(V, F);
+        return vectorArray(
+            compute([&] { return lumpedMass(mesh.topology, mesh.positions, type); }));
+      },
+      py::arg("V"), py::arg("F"), py::arg("kind") = "mixed", "The diagonal of M (vertex areas).");
+
+  m.def(
+      "curvatures",
+      [](const py::array& V, const py::object& F, const std::string& mass) {
+        const MassType type = massOf(mass);
+        Mesh mesh = meshOf(V, F);
+        VertexCurvatures c =
+            compute([&] { return computeCurvatures(mesh.topology, mesh.positions, type); });
+        py::dict counts;
+        counts["clamped_vertices"] = c.clamped_vertices;
+        counts["invalid_vertices"] = c.invalid_vertices;
+        counts["unoriented_vertices"] = c.unoriented_vertices;
+        return py::make_tuple(vectorArray(std::move(c.mean_curvature)),
+                              vectorArray(std::move(c.gauss_curvature)),
+                              vectorArray(std::move(c.k1)), vectorArray(std::move(c.k2)),
+                              vectorArray(std::move(c.vertex_area)), maskArray(c.valid), counts);
+      },
+      py::arg("V"), py::arg("F"), py::arg("mass") = "mixed",
+      "(mean, gauss, k1, k2, area, valid, counts) of computeCurvatures.");
+
+  m.def(
+      "mesh_report",
+      [](const py::array& V, const py::object& F) {
+        // As pcl_ddg_info: defects are counted, not refused.
+        Mesh mesh = meshOf(V, F, NonFinitePolicy::Keep, OutOfRangeFacePolicy::Drop);
+        return compute([&] { return makeMeshReport(mesh.topology, mesh.positions).toJson(); });
+      },
+      py::arg("V"), py::arg("F"), "makeMeshReport as JSON (pcl_ddg_info -json).");
+
+  m.def(
+      "smooth",
+      [](const py::array& V, const py::object& F, const std::string& method,
+         const std::string& weights, const std::string& mass, std::optional<double> lambda_dt,
+         int iterations, bool absolute_time, bool freeze_weights, bool rebuild_weights,
+         bool fix_boundary, bool allow_unstable, const std::string& preserve,
+         const std::string& solver) {
+        MeshSmoothingParameters p;
+        p.scheme = schemeOf(method);
+        p.weights = weightsOf(weights);
+        p.mass = massOf(mass);
+        if (iterations < 1) throw py::value_error("iterations must be at least 1");
+        p.iterations = iterations;
+        if (freeze_weights && rebuild_weights)
+          throw py::value_error("freeze_weights and rebuild_weights exclude each other");
+        if (freeze_weights) p.weight_update = WeightUpdate::Frozen;
+        if (rebuild_weights) p.weight_update = WeightUpdate::EveryIteration;
+        if (fix_boundary) p.boundary = BoundaryCondition::Fixed;
+        const std::string keep = choice("preserve", preserve, {"none", "volume", "area"});
+        p.shrinkage = keep == "volume" ? ShrinkageCorrection::PreserveVolume
+                      : keep == "area" ? ShrinkageCorrection::PreserveArea
+                                       : ShrinkageCorrection::None;
+        const SolverChoice s = solverOf(solver);
+        p.implicit_solver = s.method;
+        p.solver = s.backend;
+        if (absolute_time && !lambda_dt) throw py::value_error("absolute_time needs lambda_dt");
+        if (lambda_dt && (!(*lambda_dt > 0.0) || !std::isfinite(*lambda_dt)))
+          throw py::value_error("lambda_dt must be > 0");
+        Mesh mesh = meshOf(V, F);
+        Eigen::Matrix3Xd smoothed = compute([&] {
+          // As pcl_ddg_smooth: the step in units of h^2 unless absolute_time; the explicit
+          // default is half the stability bound, and a step above it is refused.
+          const double h = meanEdgeLength(mesh.topology, mesh.positions);
+          if (!(h > 0.0))
+            throw pcl::BadArgumentException("the mesh has no edge of positive length");
+          const double step = lambda_dt.value_or(1.0);
+          if (p.scheme == SmoothingScheme::Explicit) {
+            const double bound =
+                explicitStabilityLimit(mesh.topology, mesh.positions, p.weights, p.mass);
+            p.time_step = lambda_dt ? (absolute_time ? step : step * h * h) : 0.5 * bound;
+            if (p.time_step > bound && !allow_unstable) {
+              throw pcl::BadArgumentException(
+                  "the explicit step " + std::to_string(p.time_step / (h * h)) +
+                  " h^2 exceeds the stability bound " + std::to_string(bound / (h * h)) +
+                  " h^2: the surface would blow up (use method='implicit' for large steps, or "
+                  "allow_unstable=True)");
+            }
+          } else {
+            p.time_step = absolute_time ? step : step * h * h;
+          }
+          return smoothMeshPositions(mesh.topology, mesh.positions, p, nullptr, checkSignals);
+        });
+        return rowsArray(std::move(smoothed));
+      },
+      py::arg("V"), py::arg("F"), py::arg("method") = "implicit", py::arg("weights") = "cotan",
+      py::arg("mass") = "mixed", py::arg("lambda_dt") = py::none(), py::arg("iterations") = 1,
+      py::arg("absolute_time") = false, py::arg("freeze_weights") = false,
+      py::arg("rebuild_weights") = false, py::arg("fix_boundary") = false,
+      py::arg("allow_unstable") = false, py::arg("preserve") = "none", py::arg("solver") = "auto",
+      "smoothMeshPositions with pcl_ddg_smooth's options.");
+
+  m.def(
+      "smooth_field",
+      [](const py::array& V, const py::object& F, const py::array& values, double time,
+         const std::string& method, const std::string& weights, const std::string& mass,
+         int iterations, bool absolute_time, bool fix_boundary, const std::string& solver) {
+        HeatFlowParameters p;
+        p.scheme = schemeOf(method);
+        p.weights = weightsOf(weights);
+        p.mass = massOf(mass);
+        if (iterations < 1) throw py::value_error("iterations must be at least 1");
+        p.iterations = iterations;
+        if (fix_boundary) p.boundary = BoundaryCondition::Fixed;
+        const SolverChoice s = solverOf(solver);
+        p.implicit_solver = s.method;
+        p.solver = s.backend;
+        if (!(time > 0.0) || !std::isfinite(time)) throw py::value_error("time must be > 0");
+        const char kind = values.dtype().kind();
+        if (kind != 'f' && kind != 'i' && kind != 'u')
+          throw py::value_error("values must hold real numbers");
+        if (values.ndim() != 1 && values.ndim() != 2)
+          throw py::value_error("values must have shape (n,) or (n, c)");
+        Mesh mesh = meshOf(V, F);
+        if (values.shape(0) != mesh.positions.cols())
+          throw py::value_error("values has " + std::to_string(values.shape(0)) +
+                                " rows for a mesh of " + std::to_string(mesh.positions.cols()) +
+                                " vertices");
+        // Fields in columns (N x c, column-major): NumPy's Fortran order, converted once.
+        const auto input =
+            py::array_t<double, py::array::f_style | py::array::forcecast>::ensure(values);
+        const Eigen::Index columns = values.ndim() == 2 ? values.shape(1) : 1;
+        const Eigen::Map<const Eigen::MatrixXd> fields(input.data(), mesh.positions.cols(),
+                                                       columns);
+        auto* result = new Eigen::MatrixXd();
+        py::capsule owner(result, [](void* p) { delete static_cast<Eigen::MatrixXd*>(p); });
+        *result = compute([&] {
+          const double h = meanEdgeLength(mesh.topology, mesh.positions);
+          if (!(h > 0.0))
+            throw pcl::BadArgumentException("the mesh has no edge of positive length");
+          p.diffusion_time = absolute_time ? time : time * h * h;
+          return smoothScalarFields(mesh.topology, mesh.positions, fields, p);
+        });
+        const auto rows = static_cast<py::ssize_t>(result->rows());
+        if (values.ndim() == 1) return py::array_t<double>({rows}, result->data(), owner);
+        return py::array_t<double>(
+            {rows, static_cast<py::ssize_t>(result->cols())},
+            {py::ssize_t{sizeof(double)}, rows * py::ssize_t{sizeof(double)}}, result->data(),
+            owner);
+      },
+      py::arg("V"), py::arg("F"), py::arg("values"), py::arg("time"),
+      py::arg("method") = "implicit", py::arg("weights") = "cotan", py::arg("mass") = "mixed",
+      py::arg("iterations") = 1, py::arg("absolute_time") = false, py::arg("fix_boundary") = false,
+      py::arg("solver") = "auto", "smoothScalarFields (heat flow) with the time in units of h^2.");
+}
+
+}  // namespace python
+}  // namespace pcl_ddg

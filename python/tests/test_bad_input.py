@@ -1,0 +1,108 @@
+"""The bad-input table: every case must raise its Python exception; each runs in a subprocess,
+so that a crash (a segfault, an abort) fails the test instead of the whole run."""
+
+import pytest
+
+from conftest import python_subprocess
+
+SETUP = """
+import numpy as np, pcl_ddg
+t = (1 + 5 ** 0.5) / 2
+V = np.array([[-1, t, 0], [1, t, 0], [-1, -t, 0], [1, -t, 0], [0, -1, t], [0, 1, t],
+              [0, -1, -t], [0, 1, -t], [t, 0, -1], [t, 0, 1], [-t, 0, -1], [-t, 0, 1]], float)
+F = np.array([[0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
+              [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8],
+              [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1]])
+P = np.random.default_rng(0).random((50, 3))
+"""
+
+CASES = {
+    # shapes and dtypes
+    "V 1-D": ("pcl_ddg.vertex_normals(V.ravel(), F)", "ValueError"),
+    "V (n, 2)": ("pcl_ddg.laplacian(V[:, :2], F)", "ValueError"),
+    "V (n, 4)": ("pcl_ddg.curvatures(np.hstack([V, V[:, :1]]), F)", "ValueError"),
+    "V strings": ("pcl_ddg.mass_matrix(V.astype(str), F)", "ValueError"),
+    "V complex": ("pcl_ddg.vertex_normals(V.astype(complex), F)", "ValueError"),
+    "V object": ("pcl_ddg.vertex_normals(np.array([[1, 2, None]] * 12), F)", "ValueError"),
+    "F float": ("pcl_ddg.vertex_normals(V, F.astype(float))", "ValueError"),
+    "F (m, 2)": ("pcl_ddg.vertex_normals(V, F[:, :2])", "ValueError"),
+    "F 3-D": ("pcl_ddg.vertex_normals(V, F[None])", "ValueError"),
+    "F string": ("pcl_ddg.vertex_normals(V, 'faces')", "ValueError"),
+    "F ragged junk": ("pcl_ddg.vertex_normals(V, [[0, 1, 2], ['a']])", "ValueError"),
+    # empty input
+    "empty mesh": ("pcl_ddg.vertex_normals(np.zeros((0, 3)), np.zeros((0, 3), int))",
+                   "ValueError"),
+    "empty cloud": ("pcl_ddg.estimate_normals(np.zeros((0, 3)))", "ValueError"),
+    # NaN and out-of-range indices
+    "NaN vertex": ("V[3] = np.nan; pcl_ddg.laplacian(V, F)", "pcl_ddg.InvalidMeshError"),
+    "inf vertex": ("V[3, 1] = np.inf; pcl_ddg.smooth(V, F)", "pcl_ddg.InvalidMeshError"),
+    "face index too large": ("F[4, 1] = 12; pcl_ddg.curvatures(V, F)", "ValueError"),
+    "negative face index": ("F[4, 1] = -1; pcl_ddg.vertex_normals(V, F)", "ValueError"),
+    "int64 face index overflow": ("F = F.astype(np.int64); F[0, 0] = 2**40; "
+                                  "pcl_ddg.laplacian(V, F)", "ValueError"),
+    "polygon out of range": ("pcl_ddg.mass_matrix(V, [[0, 1, 2, 99]])", "ValueError"),
+    "faces out of range (cloud)": ("pcl_ddg.estimate_normals(V, faces=F + 100)", "ValueError"),
+    # options
+    "unknown weighting": ("pcl_ddg.vertex_normals(V, F, weighting='cot')", "ValueError"),
+    "epsilon without mean_curvature": ("pcl_ddg.vertex_normals(V, F, epsilon=0.1)", "ValueError"),
+    "negative epsilon": ("pcl_ddg.vertex_normals(V, F, weighting='mean_curvature', epsilon=-1)",
+                         "ValueError"),
+    "unknown form": ("pcl_ddg.laplacian(V, F, form='normalised')", "ValueError"),
+    "unknown mass": ("pcl_ddg.mass_matrix(V, F, kind='lumped')", "ValueError"),
+    "iterations 0": ("pcl_ddg.smooth(V, F, iterations=0)", "ValueError"),
+    "negative time step": ("pcl_ddg.smooth(V, F, lambda_dt=-1)", "ValueError"),
+    "NaN time step": ("pcl_ddg.smooth(V, F, lambda_dt=float('nan'))", "ValueError"),
+    "both weight updates": ("pcl_ddg.smooth(V, F, freeze_weights=True, rebuild_weights=True)",
+                            "ValueError"),
+    "unknown solver": ("pcl_ddg.smooth(V, F, solver='magic')", "ValueError"),
+    "field row count": ("pcl_ddg.smooth_field(V, F, np.ones(5), 1.0)", "ValueError"),
+    "field zero time": ("pcl_ddg.smooth_field(V, F, np.ones(12), 0.0)", "ValueError"),
+    "k > n": ("pcl_ddg.estimate_normals(P, k=51)", "ValueError"),
+    "k < 3": ("pcl_ddg.estimate_normals(P, k=2)", "ValueError"),
+    "negative radius": ("pcl_ddg.estimate_normals(P, radius=-0.1)", "ValueError"),
+    "k and radius": ("pcl_ddg.estimate_normals(P, k=8, radius=0.1)", "ValueError"),
+    "max_nn without radius": ("pcl_ddg.estimate_normals(P, max_nn=10)", "ValueError"),
+    "unknown method": ("pcl_ddg.estimate_normals(P, method='svd')", "ValueError"),
+    "bfs without faces": ("pcl_ddg.estimate_normals(P, neighbours='bfs')", "ValueError"),
+    "grid on a flat cloud": ("pcl_ddg.estimate_normals(P, neighbours='grid')", "ValueError"),
+    "viewpoint of 2": ("pcl_ddg.estimate_normals(P, viewpoint=[0, 0])", "ValueError"),
+    "zero up": ("pcl_ddg.estimate_normals(P, orient='up', up=[0, 0, 0])", "ValueError"),
+    "orient mesh on a cloud": ("pcl_ddg.estimate_normals(P, orient='mesh')", "ValueError"),
+    "grid_normals of (n, 3)": ("pcl_ddg.grid_normals(P)", "ValueError"),
+    "orient row mismatch": ("pcl_ddg.orient_normals(P, P[:10])", "ValueError"),
+    "unknown orientation": ("pcl_ddg.orient_normals(P, P, method='random')", "ValueError"),
+    "compare without faces": ("pcl_ddg.compare_neighbourhoods(P, None)", "ValueError"),
+    # files
+    "missing file": ("pcl_ddg.read('/nonexistent/x.ply')", "OSError"),
+    "unknown extension": ("pcl_ddg.read(__file__ if '__file__' in dir() else '/etc/hostname')",
+                          "OSError"),
+    "write to a missing folder": ("pcl_ddg.write('/nonexistent/x.ply', V)", "OSError"),
+    "write unknown format": ("import tempfile, os; pcl_ddg.write(os.path.join("
+                             "tempfile.mkdtemp(), 'x.obj2'), V)", "OSError"),
+    "write bad colours": ("import tempfile, os; pcl_ddg.write(os.path.join(tempfile.mkdtemp(), "
+                          "'x.ply'), V, fields={'rgb': np.ones((12, 3))})", "ValueError"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_bad_input_raises(name):
+    code, expected = CASES[name]
+    script = SETUP + f"""
+try:
+    {code}
+except {expected} as error:
+    assert str(error), "an empty message"
+    print("RAISED", type(error).__name__, error)
+else:
+    print("NO EXCEPTION")
+"""
+    result = python_subprocess(script)
+    assert result.returncode == 0, f"crashed or failed ({result.returncode}): {result.stderr}"
+    assert "RAISED" in result.stdout, result.stdout + result.stderr
+
+
+def test_invalid_mesh_error_is_a_value_error():
+    import pcl_ddg
+
+    assert issubclass(pcl_ddg.InvalidMeshError, ValueError)
+    assert issubclass(pcl_ddg.SurfaceCollapseError, RuntimeError)

@@ -1,0 +1,95 @@
+"""Cloud functions on analytic surfaces: normals, principal curvatures, grids, orientation."""
+
+import numpy as np
+import pytest
+
+import pcl_ddg
+from conftest import icosphere
+
+
+def sphere_cloud(n=20000, radius=2.0, seed=0):
+    rng = np.random.default_rng(seed)
+    p = rng.standard_normal((n, 3))
+    return radius * p / np.linalg.norm(p, axis=1, keepdims=True)
+
+
+def test_pca_normals_of_a_sphere_are_radial_and_face_the_viewpoint():
+    points = sphere_cloud()
+    r = pcl_ddg.estimate_normals(points, method="pca", k=16)
+    assert r.valid.all() and r.normals.shape == points.shape
+    radial = points / 2.0
+    # Viewpoint at the origin (PCL's default): the normals point inwards.
+    assert np.max(1.0 + np.einsum("ij,ij->i", r.normals, radial)) < 2e-3
+    # Without a reference the tree is seeded up at the highest point: outwards everywhere.
+    out = pcl_ddg.estimate_normals(points, k=16, orient="mst")
+    assert np.all(np.einsum("ij,ij->i", out.normals, radial) > 0.99)
+    assert np.all(r.curvature >= 0) and np.all(r.curvature < 0.05)
+
+
+def test_quadric_principal_curvatures_of_a_sphere():
+    points = sphere_cloud(30000, radius=2.0, seed=1)
+    c = pcl_ddg.principal_curvatures(points, k=20, orient="mst")
+    assert c.valid.mean() > 0.99
+    # Outward normals: the sphere bends away from them, k1 = k2 = 1/R > 0.
+    assert np.median(c.k1[c.valid]) == pytest.approx(0.5, rel=0.02)
+    assert np.median(c.k2[c.valid]) == pytest.approx(0.5, rel=0.02)
+    inward = pcl_ddg.principal_curvatures(points, k=20)  # facing the viewpoint at the centre
+    assert np.median(inward.k1[inward.valid]) == pytest.approx(-0.5, rel=0.02)
+    assert np.all(c.k1[c.valid] >= c.k2[c.valid])
+    assert np.allclose(np.linalg.norm(c.direction1[c.valid], axis=1), 1.0, atol=1e-6)
+
+
+def test_mesh_neighbourhoods_with_faces():
+    V, F = icosphere(4, 1.0)
+    r = pcl_ddg.estimate_normals(V, faces=F)  # bfs rings, oriented like the faces (outward)
+    assert r.valid.all()
+    assert np.min(np.einsum("ij,ij->i", r.normals, V)) > 0.999
+    q = pcl_ddg.estimate_normals(V, method="quadric", faces=F, neighbours="knn")
+    assert np.min(np.einsum("ij,ij->i", q.normals, V)) > 0.999
+
+
+def test_grid_normals_of_a_tilted_plane_keep_the_grid():
+    h, w = 60, 80
+    y, x = np.mgrid[0:h, 0:w].astype(float) * 0.01
+    z = 2.0 + 0.5 * x + 0.25 * y
+    xyz = np.stack([x - 0.4, y - 0.3, z], axis=-1)
+    xyz[10, 10] = np.nan  # a hole stays a hole
+    r = pcl_ddg.grid_normals(xyz)
+    assert r.normals.shape == (h, w, 3) and r.valid.shape == (h, w)
+    assert not r.valid[10, 10] and np.isnan(r.normals[10, 10]).all()
+    exact = np.array([-0.5, -0.25, 1.0]) / np.linalg.norm([-0.5, -0.25, 1.0])
+    good = r.normals[r.valid]
+    # Facing the sensor at the origin (the plane lies at z ~ 2): n . exact = -1.
+    assert np.max(np.abs(np.abs(good @ exact) - 1.0)) < 1e-5
+    assert np.all(good @ exact < 0)
+
+
+def test_nan_points_are_invalid_rows():
+    points = sphere_cloud(2000)
+    points[5] = np.nan
+    r = pcl_ddg.estimate_normals(points)
+    assert r.normals.shape == points.shape
+    assert not r.valid[5] and np.isnan(r.normals[5]).all() and r.valid.sum() == 1999
+
+
+def test_orient_normals_only_changes_signs():
+    points = sphere_cloud(5000)
+    exact = points / 2.0
+    rng = np.random.default_rng(3)
+    signs = rng.choice([-1.0, 1.0], size=(points.shape[0], 1))
+    normals = exact * signs
+    for method, kwargs, expected_sign in (("viewpoint", {"viewpoint": [0, 0, 0]}, -1.0),
+                                          ("mst", {"viewpoint": [0, 0, 0]}, -1.0)):
+        out = pcl_ddg.orient_normals(points, normals, method=method, **kwargs)
+        assert np.array_equal(np.abs(out.normals), np.abs(normals))
+        assert np.all(np.sign(np.einsum("ij,ij->i", out.normals, exact)) == expected_sign)
+    up = pcl_ddg.orient_normals(points, normals, method="up")
+    assert np.all(up.normals[:, 2] >= 0)
+
+
+def test_compare_neighbourhoods_on_a_mesh():
+    V, F = icosphere(3)
+    c = pcl_ddg.compare_neighbourhoods(V, F, k=12)
+    assert c.angle_difference.shape == (V.shape[0],)
+    assert c.summary["compared"] == V.shape[0]
+    assert np.all((c.overlap >= 0) & (c.overlap <= 1))
