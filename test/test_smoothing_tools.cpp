@@ -218,6 +218,14 @@ TEST_F(SmoothingTools, OrganizedCloudKeepsItsGridHolesAndRays) {
   EXPECT_EQ(runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL, input + " " + path("x.pcd") + " -max_jump 0")
                 .exit_code,
             2);
+  const ToolRun zero =
+      runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL, input + " " + path("x.pcd") + " -max_depth_jump 0");
+  EXPECT_EQ(zero.exit_code, 2);
+  EXPECT_NE(zero.err.find("-max_depth_jump must be > 0"), std::string::npos) << zero.err;
+  EXPECT_EQ(runTool(PCL_DDG_SMOOTH_ORGANIZED_TOOL,
+                    input + " " + path("x.pcd") + " -max_jump 0.1 -max_depth_jump 0.1")
+                .exit_code,
+            2);
   EXPECT_FALSE(std::filesystem::exists(path("flat.pcd")));
   expectNoLeftovers();
 }

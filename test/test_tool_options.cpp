@@ -554,7 +554,7 @@ TEST_F(ToolOptions, SmoothOrganizedEqualsTheLibraryForEveryOption) {
        on(explicit_scheme)},
       {"-lambda_dt 4", on(with([](P& p) { p.time_step = 4.0; })), on(implicit)},
       {"-iterations 3", on(with([](P& p) { p.iterations = 3; })), on(implicit)},
-      {"-max_jump 0.5", on(with([](P& p) { p.max_depth_jump = 0.5; })), on(implicit)},
+      {"-max_depth_jump 0.5", on(with([](P& p) { p.max_depth_jump = 0.5; })), on(implicit)},
   };
   // The tool writes float coordinates (no -precision option).
   checkOptionTable(PCL_DDG_SMOOTH_ORGANIZED_TOOL, path("frame.pcd"), path("s.pcd"), "",

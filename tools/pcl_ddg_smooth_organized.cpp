@@ -5,6 +5,8 @@
 #include <cmath>
 #include <iostream>
 
+#include <string>
+
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
 #include "pcl_ddg/io/mesh_io.h"
@@ -18,28 +20,34 @@ constexpr const char* kDescription =
     "Smooths an organized cloud (width x height: a Kinect frame, a PLY range_grid scan) by the\n"
     "heat equation on its pixel grid (5-point stencil), applied to each point's range along its\n"
     "ray from the sensor origin (the PCD VIEWPOINT), so points stay on their rays. NaN pixels are\n"
-    "holes: never filled, never spread. Neighbours whose ranges differ by more than -max_jump\n"
-    "(relative) are not coupled, so object edges stay sharp. -lambda_dt is in pixel^2; explicit\n"
-    "steps need it below 0.25.";
+    "holes: never filled, never spread. Neighbours whose ranges differ by more than\n"
+    "-max_depth_jump (relative) are not coupled, so object edges stay sharp (-max_jump, its "
+    "former\n"
+    "name, is still read). -lambda_dt is in pixel^2; explicit steps need it below 0.25.";
 constexpr const char* kSyntax =
     "input.{pcd,ply} output.{pcd,ply} [-method explicit|implicit (default implicit)]\n"
     "         [-lambda_dt t (default: implicit 1, explicit 0.2)] [-iterations n (default 1)]\n"
-    "         [-max_jump f (default 0.05)] [-solver auto|cholmod|ldlt|cg] [-allow_unstable]";
+    "         [-max_depth_jump f (default 0.05)] [-solver auto|cholmod|ldlt|cg] [-allow_unstable]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(
-      argc, argv, {"method", "lambda_dt", "iterations", "max_jump", "solver"}, {"allow_unstable"});
+      argc, argv, {"method", "lambda_dt", "iterations", "max_depth_jump", "max_jump", "solver"},
+      {"allow_unstable"});
   GridSmoothingParameters p;
   p.scheme = args.choice("method", {"explicit", "implicit"}, "implicit") == "explicit"
                  ? SmoothingScheme::Explicit
                  : SmoothingScheme::Implicit;
   p.time_step = args.number("lambda_dt", p.scheme == SmoothingScheme::Explicit ? 0.2 : 1.0);
   p.iterations = args.integer("iterations", 1);
-  p.max_depth_jump = args.number("max_jump", 0.05);
+  // One name with pcl_ddg_normals' -max_depth_jump; the old -max_jump still works.
+  if (args.has("max_jump") && args.has("max_depth_jump"))
+    throw tools::UsageError("-max_jump is the old name of -max_depth_jump: give one");
+  const char* jump = args.has("max_jump") ? "max_jump" : "max_depth_jump";
+  p.max_depth_jump = args.number(jump, 0.05);
   if (!(p.time_step > 0.0)) throw tools::UsageError("-lambda_dt must be > 0");
   if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
-  if (!(p.max_depth_jump > 0.0)) throw tools::UsageError("-max_jump must be > 0");
+  if (!(p.max_depth_jump > 0.0)) throw tools::UsageError(std::string("-") + jump + " must be > 0");
   const tools::SolverChoice solver = tools::solverArgument(args);
   p.implicit_solver = solver.method;
   p.solver = solver.backend;
