@@ -148,6 +148,25 @@ TEST(GridSmoothing, NeighboursAcrossADepthJumpAreNotCoupled) {
   EXPECT_GT(smoothed.rightCols(width / 2).minCoeff(), 3.95);
 }
 
+// The cut is relative to the nearer of the two ranges: |r_i - r_j| > f min(r_i, r_j). Ranges 1 and
+// 1.05 differ by 0.05, which is above 0.0488 x 1 (cut) but below 0.0488 x 1.05 = 0.0512: a
+// threshold relative to the farther range would couple them.
+TEST(GridSmoothing, TheJumpIsRelativeToTheNearerRange) {
+  const int width = 8, height = 4;
+  Eigen::MatrixXd range(height, width);
+  for (int row = 0; row < height; ++row) {
+    for (int column = 0; column < width; ++column) range(row, column) = column < 4 ? 1.0 : 1.05;
+  }
+  for (const double f : {0.0488, 0.0512}) {
+    GridSmoothingParameters p;
+    p.max_depth_jump = f;
+    GridSmoothingReport report;
+    smoothOrganizedPositions(imageFromRanges(range), width, height, Eigen::Vector3d::Zero(), p,
+                             &report);
+    EXPECT_EQ(report.cut_pairs, f < 0.05 ? height : 0) << "max_depth_jump " << f;
+  }
+}
+
 TEST(GridSmoothing, ExplicitAboveAQuarterIsUnstableImplicitIsNot) {
   const int width = 16, height = 16;
   const Eigen::MatrixXd range =

@@ -15,6 +15,7 @@
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/surface/mesh_smoothing.h"
+#include "reference_operators.h"
 #include "smoothing_support.h"
 #include "test_data.h"
 
@@ -320,6 +321,38 @@ TEST(MeshSmoothing, FrozenImplicitStepsAreTheBackwardEulerOperatorAndBothSolvers
     EXPECT_EQ(report.solver, CholeskyBackend::Cholmod);
     EXPECT_LT((cholmod - simplicial).cwiseAbs().maxCoeff(), 1e-12);
   }
+}
+
+// The default (WeightUpdate::FrozenStiffness): every step solves (M_k - tau L_0) x_{k+1} = M_k x_k
+// with the input's stiffness L_0 and the mass of the current positions x_k, here by the reference
+// operators and Eigen's SimplicialLLT. Fully frozen (M_0 every step) is measurably different.
+TEST(MeshSmoothing, FrozenStiffnessKeepsTheInputsStiffnessAndTakesEachStepsMass) {
+  const SurfaceSample s = makeIcosphere(3, 1.0, 0.2, 5);
+  const MeshTopology t(static_cast<int>(s.points.cols()), s.triangles);
+  const double tau = 2.0 * squaredEdge(t, s.points);
+  MeshSmoothingParameters p;
+  p.time_step = tau;
+  p.iterations = 3;
+  p.implicit_solver = ImplicitSolver::Cholesky;
+  const Eigen::Matrix3Xd ours = smoothMeshPositions(t, s.points, p);
+  p.weight_update = WeightUpdate::Frozen;
+  const Eigen::Matrix3Xd frozen = smoothMeshPositions(t, s.points, p);
+
+  const Eigen::SparseMatrix<double> stiffness = referenceCotangentLaplacian(t, s.points);
+  Eigen::MatrixXd x = s.points.transpose();
+  for (int step = 0; step < 3; ++step) {
+    const Eigen::VectorXd mass = referenceMass(t, x.transpose());
+    Eigen::SparseMatrix<double> system = -tau * stiffness;
+    for (int v = 0; v < t.numVertices(); ++v) system.coeffRef(v, v) += mass[v];
+    const Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> solver(system);
+    x = solver.solve(mass.asDiagonal() * x).eval();
+  }
+  const double error = (ours - x.transpose()).cwiseAbs().maxCoeff();
+  const double frozen_difference = (ours - frozen).cwiseAbs().maxCoeff();
+  std::printf("frozen stiffness vs reference %.2e, vs fully frozen %.2e\n", error,
+              frozen_difference);
+  EXPECT_LT(error, 1e-10);
+  EXPECT_GT(frozen_difference, 1e3 * error + 1e-8);
 }
 
 TEST(MeshSmoothing, IsolatedVerticesStayAndADegenerateFaceDoesNoHarm) {
