@@ -243,6 +243,14 @@ TEST(OrganizedNormals, NoNormalBendsAcrossADepthStep) {
               bent, near_step);
 }
 
+// The grid neighbourhood of k pixels is the smallest square window holding at least k: (2r + 1)^2
+// >= k with r >= 1.
+TEST(OrganizedNormals, TheWindowForKPixelsIsTheSmallestSquareHoldingThem) {
+  const std::pair<int, int> cases[] = {{1, 1},  {8, 1},  {9, 1},  {10, 2}, {16, 2},
+                                       {25, 2}, {26, 3}, {49, 3}, {50, 4}};
+  for (const auto& [k, radius] : cases) EXPECT_EQ(gridWindowRadius(k), radius) << "k = " << k;
+}
+
 TEST(OrganizedNormals, AtLeastAsAccurateAsIntegralImageNormalEstimation) {
   const auto image = renderRangeImage(RangeScene::Sphere, PinholeCamera{}.scaled(4.0), 1e-3, 3);
   // At most 1 in 10^4 seen pixels without a normal: silhouette pixels whose window the depth-jump
