@@ -16,11 +16,13 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "test_data.h"
 
@@ -105,6 +107,29 @@ TEST(NumberParsing, SeventeenDigitDoublesAreReadExactlyInEveryTextFormat) {
     return "# vtk DataFile Version 3.0\nnumbers\nASCII\nDATASET POLYDATA\nPOINTS " +
            std::to_string(n) + " double\n" + vertexLines(text, "") + "POLYGONS 1 4\n3 0 1 2\n";
   });
+}
+
+// A number with anything after it is not a number: "1.5x", "2e", "1.5.2", "1e5e", "nanx" and
+// "inf0" are each refused with the text named, never read as their prefix; the spellings strtod
+// alone knows ("-nan", "+inf", "infinity") are read.
+TEST(NumberParsing, ANumberFollowedByJunkIsRefusedNotReadAsItsPrefix) {
+  const std::string dir = scratchFolder("number_junk");
+  const auto off = [&](const std::string& x) {
+    const std::string path = dir + "/junk.off";
+    std::ofstream(path) << "OFF\n3 1 0\n" << x << " 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    return path;
+  };
+  for (const char* junk : {"1.5x", "2e", "1.5.2", "1e5e", "nanx", "inf0"}) {
+    try {
+      readMeshFile(off(junk));
+      ADD_FAILURE() << "'" << junk << "' was read as a number";
+    } catch (const FileFormatException& e) {
+      EXPECT_NE(std::string(e.what()).find(junk), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_TRUE(std::isnan(readMeshFile(off("-nan")).positions(0, 0)));
+  EXPECT_EQ(readMeshFile(off("+inf")).positions(0, 0), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(readMeshFile(off("infinity")).positions(0, 0), std::numeric_limits<double>::infinity());
 }
 
 // PCL's readers give float x y z; ours give the file's exact values, which cast to float must be
