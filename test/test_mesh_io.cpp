@@ -206,6 +206,32 @@ TEST_F(MeshIOFiles, CoordinatesBeyondFloatAreRefused) {
   }
 }
 
+// A field with COUNT 3 before x y z: each point is 6 floats, x at byte 12 (the specification:
+// a field takes SIZE x COUNT bytes). Ascii and binary, both against the values written.
+TEST_F(MeshIOFiles, PcdFieldsWithACountAboveOneTakeThatManyValues) {
+  const float rows[2][6] = {{9, 8, 7, 1.5f, 2.5f, 3.5f}, {6, 5, 4, -1, -2, -3}};
+  const std::string header =
+      "VERSION .7\nFIELDS tag x y z\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 3 1 1 1\nWIDTH 2\n"
+      "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 2\n";
+  {
+    std::ofstream ascii(path("ascii.pcd"));
+    ascii << header << "DATA ascii\n";
+    for (const auto& row : rows) {
+      for (int k = 0; k < 6; ++k) ascii << row[k] << (k < 5 ? " " : "\n");
+    }
+    std::ofstream binary(path("binary.pcd"), std::ios::binary);
+    binary << header << "DATA binary\n";
+    binary.write(reinterpret_cast<const char*>(rows), sizeof rows);
+  }
+  for (const char* name : {"ascii.pcd", "binary.pcd"}) {
+    const Eigen::Matrix3Xd positions = vertexPositions(loadMesh(path(name)).cloud);
+    ASSERT_EQ(positions.cols(), 2) << name;
+    for (int i = 0; i < 2; ++i) {
+      for (int d = 0; d < 3; ++d) EXPECT_EQ(positions(d, i), rows[i][3 + d]) << name;
+    }
+  }
+}
+
 TEST_F(MeshIOFiles, PcdRoundTrip) {
   const pcl::PolygonMesh cloud = loadMesh(sharedData("clouds/milk.pcd"));
   saveMesh(path("milk.pcd"), cloud);
