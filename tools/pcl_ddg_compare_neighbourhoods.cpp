@@ -7,8 +7,8 @@
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
-#include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/render/color_map.h"
 
 namespace {
 
@@ -21,7 +21,8 @@ constexpr const char* kDescription =
     "angle_difference (degrees) and overlap (Jaccard, 0..1), coloured by the angle difference\n"
     "(by default unless the input has colours of its own; -color none keeps them as they are).";
 constexpr const char* kSyntax =
-    "input.{ply,obj,off,stl,vtk,pcd} output.{ply,pcd} [-method pca|quadric] [-k N (default 16)]\n"
+    "input.{ply,obj,off,stl,vtk,pcd,las} output.{ply,pcd,las} [-method pca|quadric] [-k N "
+    "(default 16)]\n"
     "         [-radius r or 2.5h (instead of -k)] [-max_nn N (with -radius; default 64)]\n"
     "         [-max_depth_jump f (organized clouds; default 0.02)]\n"
     "         [-viewpoint x,y,z] [-color angle_difference|overlap|none] [-precision float|double]";
@@ -36,7 +37,7 @@ int run(int argc, char** argv) {
   const FieldPrecision precision = tools::precisionArgument(args);
   tools::checkLocalFitArguments(args);
   return tools::forEachInput(
-      args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+      args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
         tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
         const bool organized = !in.topology && in.points->height > 1;
         if (!in.topology && !organized)
@@ -82,7 +83,7 @@ int run(int argc, char** argv) {
         }
         tools::saveResult(kName, output, in.mesh, in.positions,
                           tools::coordinatePrecision(in.coordinate_precision, precision),
-                          in.sensor_pose);
+                          in.sensor_pose, in.las);
       });
 }
 

@@ -4,10 +4,10 @@
 #include "common/local_fit_job.h"
 #include "common/mesh_job.h"
 #include "common/tool_common.h"
-#include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/operators/curvature.h"
+#include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/surface/scalar_field_smoothing.h"
 
 namespace {
@@ -22,11 +22,13 @@ constexpr const char* kDescription =
     "k1_direction_x/y/z and the normal). -smooth t first smooths the four curvature fields by the\n"
     "implicit heat flow on the mesh for a time t in units of h^2 (h = mean edge length).";
 constexpr const char* kSyntax =
-    "input.{ply,obj,off,stl,vtk,pcd} output.{ply,pcd} [-method cotan|quadric (default: cotan on "
+    "input.{ply,obj,off,stl,vtk,pcd,las} output.{ply,pcd,las} [-method cotan|quadric (default: "
+    "cotan on "
     "meshes)]\n"
     "         [-area mixed|voronoi|barycentric (cotan)]\n"
     "         [-neighbours bfs|knn] [-k N (default 20)] [-radius r or 2.5h] [-max_nn N]\n"
-    "         [-viewpoint x,y,z] (quadric)\n"
+    "         [-viewpoint x,y,z] [-classes 2,6 (fit only these classes, NaN elsewhere)] "
+    "(quadric)\n"
     "         [-smooth t (heat flow time in h^2, meshes)]\n"
     "         [-color mean|gauss|k1|k2] [-percentile p (colour scale clamp, default 2)]\n"
     "         [-precision float|double]\n"
@@ -70,10 +72,11 @@ void setCurvatureFields(pcl::PCLPointCloud2& cloud, const CurvatureFields& c,
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
-  const tools::ToolArguments args(argc, argv,
-                                  {"method", "area", "neighbours", "k", "radius", "max_nn",
-                                   "smooth", "color", "percentile", "precision", "memory"},
-                                  {});
+  const tools::ToolArguments args(
+      argc, argv,
+      {"method", "area", "neighbours", "k", "radius", "max_nn", "smooth", "color", "percentile",
+       "precision", "memory", "classes"},
+      {});
   const std::string color = args.choice("color", {"none", "mean", "gauss", "k1", "k2"}, "none");
   const double percentile = args.number("percentile", 2.0);
   if (percentile < 0.0 || percentile >= 50.0)
@@ -83,8 +86,9 @@ int run(int argc, char** argv) {
       args.has("method") ? args.choice("method", {"cotan", "quadric"}, "cotan") : "";
   if (requested == "quadric" && args.has("area"))
     throw tools::UsageError("-area applies to -method cotan");
-  if (requested == "cotan" && (args.has("neighbours") || args.has("k") || args.has("radius"))) {
-    throw tools::UsageError("-neighbours, -k and -radius apply to -method quadric");
+  if (requested == "cotan" &&
+      (args.has("neighbours") || args.has("k") || args.has("radius") || args.has("classes"))) {
+    throw tools::UsageError("-neighbours, -k, -radius and -classes apply to -method quadric");
   }
   const MassType mass = tools::massTypeArgument(args, "area");  // validated before loading
   tools::checkLocalFitArguments(args);
@@ -105,7 +109,7 @@ int run(int argc, char** argv) {
   }
 
   return tools::forEachInput(
-      args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+      args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
         tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
         const std::string method =
             !requested.empty() ? requested : (in.topology ? "cotan" : "quadric");
@@ -135,13 +139,15 @@ int run(int argc, char** argv) {
         } else {
           const LocalFitOptions options =
               tools::localFitArguments(args, in, LocalFitMethod::Quadric);
+          const std::int64_t left_out = tools::keepOnlyClasses(kName, args, in);
           const tools::SamplingCheck sampling = tools::checkSampling(kName, in, options);
           tools::Timer timer("Fitting quadrics");
-          const LocalFitResult result = [&] {
+          LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
             return fitLocalSurfaces(in.points, in.topology, options);
           }();
           timer.done(in.points->size());
+          result.failed_points -= left_out;  // -classes: not fitted by request
           tools::warnAboutLocalFit(kName, result);
           tools::warnAboutRadius(kName, sampling, options, result);
           curvatures = quadricFields(in.mesh.cloud, output, result, precision);
@@ -177,7 +183,7 @@ int run(int argc, char** argv) {
         }
         tools::saveResult(kName, output, in.mesh, in.positions,
                           tools::coordinatePrecision(in.coordinate_precision, precision),
-                          in.sensor_pose);
+                          in.sensor_pose, in.las);
       });
 }
 

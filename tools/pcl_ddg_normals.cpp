@@ -18,13 +18,14 @@ constexpr const char* kDescription =
     "mean_curvature) or by fitting a plane (pca) or a quadric to each point's neighbours, found "
     "on\n"
     "the mesh (bfs rings), on an organized cloud's pixel grid (grid: never across a depth jump;\n"
-    "pca there fits the smallest square window of k pixels from its running window sums) or in space\n"
+    "pca there fits the smallest square window of k pixels from its running window sums) or in "
+    "space\n"
     "(knn, kd-tree). An organized cloud stays organized. Writes nx ny nz (.ply) or normal_x "
     "normal_y\n"
     "normal_z curvature (.pcd; for mesh methods the curvature is PCL's surface variation over\n"
     "the vertex's 1-ring).";
 constexpr const char* kSyntax =
-    "input.{ply,obj,off,stl,vtk,pcd} output.{ply,pcd}\n"
+    "input.{ply,obj,off,stl,vtk,pcd,las} output.{ply,pcd,las}\n"
     "         [-method uniform|area|angle|mean_curvature|pca|quadric (default: area on meshes, pca "
     "on clouds)]\n"
     "         [-epsilon e (mean_curvature: |M^-1 L x| below e counts as flat; default 0.02/h)]\n"
@@ -46,6 +47,8 @@ constexpr const char* kSyntax =
     "                  it can and the tree the rest; else each tree's highest point faces up),\n"
     "                  or like the faces (meshes' default))]\n"
     "         [-up x,y,z (-orient up and mst: the up direction; default 0,0,1)]\n"
+    "         [-classes 2,6 (clouds with a classification, like LAS: fit only these classes;\n"
+    "                  every point is written, NaN elsewhere)]\n"
     "         [-normal_map out.png (organized clouds: the normals as an image, (n + 1) / 2 as "
     "RGB)]\n"
     "         [-precision float|double]\n"
@@ -100,7 +103,7 @@ int run(int argc, char** argv) {
   const tools::ToolArguments args(
       argc, argv,
       {"method", "epsilon", "neighbours", "k", "radius", "max_nn", "viewpoint", "precision",
-       "memory", "max_depth_jump", "orient", "normal_map", "up", "min_nn"},
+       "memory", "max_depth_jump", "orient", "normal_map", "up", "min_nn", "classes"},
       {});
   const FieldPrecision precision = tools::precisionArgument(args);
   const std::vector<std::string> methods = {"uniform",        "area", "angle",
@@ -109,11 +112,11 @@ int run(int argc, char** argv) {
   const bool fitted = requested == "pca" || requested == "quadric";
   const bool neighbour_options = args.has("neighbours") || args.has("k") || args.has("radius") ||
                                  args.has("max_depth_jump") || args.has("orient") ||
-                                 args.has("up") || args.has("min_nn");
+                                 args.has("up") || args.has("min_nn") || args.has("classes");
   if (!requested.empty() && !fitted && neighbour_options) {
     throw tools::UsageError(
-        "-neighbours, -k, -radius, -min_nn, -max_depth_jump, -orient and -up apply to pca and "
-        "quadric");
+        "-neighbours, -k, -radius, -min_nn, -max_depth_jump, -orient, -up and -classes apply to "
+        "pca and quadric");
   }
   if (args.has("epsilon") && requested != "mean_curvature") {
     throw tools::UsageError("-epsilon applies to -method mean_curvature only");
@@ -145,7 +148,7 @@ int run(int argc, char** argv) {
         });
   }
   return tools::forEachInput(
-      args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+      args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
         if (args.has("normal_map")) tools::checkOutputFile(*args.value("normal_map"), {input});
         tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
         if (orient == "mesh" && !in.topology)
@@ -194,6 +197,7 @@ int run(int argc, char** argv) {
           // An organized frame has one sensor: it decides the tree's signs (unless -up does).
           options.seed_facing_viewpoint =
               !args.has("up") && (args.has("viewpoint") || in.points->height > 1);
+          const std::int64_t left_out = tools::keepOnlyClasses(kName, args, in);
           const tools::SamplingCheck sampling = tools::checkSampling(kName, in, options);
           tools::Timer timer("Computing " + method + " normals (" +
                              tools::describeNeighbourhood(options) +
@@ -203,6 +207,7 @@ int run(int argc, char** argv) {
             return fitLocalSurfaces(in.points, in.topology, options);
           }();
           timer.done(in.points->size());
+          result.failed_points -= left_out;  // -classes: not fitted by request
           tools::warnAboutLocalFit(kName, result);
           tools::warnAboutRadius(kName, sampling, options, result);
           if (orient == "mst") reportSpanningTree(result.orientation);
@@ -211,7 +216,7 @@ int run(int argc, char** argv) {
         }
         tools::saveResult(kName, output, in.mesh, in.positions,
                           tools::coordinatePrecision(in.coordinate_precision, precision),
-                          in.sensor_pose);
+                          in.sensor_pose, in.las);
       });
 }
 

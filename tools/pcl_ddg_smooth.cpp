@@ -23,7 +23,7 @@ constexpr const char* kDescription =
     "step -lambda_dt is in units of h^2 (h = mean edge length), so\n"
     "one command line works on any scan; -absolute_time takes it in length^2.";
 constexpr const char* kSyntax =
-    "input.{ply,obj,off,stl,vtk} output.{ply,pcd}\n"
+    "input.{ply,obj,off,stl,vtk} output.{ply,pcd,las}\n"
     "         [-method explicit|implicit (default implicit)] [-weights uniform|cotan (default "
     "cotan)]\n"
     "         [-mass mixed|voronoi|barycentric] [-lambda_dt t (default: implicit 1, explicit half "
@@ -69,7 +69,7 @@ int run(int argc, char** argv) {
   const FieldPrecision precision = tools::precisionArgument(args);
 
   return tools::forEachInput(
-      args, kName, {"ply", "pcd"}, [&](const std::string& input, const std::string& output) {
+      args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
         tools::SurfaceMesh in = tools::loadSurfaceMesh(input, kName);
         const double h = meanEdgeLength(in.topology, in.positions);
         if (!(h > 0.0)) throw std::runtime_error("the mesh has no edge of positive length");

@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/mesh_io.h"
 
 namespace pcl_ddg {
@@ -29,6 +30,25 @@ pcl::PolygonMesh parseVTK(std::string_view data);
 /** PCD, ascii, binary or binary_compressed (padding fields "_" kept as in PCL's reader); the
  *  VIEWPOINT into sensor_pose when given. */
 pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose = nullptr);
+
+/** A LAS file read: float x y z and the records' fields in the cloud, the exact coordinates
+ *  (X * scale + offset in double) and the layout (header, VLRs, Extra Bytes). */
+struct LasCloud {
+  pcl::PolygonMesh mesh;
+  Eigen::Matrix3Xd positions;
+  LasLayout layout;
+};
+
+/** LAS 1.0-1.4, uncompressed, point formats 0-10; LAZ (the compression bit set in the point
+ *  format) is refused first, with how to decompress it. */
+LasCloud parseLAS(std::string_view data);
+
+/** A cloud as a LAS file: the layout of `source` (version, point format, scale, offset, VLRs and
+ *  EVLRs, Extra Bytes descriptors of the fields that remain), or LAS 1.4 format 6 (7 with
+ *  colours) with a scale and offset chosen for the coordinates when null. Fields that the point
+ *  format has no place for become Extra Bytes dimensions; bounds and counts are recomputed. */
+std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions,
+                      const LasLayout* source);
 
 /** How the points of a binary cloud file lie on disk, for reading it a piece at a time. */
 struct BinaryCloudLayout {

@@ -72,8 +72,23 @@ std::string fileExtension(const std::string& path) {
 MeshFile readMeshFile(const std::string& path) {
   const std::string ext = fileExtension(path);
   try {
+    if (ext == "laz") {  // before anything is read: no LAZ decoder is at hand
+      throw FileFormatException(
+          "LAZ (compressed LAS) is not supported: decompress it first with "
+          "`laszip -i in.laz -o out.las` or `pdal translate in.laz out.las`");
+    }
     const detail::FileBytes bytes(path);  // first: a missing file says so
     const std::string_view data = bytes.view();
+    if (ext == "las") {
+      detail::LasCloud las = detail::parseLAS(data);
+      if (las.positions.cols() == 0) throw FileFormatException("file has no vertices");
+      MeshFile file;
+      file.mesh = std::move(las.mesh);
+      file.positions = std::move(las.positions);
+      file.coordinate_precision = FieldPrecision::Double;  // X * scale + offset
+      file.las = std::make_shared<const LasLayout>(std::move(las.layout));
+      return file;
+    }
     using Parser = pcl::PolygonMesh (*)(std::string_view);
     Parser parse = nullptr;
     if (ext == "ply") parse = detail::parsePLY;
@@ -84,7 +99,7 @@ MeshFile readMeshFile(const std::string& path) {
     if (parse == nullptr && ext != "pcd") {
       throw FileFormatException(
           (ext.empty() ? std::string("no file extension") : "unknown file type '." + ext + "'") +
-          " (expected .ply, .obj, .off, .stl, .vtk or .pcd)");
+          " (expected .ply, .obj, .off, .stl, .vtk, .pcd or .las)");
     }
     MeshFile file;
     file.mesh = ext == "pcd" ? detail::parsePCD(data, &file.sensor_pose) : parse(data);
@@ -121,11 +136,15 @@ void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh,
               const MeshWriteOptions& options) {
   const std::string ext = fileExtension(path);
   try {
-    if (ext != "ply" && ext != "pcd") {
-      throw FileFormatException("cannot write '." + ext + "' files (use .ply or .pcd)");
+    if (ext != "ply" && ext != "pcd" && ext != "las") {
+      throw FileFormatException("cannot write '." + ext + "' files (use .ply, .pcd or .las)");
     }
     AtomicFile file(path);
-    if (ext == "ply") {
+    if (ext == "las") {
+      writeBytes(file.temporaryPath(),
+                 detail::encodeLAS(mesh.cloud, vertexPositions(mesh.cloud, NonFinitePolicy::Keep),
+                                   options.las.get()));
+    } else if (ext == "ply") {
       savePLY(file.temporaryPath(), mesh, options.ply_encoding);
     } else {
       savePCD(file.temporaryPath(), mesh, options.sensor_pose);

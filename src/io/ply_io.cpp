@@ -550,7 +550,11 @@ std::vector<OutputProperty> outputProperties(const pcl::PCLPointCloud2& cloud) {
       properties.push_back({"blue", pcl::PCLPointField::UINT8, f.offset + 0});
       if (f.name == "rgba")
         properties.push_back({"alpha", pcl::PCLPointField::UINT8, f.offset + 3});
-    } else if (f.count == 1 && !f.name.empty() && f.name != "_") {
+    } else if (f.count == 1 && !f.name.empty() && f.name != "_" &&
+               f.datatype != pcl::PCLPointField::INT64 &&
+               f.datatype != pcl::PCLPointField::UINT64) {
+      // PLY has no 64-bit integers (a LAS extra-bytes or waveform offset field): left out, as
+      // fields of several values are, rather than written as 8 bytes under a 4-byte type.
       properties.push_back({f.name, f.datatype, f.offset});
     }
   }

@@ -201,12 +201,23 @@ VertexColors vertexColors(const pcl::PCLPointCloud2& cloud) {
   VertexColors rgb(3, static_cast<Eigen::Index>(n));
   if (*layout == ColorLayout::Channels) {
     const char* names[3] = {"red", "green", "blue"};
-    for (int c = 0; c < 3; ++c) {
-      // Channels stored wider than uchar (e.g. float 0..255) are clamped, not wrapped.
-      const Eigen::VectorXd values = vertexScalarField(cloud, names[c]);
-      rgb.row(c) =
-          values.array().cwiseMax(0.0).cwiseMin(255.0).round().cast<std::uint8_t>().transpose();
-    }
+    Eigen::MatrixXd values(3, static_cast<Eigen::Index>(n));
+    for (int c = 0; c < 3; ++c) values.row(c) = vertexScalarField(cloud, names[c]).transpose();
+    // 16-bit channels (LAS) hold 0..65535; some writers put 8-bit values in them, so they are
+    // scaled down only when a value exceeds 255.
+    const bool sixteen_bits =
+        std::all_of(names, names + 3,
+                    [&](const char* name) {
+                      return std::any_of(cloud.fields.begin(), cloud.fields.end(),
+                                         [&](const pcl::PCLPointField& f) {
+                                           return f.name == name &&
+                                                  f.datatype == pcl::PCLPointField::UINT16;
+                                         });
+                    }) &&
+        n > 0 && values.maxCoeff() > 255.0;
+    if (sixteen_bits) values /= 257.0;
+    // Channels stored wider than uchar (e.g. float 0..255) are clamped, not wrapped.
+    rgb = values.array().cwiseMax(0.0).cwiseMin(255.0).round().cast<std::uint8_t>();
     return rgb;
   }
   const std::uint32_t offset = packedColorField(cloud)->offset;

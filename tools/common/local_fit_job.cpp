@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 
 #include "common/mesh_job.h"
@@ -28,6 +29,7 @@ SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name) {
     timer.done(static_cast<std::size_t>(file.positions.cols()));
   }
   input.sensor_pose = file.sensor_pose;
+  input.las = file.las;
   input.coordinate_precision = file.coordinate_precision;
   if (!file.mesh.polygons.empty()) {
     SurfaceMesh mesh = checkSurfaceMesh(std::move(file), tool_name);
@@ -183,6 +185,7 @@ void checkLocalFitArguments(const ToolArguments& args) {
   viewpointArgument(args);
   upArgument(args);
   if (args.has("min_nn") && !args.has("radius")) throw UsageError("-min_nn needs -radius");
+  classesArgument(args);
   if (args.has("min_nn") && args.integer("min_nn", 3) < 3)
     throw UsageError("-min_nn must be at least 3");
   args.choice("neighbours", {"bfs", "knn", "grid"}, "knn");
@@ -319,6 +322,7 @@ LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod 
   options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20 : 16);
   options.viewpoint = viewpointArgument(args);
   options.up = upArgument(args);
+  if (args.has("classes")) throw UsageError("-classes is not available with -memory");
   if (args.has("min_nn"))
     throw UsageError(
         "-min_nn is not available with -memory (a tile's halo is certified for the "
@@ -332,6 +336,56 @@ LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod 
         static_cast<unsigned int>(args.integer("max_nn", kDefaultMaxNeighbours));
   }
   return options;
+}
+
+std::vector<int> classesArgument(const ToolArguments& args) {
+  std::vector<int> classes;
+  if (!args.has("classes")) return classes;
+  const std::string text = *args.value("classes");
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    const std::string item = text.substr(at, comma - at);
+    char* end = nullptr;
+    const long value = std::strtol(item.c_str(), &end, 10);
+    if (item.empty() || *end != '\0' || value < 0 || value > 255)
+      throw UsageError(
+          "-classes needs classification values 0-255 separated by commas, like 2,6"
+          " (not '" +
+          text + "')");
+    classes.push_back(static_cast<int>(value));
+    at = comma + 1;
+  }
+  return classes;
+}
+
+std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args,
+                             SurfaceInput& input) {
+  const std::vector<int> classes = classesArgument(args);
+  if (classes.empty()) return 0;
+  if (input.topology) throw UsageError("-classes applies to point clouds (a LAS file), not meshes");
+  if (!hasVertexField(input.mesh.cloud, "classification"))
+    throw std::runtime_error(
+        "-classes needs a classification field (a LAS file); the input has "
+        "none");
+  const Eigen::VectorXd classification = vertexScalarField(input.mesh.cloud, "classification");
+  std::int64_t left_out = 0;
+  for (Eigen::Index i = 0; i < classification.size(); ++i) {
+    if (std::find(classes.begin(), classes.end(), static_cast<int>(classification[i])) !=
+        classes.end())
+      continue;
+    pcl::PointXYZ& p = (*input.points)[static_cast<std::size_t>(i)];
+    p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+    ++left_out;
+  }
+  const std::int64_t fitted = classification.size() - left_out;
+  if (fitted == 0)
+    throw std::runtime_error("no point is of the classes -classes " + *args.value("classes"));
+  input.points->is_dense = false;
+  std::fprintf(stderr, "%s: -classes %s: fitting %lld of %lld points (NaN elsewhere)\n", tool_name,
+               args.value("classes")->c_str(), static_cast<long long>(fitted),
+               static_cast<long long>(classification.size()));
+  return left_out;
 }
 
 std::uint64_t memoryArgument(const ToolArguments& args) {

@@ -32,7 +32,8 @@ struct SurfaceInput {
   /** Mean edge length of a mesh (a cloud's mean nearest-neighbour distance costs a kd-tree, and
    *  is measured by localFitArguments when -radius asks for it). */
   double spacing = 0.0;
-  SensorPose sensor_pose;  ///< a PCD's VIEWPOINT (kept for the output)
+  SensorPose sensor_pose;                ///< a PCD's VIEWPOINT (kept for the output)
+  std::shared_ptr<const LasLayout> las;  ///< a LAS input's layout (kept for a .las output)
   FieldPrecision coordinate_precision = FieldPrecision::Float;  ///< as the file declares them
 };
 
@@ -69,6 +70,19 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
  *  neighbourhoods, -k, or -radius as a length (a multiple of the spacing needs the whole cloud),
  *  -max_nn, -viewpoint (unset: the file's VIEWPOINT). */
 LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod method);
+
+/** -classes 2,6: the classification values (0-255) to fit, checked before any file is read
+ *  (UsageError); empty without -classes. */
+std::vector<int> classesArgument(const ToolArguments& args);
+
+/**
+ * With -classes: the points of other classes (by the input's `classification` field, as LAS
+ * files have it) become NaN in input.points, so that they are neither fitted nor anyone's
+ * neighbour, and every point is still written (NaN there). Prints how many are fitted; returns how
+ * many were left out (to subtract from the fit's failures). Throws when the input has no
+ * classification or no point of those classes.
+ */
+std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args, SurfaceInput& input);
 
 /** -memory SIZE (like 2G, 512M), checked before any file is read (UsageError). */
 std::uint64_t memoryArgument(const ToolArguments& args);

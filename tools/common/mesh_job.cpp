@@ -67,7 +67,8 @@ void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
   const char* pcd_names[] = {"normal_x", "normal_y", "normal_z"};
   const bool pcd_naming = hasVertexField(cloud, "normal_x") ? true
                           : hasVertexField(cloud, "nx")     ? false
-                                                            : fileExtension(output_path) == "pcd";
+                                                            : fileExtension(output_path) == "pcd" ||
+                                                              fileExtension(output_path) == "las";
   for (int d = 0; d < 3; ++d) removeVertexField(cloud, pcd_naming ? ply_names[d] : pcd_names[d]);
   const char** names = pcd_naming ? pcd_names : ply_names;
   setVertexFields(cloud, {names[0], names[1], names[2]}, normals, precision);
@@ -92,7 +93,7 @@ FieldPrecision coordinatePrecision(FieldPrecision input, FieldPrecision requeste
 
 void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh& mesh,
                 const Eigen::Matrix3Xd& positions, FieldPrecision coordinates,
-                const SensorPose& sensor_pose) {
+                const SensorPose& sensor_pose, const std::shared_ptr<const LasLayout>& las) {
   setVertexCoordinates(mesh.cloud, positions, coordinates);
   if (fileExtension(path) == "pcd") {
     std::string doubles;
@@ -109,6 +110,7 @@ void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh
   Timer timer("Saving " + path);
   MeshWriteOptions options;
   options.sensor_pose = sensor_pose;
+  options.las = las;
   saveMesh(path, mesh, options);
   timer.done(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height);
 }

@@ -49,7 +49,8 @@ FieldPrecision precisionArgument(const ToolArguments& args);
 /**
  * Writes normals (3 x N) as one field triple: under the input's own names when it has normals
  * (nx ny nz, or normal_x normal_y normal_z), else under the output format's (PLY nx ny nz, PCD
- * normal_x normal_y normal_z, as PCL writes them). The other naming is removed, so no output ever
+ * normal_x normal_y normal_z, as PCL writes them; LAS like PCD, written as PDAL's NormalX NormalY
+ * NormalZ). The other naming is removed, so no output ever
  * holds two normal triples.
  */
 void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
@@ -71,11 +72,14 @@ FieldPrecision coordinatePrecision(FieldPrecision input, FieldPrecision requeste
 /**
  * Writes positions into the mesh as x, y, z in the given precision and saves it through saveMesh
  * (format by extension, atomic), with a timing line; a PCD output carries the sensor pose as its
- * VIEWPOINT. Warns when a .pcd gets double fields, which PCL's float point types cannot read.
+ * VIEWPOINT, a LAS output the input's LAS layout (`las`: version, point format, scale, offset,
+ * VLRs; null for a new LAS 1.4 file). Warns when a .pcd gets double fields, which PCL's float point
+ * types cannot read.
  */
 void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh& mesh,
                 const Eigen::Matrix3Xd& positions, FieldPrecision coordinates,
-                const SensorPose& sensor_pose = {});
+                const SensorPose& sensor_pose = {},
+                const std::shared_ptr<const LasLayout>& las = nullptr);
 
 }  // namespace tools
 }  // namespace pcl_ddg

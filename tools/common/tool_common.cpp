@@ -144,12 +144,13 @@ namespace {
 
 const char* const kCommonHelp =
     "Every tool also takes:\n"
-    "         -input_dir DIR [-output_dir OUT]  every .ply .obj .off .stl .vtk .pcd file of DIR "
+    "         -input_dir DIR [-output_dir OUT]  every .ply .obj .off .stl .vtk .pcd .las file of "
+    "DIR "
     "(PCL's\n"
     "                  batch mode; outputs OUT/<name>.<ext>, a failure does not stop the others)\n"
     "         -h, -help  this text;  --version  pcl_ddg's version\n";
 
-const char* const kReadableExtensions[] = {"ply", "obj", "off", "stl", "vtk", "pcd"};
+const char* const kReadableExtensions[] = {"ply", "obj", "off", "stl", "vtk", "pcd", "las"};
 
 std::string extensionList(const std::vector<std::string>& extensions) {
   std::string list;
@@ -171,7 +172,7 @@ std::vector<std::string> batchInputs(const std::string& folder) {
   }
   if (error) throw std::runtime_error("cannot list " + folder + ": " + error.message());
   if (inputs.empty())
-    throw std::runtime_error(folder + " holds no .ply .obj .off .stl .vtk or .pcd file");
+    throw std::runtime_error(folder + " holds no .ply .obj .off .stl .vtk .pcd or .las file");
   std::sort(inputs.begin(), inputs.end());
   return inputs;
 }

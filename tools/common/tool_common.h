@@ -54,8 +54,8 @@ class ToolArguments {
 
 /**
  * Runs process(input, output) on the command line's input and output files, or, with
- * -input_dir DIR -output_dir OUT (PCL's batch mode), on every .ply .obj .off .stl .vtk .pcd file of
- * DIR in name order, writing OUT/<stem>.<ext>: the input's extension if it is one of
+ * -input_dir DIR -output_dir OUT (PCL's batch mode), on every .ply .obj .off .stl .vtk .pcd .las
+ * file of DIR in name order, writing OUT/<stem>.<ext>: the input's extension if it is one of
  * output_extensions, else the first of them. An empty output_extensions means the tool writes no
  * file (no output argument, no -output_dir). In a batch one failure does not stop the others: its
  * error line is printed, a summary ends the run, and the result is 1 if any file failed.

@@ -1,22 +1,27 @@
 #pragma once
-// Loading and saving meshes and clouds, the format chosen by the file extension (case-insensitive).
-//
-// Read: .ply (ascii/binary; face, tristrips or range_grid elements), .obj, .off (also binary OFF),
-// .stl (ascii/binary), .vtk (legacy POLYDATA), .pcd (organized or not; no faces).
-// Written: .ply (binary by default) and .pcd (binary_compressed, as PCL's tools write it; faces
-// are not stored). Colours are written as each format's viewers read them (ColorLayout): PLY
-// red green blue, PCD a packed rgb.
-// A cloud is a mesh without polygons. The mesh hands PCL what its point types read: x, y, z as
-// FLOAT32 (pcl::fromPCLPointCloud2 into pcl::PointXYZ works after any load); the coordinates as
-// the file holds them (double text, binary doubles) are kept exactly beside it (MeshFile).
-// Every other vertex field is kept as stored. Malformed, truncated or unknown files raise
-// FileFormatException with the path and the reason; output goes through a temporary file renamed on
-// success, so a failed save leaves no file behind.
+/** \file
+ * Loading and saving meshes and clouds, the format chosen by the file extension (case-insensitive).
+ *
+ * Read: .ply (ascii/binary; face, tristrips or range_grid elements), .obj, .off (also binary OFF),
+ * .stl (ascii/binary), .vtk (legacy POLYDATA), .pcd (organized or not; no faces), .las (LAS
+ * 1.0-1.4 uncompressed, point formats 0-10; .laz is refused with how to decompress it).
+ * Written: .ply (binary by default), .pcd (binary_compressed, as PCL's tools write it; faces
+ * are not stored) and .las (the input's LAS layout when given, else LAS 1.4 format 6/7). Colours
+ * are written as each format's viewers read them (ColorLayout): PLY red green blue, PCD a packed
+ * rgb. A cloud is a mesh without polygons. The mesh hands PCL what its point types read: x, y, z as
+ * FLOAT32 (pcl::fromPCLPointCloud2 into pcl::PointXYZ works after any load); the coordinates as
+ * the file holds them (double text, binary doubles) are kept exactly beside it (MeshFile).
+ * Every other vertex field is kept as stored. Malformed, truncated or unknown files raise
+ * FileFormatException with the path and the reason; output goes through a temporary file renamed on
+ * success, so a failed save leaves no file behind.
+ */
 #include <pcl/PolygonMesh.h>
 
 #include <Eigen/Geometry>
+#include <memory>
 #include <string>
 
+#include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/vertex_fields.h"
 
 namespace pcl_ddg {
@@ -33,6 +38,9 @@ struct SensorPose {
 struct MeshWriteOptions {
   PlyEncoding ply_encoding = PlyEncoding::Binary;
   SensorPose sensor_pose;  ///< written as a PCD's VIEWPOINT
+  /** A .las output keeps this layout (a LAS input's MeshFile::las): version, point format, scale,
+   *  offset and every VLR. Null: LAS 1.4 format 6 (7 with colours), scale and offset chosen. */
+  std::shared_ptr<const LasLayout> las;
 };
 
 /** A loaded file: the mesh as PCL code reads it, and what float fields cannot hold. */
@@ -43,6 +51,9 @@ struct MeshFile {
    *  `double`), so that a tool writes them back as such; Float for float and untyped text. */
   FieldPrecision coordinate_precision = FieldPrecision::Float;
   SensorPose sensor_pose;  ///< a PCD file's VIEWPOINT
+  /** A LAS file's header, VLRs and Extra Bytes layout (null for other formats). Its coordinates
+   *  are X * scale + offset in double (positions; coordinate_precision Double). */
+  std::shared_ptr<const LasLayout> las;
 };
 
 /** Loads any supported file. Throws FileFormatException when a finite coordinate lies beyond

@@ -1,0 +1,983 @@
+// ASPRS LAS 1.0-1.4, uncompressed, point data record formats 0-10 (LAS 1.4 R15): read into a
+// cloud whose fields are the records' fields, and written back from such a cloud. No LAS library
+// is packaged in Debian 12, so the layout is implemented here, every size checked against the
+// bytes the file holds before anything is allocated.
+//
+// A file is: the public header block (227 bytes in 1.0-1.2, 235 in 1.3, 375 in 1.4), the
+// variable-length records (54-byte header + up to 65,535 bytes each), the point records (fixed
+// size, the format's fields then any extra bytes), and in 1.3/1.4 extended VLRs (60-byte header,
+// 64-bit length) after the points. Everything is little-endian. A coordinate is the record's
+// 32-bit integer X times the header's scale plus its offset, computed in double.
+#include <pcl/common/io.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <sstream>
+
+#include "formats.h"
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/las_layout.h"
+#include "pcl_ddg/io/vertex_fields.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
+#error "the LAS reader assumes a little-endian host"
+#endif
+
+namespace pcl_ddg {
+
+std::uint16_t lasPointFormatSize(int point_format) {
+  static constexpr std::uint16_t kSizes[] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
+  return point_format >= 0 && point_format <= 10 ? kSizes[point_format] : 0;
+}
+
+namespace {
+
+std::string upToNul(const std::string& bytes) {
+  return bytes.substr(0, bytes.find('\0'));
+}
+
+}  // namespace
+
+std::string LasVariableLengthRecord::userId() const {
+  return upToNul(user_id);
+}
+
+std::string LasVariableLengthRecord::descriptionText() const {
+  return upToNul(description);
+}
+
+namespace detail {
+namespace {
+
+constexpr std::size_t kVlrHeader = 54;
+constexpr std::size_t kEvlrHeader = 60;
+constexpr std::size_t kDescriptorSize = 192;
+
+[[noreturn]] void fail(const std::string& message) {
+  throw FileFormatException("LAS: " + message);
+}
+
+template <typename T>
+T get(const char* p) {
+  T value;
+  std::memcpy(&value, p, sizeof(T));
+  return value;
+}
+
+template <typename T>
+void put(char* p, T value) {
+  std::memcpy(p, &value, sizeof(T));
+}
+
+std::size_t headerSizeOf(int minor) {
+  return minor >= 4 ? 375 : minor == 3 ? 235 : 227;
+}
+
+// One field of a point data record format: whole bytes (copied as they are) or bits of a byte.
+struct CoreField {
+  const char* name;
+  std::uint8_t datatype;             ///< the cloud field's pcl::PCLPointField type
+  std::uint16_t offset;              ///< in the record
+  std::uint8_t shift = 0, bits = 0;  ///< bits > 0: a bit field of the byte at offset
+};
+
+using F = pcl::PCLPointField;
+
+std::vector<CoreField> coreFields(int format) {
+  std::vector<CoreField> fields = {{"intensity", F::UINT16, 12}};
+  const bool extended = format >= 6;
+  if (!extended) {
+    fields.insert(fields.end(), {{"return_number", F::UINT8, 14, 0, 3},
+                                 {"number_of_returns", F::UINT8, 14, 3, 3},
+                                 {"scan_direction_flag", F::UINT8, 14, 6, 1},
+                                 {"edge_of_flight_line", F::UINT8, 14, 7, 1},
+                                 {"classification", F::UINT8, 15, 0, 5},
+                                 {"classification_flags", F::UINT8, 15, 5, 3},
+                                 {"scan_angle_rank", F::INT8, 16},
+                                 {"user_data", F::UINT8, 17},
+                                 {"point_source_id", F::UINT16, 18}});
+  } else {
+    fields.insert(fields.end(), {{"return_number", F::UINT8, 14, 0, 4},
+                                 {"number_of_returns", F::UINT8, 14, 4, 4},
+                                 {"classification_flags", F::UINT8, 15, 0, 4},
+                                 {"scanner_channel", F::UINT8, 15, 4, 2},
+                                 {"scan_direction_flag", F::UINT8, 15, 6, 1},
+                                 {"edge_of_flight_line", F::UINT8, 15, 7, 1},
+                                 {"classification", F::UINT8, 16},
+                                 {"user_data", F::UINT8, 17},
+                                 {"scan_angle", F::INT16, 18},
+                                 {"point_source_id", F::UINT16, 20},
+                                 {"gps_time", F::FLOAT64, 22}});
+  }
+  if (format == 1 || format == 3 || format == 4 || format == 5)
+    fields.push_back({"gps_time", F::FLOAT64, 20});
+  int rgb = -1, nir = -1, wave = -1;
+  switch (format) {
+    case 2:
+      rgb = 20;
+      break;
+    case 3:
+      rgb = 28;
+      break;
+    case 4:
+      wave = 28;
+      break;
+    case 5:
+      rgb = 28;
+      wave = 34;
+      break;
+    case 7:
+      rgb = 30;
+      break;
+    case 8:
+      rgb = 30;
+      nir = 36;
+      break;
+    case 9:
+      wave = 30;
+      break;
+    case 10:
+      rgb = 30;
+      nir = 36;
+      wave = 38;
+      break;
+    default:
+      break;
+  }
+  if (rgb >= 0) {
+    const auto o = static_cast<std::uint16_t>(rgb);
+    fields.insert(fields.end(), {{"red", F::UINT16, o},
+                                 {"green", F::UINT16, static_cast<std::uint16_t>(o + 2)},
+                                 {"blue", F::UINT16, static_cast<std::uint16_t>(o + 4)}});
+  }
+  if (nir >= 0) fields.push_back({"nir", F::UINT16, static_cast<std::uint16_t>(nir)});
+  if (wave >= 0) {
+    const auto o = static_cast<std::uint16_t>(wave);
+    const auto at = [o](int k) { return static_cast<std::uint16_t>(o + k); };
+    fields.insert(fields.end(), {{"wave_packet_index", F::UINT8, o},
+                                 {"wave_packet_offset", F::UINT64, at(1)},
+                                 {"wave_packet_size", F::UINT32, at(9)},
+                                 {"wave_return_location", F::FLOAT32, at(13)},
+                                 {"wave_x_t", F::FLOAT32, at(17)},
+                                 {"wave_y_t", F::FLOAT32, at(21)},
+                                 {"wave_z_t", F::FLOAT32, at(25)}});
+  }
+  return fields;
+}
+
+// --- Extra Bytes descriptors ---------------------------------------------------------------
+
+// The pcl type and element count of an Extra Bytes data type (1-10 scalars, 11-30 the deprecated
+// 2- and 3-arrays); type 0 is `options` undocumented bytes.
+struct ExtraType {
+  std::uint8_t datatype;
+  std::uint32_t count;
+};
+
+std::uint8_t pclTypeOfLas(int base) {
+  static constexpr std::uint8_t kTypes[] = {F::UINT8, F::INT8,   F::UINT16, F::INT16,   F::UINT32,
+                                            F::INT32, F::UINT64, F::INT64,  F::FLOAT32, F::FLOAT64};
+  return kTypes[base - 1];
+}
+
+int lasTypeOfPcl(std::uint8_t datatype) {
+  switch (datatype) {
+    case F::UINT8:
+      return 1;
+    case F::INT8:
+      return 2;
+    case F::UINT16:
+      return 3;
+    case F::INT16:
+      return 4;
+    case F::UINT32:
+      return 5;
+    case F::INT32:
+      return 6;
+    case F::UINT64:
+      return 7;
+    case F::INT64:
+      return 8;
+    case F::FLOAT32:
+      return 9;
+    case F::FLOAT64:
+      return 10;
+    default:
+      return 0;
+  }
+}
+
+ExtraType extraType(const char* descriptor, std::size_t index) {
+  const int type = static_cast<std::uint8_t>(descriptor[2]);
+  const int options = static_cast<std::uint8_t>(descriptor[3]);
+  if (type == 0) {
+    if (options == 0)
+      fail("Extra Bytes dimension " + std::to_string(index) +
+           " is of type 0 (undocumented bytes) with no size in its options");
+    return {F::UINT8, static_cast<std::uint32_t>(options)};
+  }
+  if (type > 30)
+    fail("Extra Bytes dimension " + std::to_string(index) + " has unknown data type " +
+         std::to_string(type));
+  const int base = (type - 1) % 10 + 1;
+  return {pclTypeOfLas(base), static_cast<std::uint32_t>((type - 1) / 10 + 1)};
+}
+
+std::uint32_t byteSize(const ExtraType& t) {
+  return pcl::getFieldSize(t.datatype) * t.count;
+}
+
+// PDAL's names for normals and curvature in LAS (extra bytes) and ours in clouds (PCD naming).
+const std::pair<const char*, const char*> kRenamed[] = {{"NormalX", "normal_x"},
+                                                        {"NormalY", "normal_y"},
+                                                        {"NormalZ", "normal_z"},
+                                                        {"Curvature", "curvature"}};
+
+std::string cloudNameOf(const std::string& las_name, std::size_t index) {
+  for (const auto& [las, cloud] : kRenamed) {
+    if (las_name == las) return cloud;
+  }
+  std::string name;
+  for (const char c : las_name) {
+    const bool plain = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
+    name += plain ? c : '_';
+  }
+  // ("_" alone is PCL's padding, which writers skip.)
+  if (name.find_first_not_of('_') == std::string::npos) return "extra_" + std::to_string(index);
+  return name;
+}
+
+std::string lasNameOf(const std::string& field) {
+  for (const auto& [las, cloud] : kRenamed) {
+    if (field == cloud) return las;
+  }
+  if (field == "nx") return "NormalX";
+  if (field == "ny") return "NormalY";
+  if (field == "nz") return "NormalZ";
+  return field;
+}
+
+bool isExtraBytesRecord(const LasVariableLengthRecord& r) {
+  return r.userId() == "LASF_Spec" && r.record_id == 4;
+}
+
+// --- reading --------------------------------------------------------------------------------
+
+struct HeaderFacts {
+  std::uint64_t header_size = 0, point_offset = 0, vlr_count = 0, points = 0;
+  std::uint64_t evlr_start = 0, evlr_count = 0, waveform_start = 0;
+};
+
+void readRecords(std::string_view data, std::uint64_t begin, std::uint64_t end, std::uint64_t count,
+                 bool extended, std::vector<LasVariableLengthRecord>& out) {
+  const char* what = extended ? "EVLR" : "VLR";
+  const std::size_t head = extended ? kEvlrHeader : kVlrHeader;
+  std::uint64_t at = begin;
+  for (std::uint64_t i = 0; i < count; ++i) {
+    if (end < head || at > end - head)
+      fail(std::string(what) + " " + std::to_string(i) + " (at byte " + std::to_string(at) +
+           ") runs past " + (extended ? "the end of the file" : "the start of the points") +
+           " (byte " + std::to_string(end) + "); the header claims " + std::to_string(count));
+    const char* p = data.data() + at;
+    LasVariableLengthRecord r;
+    r.reserved = get<std::uint16_t>(p);
+    r.user_id.assign(p + 2, 16);
+    r.record_id = get<std::uint16_t>(p + 18);
+    const std::uint64_t length = extended ? get<std::uint64_t>(p + 20) : get<std::uint16_t>(p + 20);
+    r.description.assign(p + (extended ? 28 : 22), 32);
+    at += head;
+    if (length > end - at)
+      fail(std::string(what) + " " + std::to_string(i) + " ('" + r.userId() + "' " +
+           std::to_string(r.record_id) + ") claims " + std::to_string(length) +
+           " bytes, past byte " + std::to_string(end));
+    r.data.assign(data.data() + at, static_cast<std::size_t>(length));
+    at += length;
+    out.push_back(std::move(r));
+  }
+  if (!extended && at < end) {
+    // (bytes between the VLRs and the points: kept by the caller)
+  }
+}
+
+// Whether doubles resolve every step of the axis's integer grid: x = X * scale + offset must give
+// X back (round((x - offset) / scale)) for every 32-bit X, which needs the spacing of doubles near
+// the largest |x| well below the scale.
+bool gridResolvable(double scale, double offset) {
+  const double largest = std::abs(offset) + std::abs(scale) * 2147483648.0;
+  const double spacing = std::nextafter(largest, std::numeric_limits<double>::infinity()) - largest;
+  return spacing <= std::abs(scale) / 8.0;
+}
+
+void requireScale(const Eigen::Vector3d& scale, const Eigen::Vector3d& offset) {
+  for (int d = 0; d < 3; ++d) {
+    const char axis = static_cast<char>('x' + d);
+    if (!std::isfinite(scale[d]) || scale[d] == 0.0) {
+      std::ostringstream text;
+      text << axis << " scale factor " << scale[d] << " is not a finite non-zero number";
+      fail(text.str());
+    }
+    if (!std::isfinite(offset[d])) {
+      std::ostringstream text;
+      text << axis << " offset " << offset[d] << " is not finite";
+      fail(text.str());
+    }
+    if (!gridResolvable(scale[d], offset[d])) {
+      std::ostringstream text;
+      text << axis << " scale factor " << scale[d] << " is finer than doubles resolve at offset "
+           << offset[d] << " (the coordinates could not be exact)";
+      fail(text.str());
+    }
+  }
+}
+
+// The header, VLRs and EVLRs; the points' place is checked against the file's size.
+LasLayout parseLayout(std::string_view data, HeaderFacts& facts) {
+  const std::uint64_t size = data.size();
+  if (size < 4 || data.substr(0, 4) != "LASF") fail("not a LAS file (no LASF signature)");
+  // LAZ first: nothing else of a compressed file is worth reading.
+  if (size > 104 && (static_cast<std::uint8_t>(data[104]) & 0xC0) != 0) {
+    throw FileFormatException(
+        "LAZ (compressed LAS) is not supported: decompress it first with "
+        "`laszip -i in.laz -o out.las` or `pdal translate in.laz out.las`");
+  }
+  if (size < 227) fail("the file (" + std::to_string(size) + " bytes) is shorter than a header");
+  LasLayout layout;
+  const char* h = data.data();
+  layout.file_source_id = get<std::uint16_t>(h + 4);
+  layout.global_encoding = get<std::uint16_t>(h + 6);
+  layout.project_id.assign(h + 8, 16);
+  layout.version_major = static_cast<std::uint8_t>(h[24]);
+  layout.version_minor = static_cast<std::uint8_t>(h[25]);
+  if (layout.version_major != 1 || layout.version_minor > 4)
+    fail("unsupported version " + std::to_string(layout.version_major) + "." +
+         std::to_string(layout.version_minor) + " (1.0 to 1.4 are read)");
+  layout.system_identifier.assign(h + 26, 32);
+  layout.generating_software.assign(h + 58, 32);
+  layout.creation_day = get<std::uint16_t>(h + 90);
+  layout.creation_year = get<std::uint16_t>(h + 92);
+  facts.header_size = get<std::uint16_t>(h + 94);
+  facts.point_offset = get<std::uint32_t>(h + 96);
+  facts.vlr_count = get<std::uint32_t>(h + 100);
+  layout.point_format = static_cast<std::uint8_t>(h[104]);
+  layout.record_length = get<std::uint16_t>(h + 105);
+  const std::uint64_t legacy_points = get<std::uint32_t>(h + 107);
+  for (int d = 0; d < 3; ++d) {
+    layout.scale[d] = get<double>(h + 131 + 8 * d);
+    layout.offset[d] = get<double>(h + 155 + 8 * d);
+    layout.max[d] = get<double>(h + 179 + 16 * d);
+    layout.min[d] = get<double>(h + 187 + 16 * d);
+  }
+  const std::size_t standard = headerSizeOf(layout.version_minor);
+  if (facts.header_size < standard)
+    fail("header size " + std::to_string(facts.header_size) + " is smaller than LAS 1." +
+         std::to_string(layout.version_minor) + "'s " + std::to_string(standard) + " bytes");
+  if (facts.header_size > size)
+    fail("header size " + std::to_string(facts.header_size) + " is past the end of the file (" +
+         std::to_string(size) + " bytes)");
+  if (facts.point_offset < facts.header_size || facts.point_offset > size)
+    fail("offset to the points " + std::to_string(facts.point_offset) +
+         " is outside the file (header " + std::to_string(facts.header_size) + ", file " +
+         std::to_string(size) + " bytes)");
+  if (layout.point_format > 10)
+    fail("unknown point data record format " + std::to_string(layout.point_format) +
+         " (0 to 10 are defined)");
+  const std::uint16_t format_size = lasPointFormatSize(layout.point_format);
+  if (layout.record_length < format_size)
+    fail("point record length " + std::to_string(layout.record_length) +
+         " is smaller than point format " + std::to_string(layout.point_format) + "'s " +
+         std::to_string(format_size) + " bytes");
+  requireScale(layout.scale, layout.offset);
+  if (layout.version_minor >= 3) facts.waveform_start = get<std::uint64_t>(h + 227);
+  facts.points = legacy_points;
+  if (layout.version_minor >= 4) {
+    facts.evlr_start = get<std::uint64_t>(h + 235);
+    facts.evlr_count = get<std::uint32_t>(h + 243);
+    facts.points = get<std::uint64_t>(h + 247);
+    if (legacy_points != 0 && legacy_points != facts.points)
+      fail("the legacy point count " + std::to_string(legacy_points) +
+           " differs from the 64-bit point count " + std::to_string(facts.points));
+  }
+  layout.point_count = facts.points;
+  layout.header_extra.assign(h + standard, facts.header_size - standard);
+
+  readRecords(data, facts.header_size, facts.point_offset, facts.vlr_count, false, layout.vlrs);
+  std::uint64_t vlr_end = facts.header_size;
+  for (const auto& r : layout.vlrs) vlr_end += kVlrHeader + r.data.size();
+  layout.after_vlrs.assign(h + vlr_end, facts.point_offset - vlr_end);
+
+  // The points: offset + count x length within the file (and before the EVLRs).
+  std::uint64_t point_bytes = 0;
+  if (__builtin_mul_overflow(facts.points, std::uint64_t{layout.record_length}, &point_bytes) ||
+      point_bytes > size - facts.point_offset)
+    fail("the header claims " + std::to_string(facts.points) + " points of " +
+         std::to_string(layout.record_length) + " bytes from byte " +
+         std::to_string(facts.point_offset) + ", but the file holds " +
+         std::to_string((size - facts.point_offset) / layout.record_length) +
+         " whole records (truncated, or a lying count)");
+  const std::uint64_t points_end = facts.point_offset + point_bytes;
+  if (facts.evlr_count > 0) {
+    if (facts.evlr_start < points_end || facts.evlr_start > size)
+      fail("the EVLRs' start " + std::to_string(facts.evlr_start) +
+           " is not between the end of the points (" + std::to_string(points_end) +
+           ") and the end of the file (" + std::to_string(size) + ")");
+    readRecords(data, facts.evlr_start, size, facts.evlr_count, true, layout.evlrs);
+  }
+  // The waveform data packets: an EVLR (1.4), or the one record at that offset (1.3).
+  const bool internal_waves = (layout.global_encoding & 0x2) != 0;
+  if (facts.waveform_start != 0 && internal_waves) {
+    if (layout.version_minor >= 4) {
+      std::uint64_t at = facts.evlr_start;
+      for (std::size_t i = 0; i < layout.evlrs.size(); ++i) {
+        if (at == facts.waveform_start) layout.waveform_evlr = static_cast<int>(i);
+        at += kEvlrHeader + layout.evlrs[i].data.size();
+      }
+    } else {
+      if (facts.waveform_start < points_end || facts.waveform_start > size)
+        fail("the waveform data's start " + std::to_string(facts.waveform_start) +
+             " is not after the points");
+      readRecords(data, facts.waveform_start, size, 1, true, layout.evlrs);
+      layout.waveform_evlr = 0;
+    }
+  }
+
+  // The Extra Bytes dimensions (a VLR, or in 1.4 possibly an EVLR).
+  const LasVariableLengthRecord* extra = nullptr;
+  for (const auto* list : {&layout.vlrs, &layout.evlrs}) {
+    for (const auto& r : *list) {
+      if (extra == nullptr && isExtraBytesRecord(r)) extra = &r;
+    }
+  }
+  std::uint32_t described = 0;
+  const std::uint32_t available = layout.record_length - format_size;
+  if (extra != nullptr) {
+    if (extra->data.size() % kDescriptorSize != 0)
+      fail("the Extra Bytes VLR's length " + std::to_string(extra->data.size()) +
+           " is not a multiple of 192");
+    for (std::size_t k = 0; k < extra->data.size() / kDescriptorSize; ++k) {
+      LasExtraBytesDimension dim;
+      dim.descriptor = extra->data.substr(k * kDescriptorSize, kDescriptorSize);
+      described += byteSize(extraType(dim.descriptor.data(), k));
+      if (described > available)
+        fail("the Extra Bytes VLR describes " + std::to_string(described) +
+             " bytes or more, but the records have " + std::to_string(available) +
+             " bytes beyond point format " + std::to_string(layout.point_format) + "'s");
+      layout.extra_bytes.push_back(std::move(dim));
+    }
+  }
+  layout.undocumented_bytes = available - described;
+  return layout;
+}
+
+struct Copy {
+  std::uint32_t from, to, size;
+};
+struct Bits {
+  std::uint32_t from, to;
+  std::uint8_t shift, mask;
+};
+
+pcl::PCLPointField makeField(const std::string& name, std::uint8_t datatype, std::uint32_t offset,
+                             std::uint32_t count = 1) {
+  pcl::PCLPointField f;
+  f.name = name;
+  f.datatype = datatype;
+  f.offset = offset;
+  f.count = count;
+  return f;
+}
+
+}  // namespace
+
+LasCloud parseLAS(std::string_view data) {
+  HeaderFacts facts;
+  LasCloud result;
+  LasLayout& layout = result.layout;
+  layout = parseLayout(data, facts);
+
+  // The cloud's fields: float x y z (PCL's), the format's, the extra bytes, undocumented bytes.
+  pcl::PCLPointCloud2& cloud = result.mesh.cloud;
+  std::uint32_t step = 0;
+  for (const char* axis : {"x", "y", "z"}) {
+    cloud.fields.push_back(makeField(axis, F::FLOAT32, step));
+    step += 4;
+  }
+  std::vector<Copy> copies;
+  std::vector<Bits> bits;
+  for (const CoreField& core : coreFields(layout.point_format)) {
+    cloud.fields.push_back(makeField(core.name, core.datatype, step));
+    const std::uint32_t size = pcl::getFieldSize(core.datatype);
+    if (core.bits > 0) {
+      bits.push_back(
+          {core.offset, step, core.shift, static_cast<std::uint8_t>((1u << core.bits) - 1u)});
+    } else {
+      copies.push_back({core.offset, step, size});
+    }
+    step += size;
+  }
+  const auto taken = [&](const std::string& name) {
+    return std::any_of(cloud.fields.begin(), cloud.fields.end(),
+                       [&](const pcl::PCLPointField& f) { return f.name == name; });
+  };
+  std::uint32_t at = lasPointFormatSize(layout.point_format);
+  for (std::size_t k = 0; k < layout.extra_bytes.size(); ++k) {
+    LasExtraBytesDimension& dim = layout.extra_bytes[k];
+    const ExtraType type = extraType(dim.descriptor.data(), k);
+    const std::string base = cloudNameOf(upToNul(dim.descriptor.substr(4, 32)), k);
+    std::string name = base;
+    for (int n = 2; taken(name) || name == kLasUndocumentedBytesField; ++n)
+      name = base + "_" + std::to_string(n);
+    dim.field = name;
+    cloud.fields.push_back(makeField(name, type.datatype, step, type.count));
+    copies.push_back({at, step, byteSize(type)});
+    at += byteSize(type);
+    step += byteSize(type);
+  }
+  if (layout.undocumented_bytes > 0) {
+    cloud.fields.push_back(
+        makeField(kLasUndocumentedBytesField, F::UINT8, step, layout.undocumented_bytes));
+    copies.push_back({at, step, layout.undocumented_bytes});
+    step += layout.undocumented_bytes;
+  }
+  // Merge adjacent copies (the extra bytes are contiguous in both layouts).
+  std::vector<Copy> merged;
+  for (const Copy& c : copies) {
+    if (!merged.empty() && merged.back().from + merged.back().size == c.from &&
+        merged.back().to + merged.back().size == c.to) {
+      merged.back().size += c.size;
+    } else {
+      merged.push_back(c);
+    }
+  }
+
+  const std::uint64_t n = facts.points;
+  if (n > std::numeric_limits<std::uint32_t>::max() ||
+      n * step > std::numeric_limits<std::uint32_t>::max())
+    fail(std::to_string(n) + " points of " + std::to_string(step) +
+         " bytes are too many for a pcl::PCLPointCloud2 (4 GiB)");
+  cloud.width = static_cast<std::uint32_t>(n);
+  cloud.height = 1;
+  cloud.point_step = step;
+  cloud.row_step = static_cast<std::uint32_t>(n * step);
+  cloud.is_dense = true;  // integers times a finite scale plus a finite offset
+  cloud.data.resize(static_cast<std::size_t>(n * step));
+  result.positions.resize(3, static_cast<Eigen::Index>(n));
+
+  const char* records = data.data() + facts.point_offset;
+  const std::size_t length = layout.record_length;
+  const Eigen::Vector3d scale = layout.scale, offset = layout.offset;
+  std::uint8_t* out = cloud.data.data();
+  double* positions = result.positions.data();
+  const auto count = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) if (count > 100000)
+  for (std::int64_t i = 0; i < count; ++i) {
+    const char* record = records + static_cast<std::size_t>(i) * length;
+    std::uint8_t* point = out + static_cast<std::size_t>(i) * step;
+    for (int d = 0; d < 3; ++d) {
+      const double v = get<std::int32_t>(record + 4 * d) * scale[d] + offset[d];
+      positions[3 * i + d] = v;
+      put(reinterpret_cast<char*>(point) + 4 * d, static_cast<float>(v));
+    }
+    for (const Copy& c : merged) std::memcpy(point + c.to, record + c.from, c.size);
+    for (const Bits& b : bits)
+      point[b.to] = static_cast<std::uint8_t>(
+          (static_cast<std::uint8_t>(record[b.from]) >> b.shift) & b.mask);
+  }
+  // A coordinate beyond float's range cannot be held by PCL's point types.
+  for (std::int64_t i = 0; i < count; ++i) {
+    for (int d = 0; d < 3; ++d) {
+      if (std::abs(positions[3 * i + d]) > std::numeric_limits<float>::max()) {
+        std::ostringstream text;
+        text << "point " << i << ": coordinate " << positions[3 * i + d]
+             << " is beyond float's range (PCL's point types are float)";
+        fail(text.str());
+      }
+    }
+  }
+  return result;
+}
+
+// --- writing --------------------------------------------------------------------------------
+
+namespace {
+
+const pcl::PCLPointField* findField(const pcl::PCLPointCloud2& cloud, const std::string& name) {
+  for (const auto& f : cloud.fields) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
+}
+
+// A scale (a power of ten) and an offset that hold [lo, hi] in 32-bit integers finely.
+void chooseScaleAndOffset(double lo, double hi, double& scale, double& offset) {
+  if (!(hi >= lo)) {  // no finite point
+    scale = 0.001;
+    offset = 0.0;
+    return;
+  }
+  const double extent = std::max(hi - lo, std::abs(lo) * 1e-12);
+  int k = extent > 0.0 ? static_cast<int>(std::ceil(std::log10(extent / 1e9))) : -3;
+  k = std::max(-12, std::min(k, 30));
+  for (;; ++k) {  // coarser where doubles could not resolve the steps (far from the origin)
+    scale = std::pow(10.0, k);
+    const double unit = scale * 1000.0;
+    offset = std::floor(lo / unit) * unit;
+    if (gridResolvable(scale, offset) || k >= 300) break;
+  }
+}
+
+std::string padded(const std::string& text, std::size_t size) {
+  std::string bytes = text.substr(0, size);
+  bytes.resize(size, '\0');
+  return bytes;
+}
+
+std::string newDescriptor(const std::string& las_name, const pcl::PCLPointField& field) {
+  std::string d(kDescriptorSize, '\0');
+  const int base = lasTypeOfPcl(field.datatype);
+  const std::uint32_t count = std::max<std::uint32_t>(field.count, 1);
+  int type = 0, options = 0;
+  if (base == 0) {
+    fail("field '" + field.name + "' has a type LAS extra bytes cannot hold");
+  } else if (count == 1) {
+    type = base;
+  } else if (count <= 3) {
+    type = base + 10 * static_cast<int>(count - 1);  // deprecated arrays, as read
+  } else if (field.datatype == F::UINT8 && count <= 255) {
+    options = static_cast<int>(count);  // undocumented bytes
+  } else {
+    fail("field '" + field.name + "' has " + std::to_string(count) +
+         " values per point: LAS extra bytes hold 1 to 3");
+  }
+  d[2] = static_cast<char>(type);
+  d[3] = static_cast<char>(options);
+  std::memcpy(&d[4], las_name.data(), las_name.size());
+  std::memcpy(&d[160], las_name.data(), std::min<std::size_t>(las_name.size(), 32));
+  return d;
+}
+
+bool descriptorFits(const std::string& descriptor, const pcl::PCLPointField& field) {
+  if (descriptor.size() != kDescriptorSize) return false;
+  const int type = static_cast<std::uint8_t>(descriptor[2]);
+  if (type > 30 || (type == 0 && descriptor[3] == 0)) return false;
+  const ExtraType t = extraType(descriptor.data(), 0);
+  return t.datatype == field.datatype && t.count == std::max<std::uint32_t>(field.count, 1);
+}
+
+// Where a value of the cloud goes in the record.
+struct Slot {
+  const pcl::PCLPointField* field;
+  std::uint32_t to;
+  std::uint32_t size;
+};
+struct BitSlot {
+  const pcl::PCLPointField* field;  ///< null: the default value
+  std::uint32_t to;
+  std::uint8_t shift, bits, fallback;
+  bool is_return_number;
+};
+
+std::uint8_t byteValue(const std::uint8_t* point, const pcl::PCLPointField& f) {
+  return point[f.offset];
+}
+
+}  // namespace
+
+std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions,
+                      const LasLayout* source) {
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  if (static_cast<std::size_t>(positions.cols()) != n)
+    fail("positions do not match the point count");
+  LasLayout layout;
+  if (source != nullptr) {
+    layout = *source;
+  } else {
+    layout.version_major = 1;
+    layout.version_minor = 4;
+    layout.point_format = vertexColorLayout(cloud) ? 7 : 6;
+    layout.system_identifier = padded("pcl_ddg", 32);
+  }
+  if (layout.version_major != 1 || layout.version_minor > 4 || layout.point_format > 10)
+    fail("cannot write LAS " + std::to_string(layout.version_major) + "." +
+         std::to_string(layout.version_minor) + " point format " +
+         std::to_string(layout.point_format));
+  layout.generating_software = padded("pcl_ddg", 32);
+  if (source == nullptr) {
+    for (int d = 0; d < 3; ++d) {
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (std::size_t i = 0; i < n; ++i) {
+        const double v = positions(d, static_cast<Eigen::Index>(i));
+        if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+      }
+      chooseScaleAndOffset(lo, hi, layout.scale[d], layout.offset[d]);
+    }
+  }
+  requireScale(layout.scale, layout.offset);
+  const int format = layout.point_format;
+  const bool extended = format >= 6;
+
+  // The format's fields, from the cloud's fields of the same name and type.
+  std::vector<std::string> consumed = {"x", "y", "z", "_", kLasUndocumentedBytesField};
+  std::vector<Slot> slots;
+  std::vector<BitSlot> bit_slots;
+  bool has_rgb = false;
+  const pcl::PCLPointField* rank = nullptr;  // scan_angle_rank for a 6-10 record, or the reverse
+  std::uint32_t angle_to = 0;
+  for (const CoreField& core : coreFields(format)) {
+    const pcl::PCLPointField* f = findField(cloud, core.name);
+    const bool usable = f != nullptr && f->datatype == core.datatype && f->count == 1;
+    if (std::string(core.name) == "red") has_rgb = true;
+    if (core.bits > 0) {
+      const bool returns = std::string(core.name) == "return_number" ||
+                           std::string(core.name) == "number_of_returns";
+      bit_slots.push_back({usable ? f : nullptr, core.offset, core.shift, core.bits,
+                           static_cast<std::uint8_t>(returns ? 1 : 0),
+                           std::string(core.name) == "return_number"});
+    } else if (usable) {
+      slots.push_back(
+          {f, core.offset, static_cast<std::uint32_t>(pcl::getFieldSize(core.datatype))});
+    } else if (std::string(core.name) == "scan_angle" ||
+               std::string(core.name) == "scan_angle_rank") {
+      const char* other = extended ? "scan_angle_rank" : "scan_angle";
+      const pcl::PCLPointField* g = findField(cloud, other);
+      if (g != nullptr && g->count == 1 && g->datatype == (extended ? F::INT8 : F::INT16)) {
+        rank = g;
+        angle_to = core.offset;
+        consumed.push_back(other);
+      }
+    }
+    if (usable) consumed.push_back(core.name);
+  }
+  // Colours of another layout (8-bit channels, packed rgb) into a format with RGB: 16 bits.
+  const bool rgb16 = has_rgb && std::count(consumed.begin(), consumed.end(), "red") > 0 &&
+                     std::count(consumed.begin(), consumed.end(), "green") > 0 &&
+                     std::count(consumed.begin(), consumed.end(), "blue") > 0;
+  VertexColors colors;
+  std::uint32_t rgb_to = 0;
+  if (has_rgb && !rgb16 && vertexColorLayout(cloud)) {
+    colors = vertexColors(cloud);
+    for (const CoreField& core : coreFields(format)) {
+      if (std::string(core.name) == "red") rgb_to = core.offset;
+    }
+    slots.erase(std::remove_if(slots.begin(), slots.end(),
+                               [&](const Slot& s) { return s.to >= rgb_to && s.to < rgb_to + 6; }),
+                slots.end());
+    for (const char* name : {"red", "green", "blue", "alpha", "rgb", "rgba"})
+      consumed.push_back(name);
+  }
+
+  // Every other field: an Extra Bytes dimension, its descriptor kept when it still fits.
+  std::vector<LasExtraBytesDimension> dims;
+  std::vector<Slot> extra_slots;
+  std::uint32_t extra_size = 0;
+  const std::uint16_t format_size = lasPointFormatSize(format);
+  for (const auto& f : cloud.fields) {
+    if (std::find(consumed.begin(), consumed.end(), f.name) != consumed.end()) continue;
+    if (pcl::getFieldSize(f.datatype) == 0) continue;
+    LasExtraBytesDimension dim;
+    dim.field = f.name;
+    if (source != nullptr) {
+      for (const auto& kept : source->extra_bytes) {
+        if (kept.field == f.name && descriptorFits(kept.descriptor, f))
+          dim.descriptor = kept.descriptor;
+      }
+    }
+    if (dim.descriptor.empty()) {
+      const std::string las_name = lasNameOf(f.name);
+      if (las_name.size() > 32)
+        fail("field name '" + f.name + "' is longer than the 32 bytes of an Extra Bytes name");
+      dim.descriptor = newDescriptor(las_name, f);
+    }
+    const std::uint32_t size = pcl::getFieldSize(f.datatype) * std::max<std::uint32_t>(f.count, 1);
+    extra_slots.push_back({&f, format_size + extra_size, size});
+    extra_size += size;
+    dims.push_back(std::move(dim));
+  }
+  const pcl::PCLPointField* undocumented = findField(cloud, kLasUndocumentedBytesField);
+  if (undocumented != nullptr && undocumented->datatype != F::UINT8) undocumented = nullptr;
+  const std::uint32_t undocumented_size = undocumented ? undocumented->count : 0;
+  const std::uint64_t record_length = std::uint64_t{format_size} + extra_size + undocumented_size;
+  if (record_length > std::numeric_limits<std::uint16_t>::max())
+    fail("a point record of " + std::to_string(record_length) + " bytes exceeds LAS's 65,535");
+
+  // The Extra Bytes VLR: rewritten in place, added, or dropped.
+  std::string descriptors;
+  for (const auto& dim : dims) descriptors += dim.descriptor;
+  bool placed = false;
+  for (auto* list : {&layout.vlrs, &layout.evlrs}) {
+    for (auto it = list->begin(); it != list->end();) {
+      if (!isExtraBytesRecord(*it) || placed) {  // every other record as it was
+        ++it;
+        continue;
+      }
+      if (descriptors.empty() && !it->data.empty()) {  // (an empty one is kept as it was)
+        it = list->erase(it);
+        continue;
+      }
+      it->data = descriptors;
+      placed = true;
+      ++it;
+    }
+  }
+  if (!placed && !descriptors.empty()) {
+    LasVariableLengthRecord r;
+    r.user_id = padded("LASF_Spec", 16);
+    r.record_id = 4;
+    r.description = padded("Extra Bytes Record", 32);
+    r.data = descriptors;
+    layout.vlrs.push_back(std::move(r));
+  }
+  for (const auto& r : layout.vlrs) {
+    if (r.data.size() > std::numeric_limits<std::uint16_t>::max())
+      fail("VLR '" + r.userId() + "' " + std::to_string(r.record_id) + " holds " +
+           std::to_string(r.data.size()) + " bytes, more than a VLR's 65,535");
+  }
+  if (layout.version_minor < 4 && layout.evlrs.size() > (layout.waveform_evlr >= 0 ? 1u : 0u))
+    fail("EVLRs other than the waveform data need LAS 1.4");
+
+  // Sizes and offsets.
+  const std::size_t standard = headerSizeOf(layout.version_minor);
+  const std::uint64_t header_size = standard + layout.header_extra.size();
+  std::uint64_t point_offset = header_size + layout.after_vlrs.size();
+  for (const auto& r : layout.vlrs) point_offset += kVlrHeader + r.data.size();
+  if (header_size > std::numeric_limits<std::uint16_t>::max() ||
+      point_offset > std::numeric_limits<std::uint32_t>::max())
+    fail("the header and VLRs are too large");
+  const std::uint64_t points_end = point_offset + record_length * n;
+  std::uint64_t evlr_bytes = 0;
+  for (const auto& r : layout.evlrs) evlr_bytes += kEvlrHeader + r.data.size();
+
+  std::string file(static_cast<std::size_t>(points_end + evlr_bytes), '\0');
+  char* records = file.data() + point_offset;
+
+  // Records, bounds and counts by return.
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
+  std::array<std::uint64_t, 15> by_return{};
+  for (std::size_t i = 0; i < n; ++i) {
+    char* record = records + i * record_length;
+    const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
+    for (int d = 0; d < 3; ++d) {
+      const double v = positions(d, static_cast<Eigen::Index>(i));
+      const double q = std::round((v - layout.offset[d]) / layout.scale[d]);
+      if (!std::isfinite(v) || !(q >= -2147483648.0 && q <= 2147483647.0)) {
+        std::ostringstream text;
+        text.precision(17);
+        text << "point " << i << ": " << static_cast<char>('x' + d) << " = " << v
+             << (std::isfinite(v) ? " does not fit a 32-bit integer with scale " +
+                                        std::to_string(layout.scale[d]) + " and offset " +
+                                        std::to_string(layout.offset[d])
+                                  : " is not finite (LAS stores integers)");
+        fail(text.str());
+      }
+      const auto X = static_cast<std::int32_t>(q);
+      put(record + 4 * d, X);
+      const double stored = X * layout.scale[d] + layout.offset[d];
+      if (i == 0 || stored < lo[d]) lo[d] = stored;
+      if (i == 0 || stored > hi[d]) hi[d] = stored;
+    }
+    for (const Slot& s : slots) std::memcpy(record + s.to, point + s.field->offset, s.size);
+    int return_number = 0;
+    for (const BitSlot& b : bit_slots) {
+      const std::uint8_t v = b.field ? byteValue(point, *b.field) : b.fallback;
+      if ((v >> b.bits) != 0 && b.field != nullptr) {
+        fail("point " + std::to_string(i) + ": " + b.field->name + " " + std::to_string(v) +
+             " does not fit point format " + std::to_string(format) + "'s " +
+             std::to_string(b.bits) + " bits" +
+             (b.field->name == "classification" ? " (classes above 31 need formats 6-10)" : ""));
+      }
+      record[b.to] = static_cast<char>(static_cast<std::uint8_t>(record[b.to]) | (v << b.shift));
+      if (b.is_return_number) return_number = v;
+    }
+    if (return_number >= 1 && return_number <= 15) ++by_return[return_number - 1];
+    if (rank != nullptr) {
+      if (extended) {  // degrees -> 0.006 degree steps
+        const auto r = get<std::int8_t>(reinterpret_cast<const char*>(point) + rank->offset);
+        put(record + angle_to, static_cast<std::int16_t>(std::lround(r / 0.006)));
+      } else {
+        const auto a = get<std::int16_t>(reinterpret_cast<const char*>(point) + rank->offset);
+        put(record + angle_to, static_cast<std::int8_t>(std::lround(a * 0.006)));
+      }
+    }
+    if (colors.cols() > 0) {
+      for (int c = 0; c < 3; ++c)
+        put(record + rgb_to + 2 * c,
+            static_cast<std::uint16_t>(colors(c, static_cast<Eigen::Index>(i)) * 257));
+    }
+    for (const Slot& s : extra_slots) std::memcpy(record + s.to, point + s.field->offset, s.size);
+    if (undocumented)
+      std::memcpy(record + format_size + extra_size, point + undocumented->offset,
+                  undocumented_size);
+  }
+
+  // The header.
+  char* h = file.data();
+  std::memcpy(h, "LASF", 4);
+  put(h + 4, layout.file_source_id);
+  put(h + 6, layout.global_encoding);
+  std::memcpy(h + 8, padded(layout.project_id, 16).data(), 16);
+  h[24] = static_cast<char>(layout.version_major);
+  h[25] = static_cast<char>(layout.version_minor);
+  std::memcpy(h + 26, padded(layout.system_identifier, 32).data(), 32);
+  std::memcpy(h + 58, padded(layout.generating_software, 32).data(), 32);
+  put(h + 90, layout.creation_day);
+  put(h + 92, layout.creation_year);
+  put(h + 94, static_cast<std::uint16_t>(header_size));
+  put(h + 96, static_cast<std::uint32_t>(point_offset));
+  put(h + 100, static_cast<std::uint32_t>(layout.vlrs.size()));
+  h[104] = static_cast<char>(format);
+  put(h + 105, static_cast<std::uint16_t>(record_length));
+  // Legacy counts: always below 1.4; in 1.4 for formats 0-5 when they fit, zero for 6-10.
+  if (layout.version_minor < 4 && n > 0xffffffffu)
+    fail(std::to_string(n) + " points need LAS 1.4 (64-bit counts)");
+  if (layout.version_minor < 4 || (!extended && n <= 0xffffffffu)) {
+    put(h + 107, static_cast<std::uint32_t>(n));
+    for (int r = 0; r < 5; ++r) put(h + 111 + 4 * r, static_cast<std::uint32_t>(by_return[r]));
+  }
+  for (int d = 0; d < 3; ++d) {
+    put(h + 131 + 8 * d, layout.scale[d]);
+    put(h + 155 + 8 * d, layout.offset[d]);
+    put(h + 179 + 16 * d, hi[d]);
+    put(h + 187 + 16 * d, lo[d]);
+  }
+  std::uint64_t at = points_end;
+  std::uint64_t waveform_start = 0;
+  for (std::size_t k = 0; k < layout.evlrs.size(); ++k) {
+    const auto& r = layout.evlrs[k];
+    if (static_cast<int>(k) == layout.waveform_evlr) waveform_start = at;
+    char* p = file.data() + at;
+    put(p, r.reserved);
+    std::memcpy(p + 2, padded(r.user_id, 16).data(), 16);
+    put(p + 18, r.record_id);
+    put(p + 20, static_cast<std::uint64_t>(r.data.size()));
+    std::memcpy(p + 28, padded(r.description, 32).data(), 32);
+    std::memcpy(p + kEvlrHeader, r.data.data(), r.data.size());
+    at += kEvlrHeader + r.data.size();
+  }
+  if (layout.version_minor >= 3) put(h + 227, waveform_start);
+  if (layout.version_minor >= 4) {
+    put(h + 235, layout.evlrs.empty() ? std::uint64_t{0} : points_end);
+    put(h + 243, static_cast<std::uint32_t>(layout.evlrs.size()));
+    put(h + 247, static_cast<std::uint64_t>(n));
+    for (int r = 0; r < 15; ++r) put(h + 255 + 8 * r, by_return[r]);
+  }
+  std::memcpy(h + standard, layout.header_extra.data(), layout.header_extra.size());
+  std::uint64_t p = header_size;
+  for (const auto& r : layout.vlrs) {
+    char* v = file.data() + p;
+    put(v, r.reserved);
+    std::memcpy(v + 2, padded(r.user_id, 16).data(), 16);
+    put(v + 18, r.record_id);
+    put(v + 20, static_cast<std::uint16_t>(r.data.size()));
+    std::memcpy(v + 22, padded(r.description, 32).data(), 32);
+    std::memcpy(v + kVlrHeader, r.data.data(), r.data.size());
+    p += kVlrHeader + r.data.size();
+  }
+  std::memcpy(file.data() + p, layout.after_vlrs.data(), layout.after_vlrs.size());
+  return file;
+}
+
+}  // namespace detail
+}  // namespace pcl_ddg

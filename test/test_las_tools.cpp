@@ -1,0 +1,178 @@
+// The tools on LAS files: the same normals as from the same points in a PCD F 8 file, every field
+// and VLR kept, -classes, batch mode, pcl_ddg_info's LAS report, and LAZ refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/io/vertex_fields.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+#include "test_data.h"
+#include "tool_runner.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+const char* const kSurvey = "las/autzen_trim.las";
+
+std::string readBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// The points of a LAS file (all, or those of one class) as a PCD with F 8 coordinates only.
+void writeDoublePcd(const std::string& path, const MeshFile& las, int only_class = -1) {
+  const Eigen::VectorXd classes = vertexScalarField(las.mesh.cloud, "classification");
+  std::vector<Eigen::Index> kept;
+  for (Eigen::Index i = 0; i < las.positions.cols(); ++i)
+    if (only_class < 0 || classes[i] == only_class) kept.push_back(i);
+  Eigen::Matrix3Xd p(3, static_cast<Eigen::Index>(kept.size()));
+  for (std::size_t k = 0; k < kept.size(); ++k) p.col(k) = las.positions.col(kept[k]);
+  pcl::PolygonMesh mesh = makeMesh(p, {});
+  setVertexCoordinates(mesh.cloud, p, FieldPrecision::Double);
+  saveMesh(path, mesh);
+}
+
+Eigen::Matrix3Xd normalsOf(const MeshFile& file) {
+  Eigen::Matrix3Xd n(3, file.positions.cols());
+  n.row(0) = vertexScalarField(file.mesh.cloud, "normal_x").transpose();
+  n.row(1) = vertexScalarField(file.mesh.cloud, "normal_y").transpose();
+  n.row(2) = vertexScalarField(file.mesh.cloud, "normal_z").transpose();
+  return n;
+}
+
+bool sameValues(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+  if (a.cols() != b.cols()) return false;
+  for (Eigen::Index i = 0; i < a.size(); ++i) {
+    const double x = a.data()[i], y = b.data()[i];
+    if (!(x == y || (std::isnan(x) && std::isnan(y)))) return false;
+  }
+  return true;
+}
+
+TEST(LasTools, NormalsFromLasEqualThoseFromTheSamePointsInADoublePcd) {
+  const std::string folder = scratchFolder("las_tools_pcd");
+  const MeshFile las = readMeshFile(sharedData(kSurvey));
+  writeDoublePcd(folder + "/same.pcd", las);
+  const std::string options = " -method pca -k 12 -orient up";
+  ASSERT_EQ(runTool(PCL_DDG_NORMALS_TOOL, sharedData(kSurvey) + " " + folder + "/a.las" + options)
+                .exit_code,
+            0);
+  ASSERT_EQ(
+      runTool(PCL_DDG_NORMALS_TOOL, folder + "/same.pcd " + folder + "/b.pcd" + options).exit_code,
+      0);
+  const MeshFile a = readMeshFile(folder + "/a.las");
+  const MeshFile b = readMeshFile(folder + "/b.pcd");
+  EXPECT_TRUE(sameValues(normalsOf(a), normalsOf(b)));
+  EXPECT_EQ(vertexScalarField(a.mesh.cloud, "curvature"),
+            vertexScalarField(b.mesh.cloud, "curvature"));
+  // Every input field and VLR kept; the points' records as they were, normals after them.
+  EXPECT_EQ(a.positions, las.positions);
+  const std::string in = readBytes(sharedData(kSurvey)), out = readBytes(folder + "/a.las");
+  const auto u32 = [](const std::string& s, std::size_t at) {
+    std::uint32_t v;
+    std::memcpy(&v, s.data() + at, 4);
+    return v;
+  };
+  EXPECT_EQ(out.substr(227, u32(in, 96) - 227), in.substr(227, u32(in, 96) - 227))
+      << "the projection VLRs come first, as they were";
+  for (std::size_t i = 0; i < 110000; i += 997) {
+    ASSERT_EQ(out.substr(u32(out, 96) + i * 50, 34), in.substr(u32(in, 96) + i * 34, 34));
+  }
+}
+
+TEST(LasTools, ClassesFitsOnlyThoseClassesAndWritesEveryPoint) {
+  const std::string folder = scratchFolder("las_tools_classes");
+  const MeshFile las = readMeshFile(sharedData(kSurvey));
+  const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, sharedData(kSurvey) + " " + folder +
+                                                        "/g.las -method pca -k 10 -orient up "
+                                                        "-classes 2");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("fitting 26107 of 110000 points"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("without an estimate"), std::string::npos) << run.err;
+  // The ground alone, as a cloud of its own.
+  writeDoublePcd(folder + "/ground.pcd", las, 2);
+  ASSERT_EQ(runTool(PCL_DDG_NORMALS_TOOL,
+                    folder + "/ground.pcd " + folder + "/ground_n.pcd -method pca -k 10 -orient up")
+                .exit_code,
+            0);
+  const MeshFile out = readMeshFile(folder + "/g.las");
+  ASSERT_EQ(out.positions.cols(), 110000);
+  const Eigen::Matrix3Xd n = normalsOf(out);
+  const Eigen::Matrix3Xd ground = normalsOf(readMeshFile(folder + "/ground_n.pcd"));
+  const Eigen::VectorXd classes = vertexScalarField(out.mesh.cloud, "classification");
+  Eigen::Index g = 0;
+  for (Eigen::Index i = 0; i < n.cols(); ++i) {
+    if (classes[i] == 2) {
+      ASSERT_TRUE(sameValues(n.col(i), ground.col(g))) << "point " << i;
+      ++g;
+    } else {
+      ASSERT_TRUE(std::isnan(n(0, i)) && std::isnan(n(1, i)) && std::isnan(n(2, i)))
+          << "point " << i;
+    }
+  }
+  EXPECT_EQ(g, ground.cols());
+}
+
+TEST(LasTools, ClassesArgumentErrors) {
+  const std::string folder = scratchFolder("las_tools_class_errors");
+  const std::string in = sharedData(kSurvey) + " " + folder + "/o.las -method pca";
+  EXPECT_EQ(runTool(PCL_DDG_NORMALS_TOOL, in + " -classes 2,x").exit_code, 2);
+  EXPECT_EQ(runTool(PCL_DDG_NORMALS_TOOL, in + " -classes 256").exit_code, 2);
+  const ToolRun none = runTool(PCL_DDG_NORMALS_TOOL, in + " -classes 17");
+  EXPECT_EQ(none.exit_code, 1);
+  EXPECT_NE(none.err.find("no point is of the classes"), std::string::npos) << none.err;
+  const ToolRun cloud = runTool(PCL_DDG_NORMALS_TOOL, sharedData("clouds/bun0.pcd") + " " + folder +
+                                                          "/b.pcd -method pca -classes 2");
+  EXPECT_EQ(cloud.exit_code, 1);
+  EXPECT_NE(cloud.err.find("classification"), std::string::npos) << cloud.err;
+  EXPECT_FALSE(std::filesystem::exists(folder + "/o.las"));
+  const ToolRun quadric = runTool(
+      PCL_DDG_CURVATURE_TOOL, sharedData(kSurvey) + " " + folder + "/q.las -radius 5 -classes 2,6");
+  EXPECT_EQ(quadric.exit_code, 0) << quadric.err;
+}
+
+TEST(LasTools, BatchModeReadsAndWritesLas) {
+  const std::string folder = scratchFolder("las_tools_batch");
+  std::filesystem::create_directories(folder + "/in");
+  std::filesystem::copy_file(sharedData("las/test1_4.las"), folder + "/in/a.las");
+  std::filesystem::copy_file(sharedData("las/simple.laz"), folder + "/in/b.laz");
+  const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, "-input_dir " + folder + "/in -output_dir " +
+                                                        folder + "/out -method pca -k 8");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const MeshFile out = readMeshFile(folder + "/out/a.las");
+  EXPECT_EQ(out.las->version_minor, 4);
+  EXPECT_EQ(out.las->point_format, 6);
+  EXPECT_EQ(out.positions, readMeshFile(sharedData("las/test1_4.las")).positions);
+  EXPECT_TRUE(hasVertexField(out.mesh.cloud, "normal_x"));
+}
+
+TEST(LasTools, InfoReportsTheLasLayout) {
+  const ToolRun run = runTool(PCL_DDG_INFO_TOOL, sharedData(kSurvey));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("LAS:               1.2, point format 3"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("scale:             0.01 0.01 0.01"), std::string::npos);
+  EXPECT_NE(run.out.find("LASF_Projection 34735"), std::string::npos);
+  EXPECT_NE(run.out.find("class   2:         26107 (ground)"), std::string::npos) << run.out;
+  const ToolRun json = runTool(PCL_DDG_INFO_TOOL, sharedData("las/extrabytes.las") + " -json");
+  ASSERT_EQ(json.exit_code, 0);
+  EXPECT_NE(json.out.find("\"point_format\": 3"), std::string::npos) << json.out;
+  EXPECT_NE(json.out.find("\"Colors\""), std::string::npos) << json.out;
+  EXPECT_EQ(std::count(json.out.begin(), json.out.end(), '\n'), 1) << "one JSON object";
+}
+
+TEST(LasTools, LazIsRefusedWithOneLine) {
+  const ToolRun run = runTool(PCL_DDG_INFO_TOOL, sharedData("las/simple.laz"));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("laszip -i in.laz -o out.las"), std::string::npos) << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
