@@ -143,11 +143,10 @@ int ToolArguments::integer(const std::string& option, int fallback) const {
 namespace {
 
 const char* const kCommonHelp =
-    "Every tool also takes:\n"
-    "         -input_dir DIR [-output_dir OUT]  every .ply .obj .off .stl .vtk .pcd .las file of "
-    "DIR "
-    "(PCL's\n"
-    "                  batch mode; outputs OUT/<name>.<ext>, a failure does not stop the others)\n"
+    "Every tool but the viewer also takes:\n"
+    "         -input_dir DIR [-output_dir OUT]  every .ply .obj .off .stl .vtk .pcd .las file\n"
+    "                  of DIR (PCL's batch mode; outputs OUT/<name>.<ext>, a failure does not\n"
+    "                  stop the others)\n"
     "         -h, -help  this text;  --version  pcl_ddg's version\n";
 
 const char* const kReadableExtensions[] = {"ply", "obj", "off", "stl", "vtk", "pcd", "las"};
