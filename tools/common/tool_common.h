@@ -4,6 +4,7 @@
 #include <pcl/console/time.h>
 
 #include <condition_variable>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <mutex>
@@ -81,6 +82,10 @@ void checkOutputFile(const std::string& output, const std::vector<std::string>& 
  */
 int runTool(const char* name, const char* description, const char* syntax,
             const std::function<int()>& body);
+
+/** The number of bytes of a size written like "2G", "512M", "64k" or "1000000" (-memory);
+ *  throws pcl::BadArgumentException for anything else. */
+std::uint64_t parseByteSize(const std::string& text);
 
 /** Prints "tool: error: message" as one line of its own on stderr (newlines in the message become
  *  spaces; an unfinished progress line is ended first). */

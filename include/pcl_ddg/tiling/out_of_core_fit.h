@@ -44,10 +44,6 @@ struct OutOfCoreReport {
  *  the caller's output convention, the same as for a cloud in memory. */
 using ResultFields = std::function<void(pcl::PCLPointCloud2& piece, const LocalFitResult& fit)>;
 
-/** The number of bytes of a size written like "2G", "512M", "64k" or "1000000"; throws
- *  pcl::BadArgumentException for anything else. */
-std::uint64_t parseByteSize(const std::string& text);
-
 /**
  * Fits options' estimator to every point of the cloud file `input` and writes `output`. The
  * viewpoint, if unset, is the input's VIEWPOINT. Throws FileFormatException for inputs that
