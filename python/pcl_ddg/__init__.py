@@ -513,10 +513,16 @@ class MeshFile:
     doubles), ``faces`` ((m, 3) int32, a list of polygons, or None for a cloud), ``fields`` (every
     other vertex property by name, in its own dtype; colours as ``"rgb"`` uint8 (n, 3)),
     ``viewpoint`` (a PCD's VIEWPOINT origin; zeros otherwise), ``orientation`` (its rotation, w x
-    y z), ``organized_shape`` ((h, w) of an organized cloud, else None) and ``precision`` (the
-    declared coordinate type, ``"float"`` or ``"double"``)."""
+    y z), ``organized_shape`` ((h, w) of an organized cloud, else None), ``precision`` (the
+    declared coordinate type, ``"float"`` or ``"double"``) and ``las`` (a LAS file's
+    :class:`_pcl_ddg.LasLayout`: version, point format, scale/offset, VLRs; else None). For a LAS
+    file ``points`` are ``X * scale + offset`` in double and ``fields`` every record field as
+    stored (``red green blue`` uint16, Extra Bytes by name; docs/las.md)."""
 
-    __slots__ = ("points", "faces", "fields", "viewpoint", "orientation", "organized_shape", "precision")
+    __slots__ = (
+        "points", "faces", "fields", "viewpoint", "orientation", "organized_shape", "precision",
+        "las",
+    )
 
     def __init__(
         self,
@@ -527,6 +533,7 @@ class MeshFile:
         orientation: np.ndarray,
         organized_shape: Optional[Tuple[int, int]],
         precision: str,
+        las: Optional["_pcl_ddg.LasLayout"] = None,
     ) -> None:
         self.points = points
         self.faces = faces
@@ -535,6 +542,7 @@ class MeshFile:
         self.orientation = orientation
         self.organized_shape = organized_shape
         self.precision = precision
+        self.las = las
 
     @property
     def grid(self) -> np.ndarray:
@@ -557,14 +565,14 @@ def _path(path: Union[str, "os.PathLike[str]"]) -> str:
 
 def read(path: Union[str, "os.PathLike[str]"]) -> MeshFile:
     """Reads a mesh or a cloud: .ply (ascii/binary; face, tristrips, range_grid), .obj, .off
-    (also binary), .stl, .vtk (legacy POLYDATA), .pcd (organized or not). OSError if the file
-    is missing, unknown or malformed."""
+    (also binary), .stl, .vtk (legacy POLYDATA), .pcd (organized or not), .las (LAS 1.0-1.4,
+    formats 0-10; LAZ is refused). OSError if the file is missing, unknown or malformed."""
     path = _path(path)
     if not os.path.exists(path):
         import errno
 
         raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), path)
-    points, faces, fields, viewpoint, orientation, shape, precision = _pcl_ddg.read(path)
+    points, faces, fields, viewpoint, orientation, shape, precision, las = _pcl_ddg.read(path)
     return MeshFile(
         points,
         faces,
@@ -573,6 +581,7 @@ def read(path: Union[str, "os.PathLike[str]"]) -> MeshFile:
         np.array(orientation, dtype=np.float64),
         shape,
         precision,
+        las,
     )
 
 
@@ -585,15 +594,23 @@ def write(
     precision: Optional[str] = None,
     encoding: str = "binary",
     organized_shape: Optional[Tuple[int, int]] = None,
+    las: Optional["_pcl_ddg.LasLayout"] = None,
 ) -> None:
-    """Writes a .ply (binary, or ``encoding="ascii"``) or a .pcd (binary_compressed; faces are
-    not stored), atomically (a failed write leaves no file).
+    """Writes a .ply (binary, or ``encoding="ascii"``), a .pcd (binary_compressed; faces are
+    not stored) or a .las, atomically (a failed write leaves no file).
 
     fields: per-vertex values by name, (n,) each; ``"normals"`` (n, 3) becomes nx ny nz (PLY) or
     normal_x normal_y normal_z (PCD); ``"rgb"`` uint8 (n, 3) the colours; another (n, c) array
     becomes name_0 .. name_{c-1}. precision: ``"float"`` or ``"double"``; None (default) keeps
     every value exact (double where float would round a float64 value). viewpoint: a PCD's
     VIEWPOINT. organized_shape: (h, w) of an organized cloud (h * w = n).
+
+    .las: every field keeps its dtype ((n, c) is one field of c values); the LAS point fields
+    (``intensity``, ``classification``, ``red``, ... as :func:`read` gives them) fill the
+    records, every other field becomes an Extra Bytes dimension (``"normals"`` as NormalX
+    NormalY NormalZ). ``las``: the layout to keep (a LAS :func:`read`'s ``las``: version, point
+    format, scale/offset, VLRs), so that unchanged records round-trip bit for bit; None: LAS 1.4
+    format 6 (7 with ``"rgb"``).
     """
     points = _array(points, "points")
     if points.ndim == 3 and organized_shape is None:
@@ -608,4 +625,5 @@ def write(
         precision,
         encoding,
         None if organized_shape is None else (int(organized_shape[0]), int(organized_shape[1])),
+        las,
     )

@@ -86,6 +86,7 @@ auto compute(Body&& body) {
 void bindMeshes(py::module_& m);
 void bindClouds(py::module_& m);
 void bindIO(py::module_& m);
+void bindDistributed(py::module_& m);
 
 }  // namespace python
 }  // namespace pcl_ddg

@@ -3,6 +3,7 @@
 // field in its own type; colours as uint8 (n, 3).
 #include <pcl/PCLPointField.h>
 #include <pcl/PolygonMesh.h>
+#include <pcl/common/io.h>
 
 #include <algorithm>
 #include <cmath>
@@ -130,9 +131,129 @@ std::vector<pcl::Vertices> polygonsOf(int n, const py::object& faces) {
   return polygons;
 }
 
+// The PCL type of a numpy dtype (bool as UINT8); 0 if it has none.
+std::uint8_t pclTypeOf(const py::dtype& dtype) {
+  const char kind = dtype.kind();
+  const auto size = dtype.itemsize();
+  if (kind == 'b') return pcl::PCLPointField::UINT8;
+  if (kind == 'f')
+    return size == 4 ? pcl::PCLPointField::FLOAT32 : size == 8 ? pcl::PCLPointField::FLOAT64 : 0;
+  if (kind == 'i' || kind == 'u') {
+    const bool u = kind == 'u';
+    switch (size) {
+      case 1:
+        return u ? pcl::PCLPointField::UINT8 : pcl::PCLPointField::INT8;
+      case 2:
+        return u ? pcl::PCLPointField::UINT16 : pcl::PCLPointField::INT16;
+      case 4:
+        return u ? pcl::PCLPointField::UINT32 : pcl::PCLPointField::INT32;
+      case 8:
+        return u ? pcl::PCLPointField::UINT64 : pcl::PCLPointField::INT64;
+      default:
+        return 0;
+    }
+  }
+  return 0;
+}
+
+// A field appended in its own type: (n,) or (n, count) values, C-contiguous.
+struct TypedField {
+  std::string name;
+  std::uint8_t datatype;
+  std::uint32_t count;
+  py::array values;
+};
+
+// Appends the fields to an unorganized cloud (one repacking of every point).
+void appendTypedFields(pcl::PCLPointCloud2& cloud, const std::vector<TypedField>& fields) {
+  if (fields.empty()) return;
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  std::uint32_t step = cloud.point_step;
+  std::vector<std::uint32_t> offsets;
+  for (const TypedField& f : fields) {
+    pcl::PCLPointField field;
+    field.name = f.name;
+    field.offset = step;
+    field.datatype = f.datatype;
+    field.count = f.count;
+    cloud.fields.push_back(field);
+    offsets.push_back(step);
+    step += static_cast<std::uint32_t>(pcl::getFieldSize(f.datatype)) * f.count;
+  }
+  std::vector<std::uint8_t> data(n * step);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t row = i / cloud.width, column = i % cloud.width;
+    std::memcpy(data.data() + i * step,
+                cloud.data.data() + row * cloud.row_step + column * cloud.point_step,
+                cloud.point_step);
+  }
+  for (std::size_t k = 0; k < fields.size(); ++k) {
+    const std::size_t bytes = pcl::getFieldSize(fields[k].datatype) * fields[k].count;
+    const auto* src = static_cast<const std::uint8_t*>(fields[k].values.data());
+    for (std::size_t i = 0; i < n; ++i)
+      std::memcpy(data.data() + i * step + offsets[k], src + i * bytes, bytes);
+  }
+  cloud.data = std::move(data);
+  cloud.point_step = step;
+  cloud.row_step = step * cloud.width;
+}
+
+py::bytes bytesOf(const std::string& s) {
+  return py::bytes(s.data(), s.size());
+}
+
+py::tuple vector3(const Eigen::Vector3d& v) {
+  return py::make_tuple(v.x(), v.y(), v.z());
+}
+
+py::list recordsOf(const std::vector<LasVariableLengthRecord>& records) {
+  py::list out;
+  for (const LasVariableLengthRecord& r : records)
+    out.append(py::make_tuple(r.userId(), r.record_id, r.descriptionText(), bytesOf(r.data)));
+  return out;
+}
+
 }  // namespace
 
 void bindIO(py::module_& m) {
+  py::class_<LasLayout, std::shared_ptr<LasLayout>>(
+      m, "LasLayout",
+      "A LAS file's layout as read (version, point format, scale and offset, VLRs, Extra Bytes): "
+      "passed back to write, a .las output keeps it.")
+      .def_property_readonly(
+          "version",
+          [](const LasLayout& l) { return py::make_tuple(l.version_major, l.version_minor); })
+      .def_readonly("point_format", &LasLayout::point_format)
+      .def_readonly("record_length", &LasLayout::record_length)
+      .def_readonly("point_count", &LasLayout::point_count)
+      .def_readonly("file_source_id", &LasLayout::file_source_id)
+      .def_readonly("global_encoding", &LasLayout::global_encoding)
+      .def_property_readonly("scale", [](const LasLayout& l) { return vector3(l.scale); })
+      .def_property_readonly("offset", [](const LasLayout& l) { return vector3(l.offset); })
+      .def_property_readonly("min", [](const LasLayout& l) { return vector3(l.min); })
+      .def_property_readonly("max", [](const LasLayout& l) { return vector3(l.max); })
+      .def_property_readonly(
+          "vlrs", [](const LasLayout& l) { return recordsOf(l.vlrs); },
+          "[(user_id, record_id, description, data bytes)] in file order")
+      .def_property_readonly("evlrs", [](const LasLayout& l) { return recordsOf(l.evlrs); })
+      .def_property_readonly(
+          "extra_bytes",
+          [](const LasLayout& l) {
+            py::list out;
+            for (const LasExtraBytesDimension& d : l.extra_bytes)
+              out.append(py::make_tuple(d.field, bytesOf(d.descriptor)));
+            return out;
+          },
+          "[(field, 192-byte descriptor)] of the Extra Bytes VLR, in record order")
+      .def_readonly("undocumented_bytes", &LasLayout::undocumented_bytes)
+      .def("__repr__", [](const LasLayout& l) {
+        return "LasLayout(version=" + std::to_string(l.version_major) + "." +
+               std::to_string(l.version_minor) +
+               ", point_format=" + std::to_string(l.point_format) +
+               ", points=" + std::to_string(l.point_count) +
+               ", vlrs=" + std::to_string(l.vlrs.size()) + ")";
+      });
+
   m.def(
       "read",
       [](const std::string& path) {
@@ -142,7 +263,8 @@ void bindIO(py::module_& m) {
         }();
         const pcl::PCLPointCloud2& cloud = file.mesh.cloud;
         py::dict fields;
-        const bool colours = vertexColorLayout(cloud).has_value();
+        // LAS: every field as stored (red green blue stay uint16, so that write gives them back).
+        const bool colours = !file.las && vertexColorLayout(cloud).has_value();
         const std::set<std::string> coordinates = {"x", "y", "z", "_"};
         const std::set<std::string> colour_fields = {"rgb",   "rgba", "red",
                                                      "green", "blue", "alpha"};
@@ -168,17 +290,20 @@ void bindIO(py::module_& m) {
             rowsArray(std::move(file.positions)), faces, fields,
             py::make_tuple(origin.x(), origin.y(), origin.z()),
             py::make_tuple(q.w(), q.x(), q.y(), q.z()), shape,
-            file.coordinate_precision == FieldPrecision::Double ? "double" : "float");
+            file.coordinate_precision == FieldPrecision::Double ? "double" : "float",
+            file.las ? py::cast(std::const_pointer_cast<LasLayout>(file.las))
+                     : py::object(py::none()));
       },
       py::arg("path"),
-      "(points, faces, fields, viewpoint, orientation, organized_shape, precision) of a file.");
+      "(points, faces, fields, viewpoint, orientation, organized_shape, precision, las) of a "
+      "file; las: a LAS file's LasLayout, else None.");
 
   m.def(
       "write",
       [](const std::string& path, const py::array& points, const py::object& faces,
          const std::optional<py::dict>& fields, std::optional<std::vector<double>> viewpoint,
          std::optional<std::string> precision, const std::string& encoding,
-         std::optional<std::pair<int, int>> organized_shape) {
+         std::optional<std::pair<int, int>> organized_shape, std::shared_ptr<LasLayout> las) {
         const Eigen::Matrix3Xd positions = positionsOf(points, "points");
         const int n = static_cast<int>(positions.cols());
         pcl::PolygonMesh mesh;
@@ -195,12 +320,38 @@ void bindIO(py::module_& m) {
         setVertexCoordinates(mesh.cloud, positions,
                              precisionOf(precision, points.dtype(), positions));
         const std::string extension = fileExtension(path);
+        // LAS: every field in its own type, (n, c) as one field of c values (Extra Bytes arrays).
+        std::vector<TypedField> typed;
         if (fields) {
           for (const auto& [key, value] : *fields) {
             const std::string name = py::str(key);
             const py::array array = py::array::ensure(value);
             if (!array || array.ndim() < 1 || array.shape(0) != n)
               throw py::value_error("field '" + name + "' must have one row per point");
+            if (extension == "las" && name != "rgb") {
+              if (array.ndim() > 2)
+                throw py::value_error("field '" + name + "' has more than 2 dimensions");
+              const std::uint8_t datatype = pclTypeOf(array.dtype());
+              if (datatype == 0) throw py::value_error("field '" + name + "' must hold numbers");
+              const auto columns =
+                  static_cast<std::uint32_t>(array.ndim() == 2 ? array.shape(1) : 1);
+              py::array values = py::array::ensure(
+                  array.dtype().kind() == 'b' ? array.attr("astype")("uint8") : py::object(array),
+                  py::array::c_style);
+              if (name == "normals") {
+                if (columns != 3) throw py::value_error("field 'normals' must have shape (n, 3)");
+                // normal_x normal_y normal_z: the writer's NormalX NormalY NormalZ
+                for (int c = 0; c < 3; ++c) {
+                  typed.push_back(
+                      {std::string("normal_") + "xyz"[c], datatype, 1,
+                       py::array::ensure(values[py::make_tuple(py::ellipsis(), c)].attr("copy")(),
+                                         py::array::c_style)});
+                }
+                continue;
+              }
+              typed.push_back({name, datatype, columns, values});
+              continue;
+            }
             if (name == "rgb") {
               if (array.ndim() != 2 || array.shape(1) != 3 || array.dtype().kind() != 'u' ||
                   array.dtype().itemsize() != 1)
@@ -239,8 +390,12 @@ void bindIO(py::module_& m) {
                             precisionOf(precision, array.dtype(), matrix));
           }
         }
+        if (!typed.empty() && mesh.cloud.height != 1)
+          throw py::value_error("a .las file holds no organized cloud");
+        appendTypedFields(mesh.cloud, typed);
         mesh.polygons = polygonsOf(n, faces);
         MeshWriteOptions options;
+        options.las = las;
         options.ply_encoding = choice("encoding", encoding, {"binary", "ascii"}) == "ascii"
                                    ? PlyEncoding::Ascii
                                    : PlyEncoding::Binary;
@@ -254,7 +409,8 @@ void bindIO(py::module_& m) {
       py::arg("path"), py::arg("points"), py::arg("faces") = py::none(),
       py::arg("fields") = py::none(), py::arg("viewpoint") = py::none(),
       py::arg("precision") = py::none(), py::arg("encoding") = "binary",
-      py::arg("organized_shape") = py::none(), "saveMesh of points, faces and fields.");
+      py::arg("organized_shape") = py::none(), py::arg("las") = py::none(),
+      "saveMesh of points, faces and fields; las: the LasLayout a .las output keeps.");
 }
 
 }  // namespace python

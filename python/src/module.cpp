@@ -299,4 +299,5 @@ PYBIND11_MODULE(_pcl_ddg, m) {
   bindMeshes(m);
   bindClouds(m);
   bindIO(m);
+  bindDistributed(m);
 }

@@ -1,0 +1,760 @@
+// The compiled half of pcl_ddg.distributed (a dask.distributed runner): what a worker needs to read
+// its own points from a shared file by byte ranges, fit a tile's core points with the out-of-core
+// path's certified-halo rule (src/tiling/tiled_local_fit.cpp), and what the client needs to write
+// the merged output the way the tools write it (src/tiling/out_of_core_fit.cpp, step 5), so that
+// a distributed run equals `pcl_ddg_normals` / `pcl_ddg_curvature` on the merged cloud byte for
+// byte. Every function releases the GIL while it reads, fits or writes.
+#include <fcntl.h>
+#include <pcl/exceptions.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+#include "../../src/io/formats.h"  // the binary layouts and writers of the out-of-core path
+#include "binding_common.h"
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/features/local_fit.h"
+#include "pcl_ddg/io/atomic_file.h"
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/io/vertex_fields.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/search/kd_tree_search.h"
+
+namespace pcl_ddg {
+namespace python {
+namespace {
+
+// As tiled_local_fit.cpp: a point counts as inside the halo only with this relative margin.
+constexpr double kRoundingMargin = 1e-5;
+
+[[noreturn]] void failSystem(const std::string& what) {
+  throw FileFormatException(what + ": " + std::strerror(errno));
+}
+
+// A piece of an input: its records parsed as the whole file is (so every value converts exactly as
+// it does in memory), and its points' exact coordinates.
+struct Piece {
+  pcl::PCLPointCloud2 cloud;
+  Eigen::Matrix3Xd positions;
+  bool exact_double = false;  ///< LAS: X * scale + offset, written as doubles (as the tools do)
+};
+
+template <typename T>
+void putLE(std::string& bytes, std::size_t at, T value) {
+  std::memcpy(bytes.data() + at, &value, sizeof(T));
+}
+template <typename T>
+T getLE(const std::string& bytes, std::size_t at) {
+  T value;
+  std::memcpy(&value, bytes.data() + at, sizeof(T));
+  return value;
+}
+
+// An input read a piece at a time: out_of_core_fit.cpp's CloudPieces for binary PCD and PLY, and
+// for LAS the header and VLRs with the piece's count, before the piece's records.
+class Pieces {
+ public:
+  explicit Pieces(const std::string& path) : path_(path), ext_(fileExtension(path)) {
+    if (ext_ != "pcd" && ext_ != "ply" && ext_ != "las")
+      throw FileFormatException(path +
+                                ": only binary .pcd, binary .ply and .las clouds are read by "
+                                "ranges");
+    in_.open(path, std::ios::binary);
+    if (!in_) failSystem(path);
+    const auto size = static_cast<std::int64_t>(std::filesystem::file_size(path));
+    if (ext_ == "las") {
+      openLAS(size);
+      return;
+    }
+    for (const std::int64_t want : {std::int64_t{64} << 10, std::int64_t{4} << 20}) {
+      std::string head(static_cast<std::size_t>(std::min(want, size)), '\0');
+      in_.seekg(0);
+      in_.read(head.data(), static_cast<std::streamsize>(head.size()));
+      head.resize(static_cast<std::size_t>(in_.gcount()));
+      in_.clear();
+      try {
+        layout_ = ext_ == "pcd" ? detail::pcdBinaryLayout(head) : detail::plyBinaryLayout(head);
+        break;
+      } catch (const pcl::PCLException& e) {
+        if (want < (std::int64_t{4} << 20) && size > want) continue;  // a longer header?
+        throw FileFormatException(path + ": " + errorDescription(e));
+      }
+    }
+    if (size - layout_.header_bytes < layout_.points * layout_.point_bytes)
+      throw FileFormatException(path + ": shorter than its points (truncated?)");
+  }
+
+  const detail::BinaryCloudLayout& layout() const { return layout_; }
+
+  Piece read(std::int64_t first, std::int64_t count) {
+    if (first < 0 || count < 0 || first + count > layout_.points)
+      throw pcl::BadArgumentException(path_ + ": points " + std::to_string(first) + ".." +
+                                      std::to_string(first + count) + " are not in the file");
+    std::string file = ext_ == "las" ? lasHeaderFor(count)
+                                     : layout_.header_for(layout_.header, count);
+    const std::size_t header = file.size();
+    file.resize(header + static_cast<std::size_t>(count * layout_.point_bytes));
+    in_.seekg(layout_.header_bytes + first * layout_.point_bytes);
+    in_.read(file.data() + header, static_cast<std::streamsize>(file.size() - header));
+    if (in_.gcount() != static_cast<std::streamsize>(file.size() - header))
+      throw FileFormatException(path_ + ": cannot read points " + std::to_string(first) + "..");
+    Piece piece;
+    try {
+      if (ext_ == "las") {
+        detail::LasCloud las = detail::parseLAS(file);
+        piece.cloud = std::move(las.mesh.cloud);
+        piece.positions = std::move(las.positions);
+        piece.exact_double = true;
+        return piece;
+      }
+      piece.cloud = (ext_ == "pcd" ? detail::parsePCD(file) : detail::parsePLY(file)).cloud;
+    } catch (const pcl::PCLException& e) {
+      throw FileFormatException(path_ + ": " + errorDescription(e));
+    }
+    piece.positions = vertexPositions(piece.cloud, NonFinitePolicy::Keep);
+    return piece;
+  }
+
+ private:
+  void openLAS(std::int64_t size) {
+    std::string head(static_cast<std::size_t>(std::min<std::int64_t>(375, size)), '\0');
+    in_.read(head.data(), static_cast<std::streamsize>(head.size()));
+    if (in_.gcount() < 227 || head.compare(0, 4, "LASF") != 0)
+      throw FileFormatException(path_ + ": not a LAS file (no LASF signature)");
+    if ((static_cast<std::uint8_t>(head[104]) & 0xC0) != 0)
+      throw FileFormatException(path_ + ": LAZ (compressed LAS) is not supported: decompress it "
+                                        "first (laszip -i in.laz -o out.las)");
+    las_minor_ = static_cast<std::uint8_t>(head[25]);
+    const auto point_offset = getLE<std::uint32_t>(head, 96);
+    layout_.header_bytes = point_offset;
+    layout_.point_bytes = getLE<std::uint16_t>(head, 105);
+    legacy_count_ = getLE<std::uint32_t>(head, 107) != 0;
+    layout_.points = getLE<std::uint32_t>(head, 107);
+    if (las_minor_ >= 4 && head.size() >= 255) {
+      layout_.points = static_cast<std::int64_t>(getLE<std::uint64_t>(head, 247));
+      if (getLE<std::uint32_t>(head, 243) != 0)
+        throw FileFormatException(path_ + ": LAS EVLRs are not read by ranges yet");
+    }
+    if (point_offset > size || layout_.point_bytes == 0 ||
+        size - point_offset < layout_.points * layout_.point_bytes)
+      throw FileFormatException(path_ + ": shorter than its points (truncated?)");
+    layout_.header.resize(point_offset);
+    in_.seekg(0);
+    in_.read(layout_.header.data(), static_cast<std::streamsize>(point_offset));
+    if (in_.gcount() != static_cast<std::streamsize>(point_offset))
+      throw FileFormatException(path_ + ": cannot read its header");
+    layout_.width = static_cast<std::uint32_t>(layout_.points);
+    layout_.height = 1;
+  }
+  // The header and VLRs of a file of `count` of these records (no waveform data, no EVLRs).
+  std::string lasHeaderFor(std::int64_t count) const {
+    std::string header = layout_.header;
+    if (legacy_count_) putLE<std::uint32_t>(header, 107, static_cast<std::uint32_t>(count));
+    if (las_minor_ >= 3) putLE<std::uint64_t>(header, 227, 0);
+    if (las_minor_ >= 4) {
+      putLE<std::uint64_t>(header, 235, 0);
+      putLE<std::uint32_t>(header, 243, 0);
+      putLE<std::uint64_t>(header, 247, static_cast<std::uint64_t>(count));
+    }
+    return header;
+  }
+
+  std::string path_, ext_;
+  std::ifstream in_;
+  detail::BinaryCloudLayout layout_;
+  std::uint8_t las_minor_ = 0;
+  bool legacy_count_ = false;
+};
+
+py::dict cloudLayout(const std::string& path) {
+  py::list fields;
+  detail::BinaryCloudLayout layout;
+  pcl::PCLPointCloud2 empty;
+  {
+    py::gil_scoped_release release;
+    Pieces pieces(path);
+    layout = pieces.layout();
+    empty = pieces.read(0, std::min<std::int64_t>(1, layout.points)).cloud;
+  }
+  for (const auto& f : empty.fields)
+    fields.append(py::make_tuple(f.name, static_cast<int>(f.datatype), f.count, f.offset));
+  py::dict d;
+  d["points"] = layout.points;
+  d["header_bytes"] = layout.header_bytes;
+  d["point_bytes"] = layout.point_bytes;
+  d["width"] = layout.width;
+  d["height"] = layout.height;
+  const SensorPose& pose = layout.sensor_pose;
+  d["viewpoint"] = py::make_tuple(pose.origin.x(), pose.origin.y(), pose.origin.z());
+  d["orientation"] = py::make_tuple(pose.orientation.w(), pose.orientation.x(),
+                                    pose.orientation.y(), pose.orientation.z());
+  d["fields"] = fields;
+  return d;
+}
+
+// Points [first, first + count) of a binary PCD/PLY file as PCL's float points (the tools' toXYZ:
+// exact coordinates, then float); NaN rows stay.
+py::array_t<float> readXYZ(const std::string& path, std::int64_t first, std::int64_t count) {
+  py::array_t<float> out({static_cast<py::ssize_t>(std::max<std::int64_t>(count, 0)),
+                          py::ssize_t{3}});
+  float* data = out.mutable_data();
+  {
+    py::gil_scoped_release release;
+    Pieces pieces(path);
+    const Eigen::Matrix3Xd positions = pieces.read(first, count).positions;
+    for (Eigen::Index i = 0; i < positions.cols(); ++i)
+      for (int d = 0; d < 3; ++d) data[3 * i + d] = static_cast<float>(positions(d, i));
+  }
+  return out;
+}
+
+// A chunk's points that a tile gathers: those inside the closed box [lo, hi] and (tile >= 0) the
+// tile's own (their grid cell, half-open: floor((x - origin) / size), clamped to the grid). Returns
+// (float32 points, their positions in the chunk, own mask), in the chunk's order.
+py::tuple gatherChunk(const std::string& path, std::int64_t first, std::int64_t count,
+                      const std::vector<double>& lo, const std::vector<double>& hi,
+                      const std::vector<double>& origin, const std::vector<double>& size,
+                      const std::vector<std::int64_t>& dims, std::int64_t tile) {
+  if (lo.size() != 3 || hi.size() != 3 || origin.size() != 3 || size.size() != 3 ||
+      dims.size() != 3)
+    throw py::value_error("lo, hi, origin, size and dims are x, y, z");
+  std::vector<float> kept;
+  std::vector<std::int64_t> at;
+  std::vector<std::uint8_t> own;
+  {
+    py::gil_scoped_release release;
+    Pieces pieces(path);
+    const Eigen::Matrix3Xd positions = pieces.read(first, count).positions;
+    for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+      float f[3];
+      double v[3];
+      bool finite = true, inside = true;
+      for (int d = 0; d < 3; ++d) {
+        f[d] = static_cast<float>(positions(d, i));
+        v[d] = static_cast<double>(f[d]);
+        finite = finite && std::isfinite(v[d]);
+        inside = inside && v[d] >= lo[d] && v[d] <= hi[d];
+      }
+      if (!finite) continue;
+      bool mine = false;
+      if (tile >= 0) {
+        std::int64_t cell[3];
+        for (int d = 0; d < 3; ++d) {
+          const double c = std::floor((v[d] - origin[d]) / size[d]);
+          cell[d] = static_cast<std::int64_t>(
+              std::clamp(c, 0.0, static_cast<double>(dims[d] - 1)));
+        }
+        mine = (cell[0] * dims[1] + cell[1]) * dims[2] + cell[2] == tile;
+      }
+      if (!inside && !mine) continue;
+      kept.insert(kept.end(), f, f + 3);
+      at.push_back(i);
+      own.push_back(mine ? 1 : 0);
+    }
+  }
+  py::array_t<float> points({static_cast<py::ssize_t>(at.size()), py::ssize_t{3}});
+  if (!kept.empty()) std::memcpy(points.mutable_data(), kept.data(), kept.size() * sizeof(float));
+  std::vector<std::uint8_t> own_copy = own;
+  return py::make_tuple(points, vectorArray(std::move(at)), maskArray(own_copy));
+}
+
+Eigen::AlignedBox3d boxOf(const std::vector<double>& b) {
+  if (b.size() != 6) throw py::value_error("a box is (xmin, ymin, zmin, xmax, ymax, zmax)");
+  return {Eigen::Vector3d(b[0], b[1], b[2]), Eigen::Vector3d(b[3], b[4], b[5])};
+}
+
+// tiled_local_fit.cpp's reach: how far the point may look before it could meet a point that was
+// not gathered (the nearest face of the halo box that does not lie beyond the cloud's bounds).
+double reach(const Eigen::Vector3d& q, const Eigen::AlignedBox3d& halo_box,
+             const Eigen::AlignedBox3d& bounds) {
+  double r = std::numeric_limits<double>::infinity();
+  for (int d = 0; d < 3; ++d) {
+    if (halo_box.min()[d] > bounds.min()[d]) r = std::min(r, q[d] - halo_box.min()[d]);
+    if (halo_box.max()[d] < bounds.max()[d]) r = std::min(r, halo_box.max()[d] - q[d]);
+  }
+  return r;
+}
+
+// Point counts on a grid of cubic cells over a gathered tile, with their 3-D prefix sums: the
+// count of any block of cells in O(1). A point's k-th neighbour (itself counted, as the kd-tree
+// counts it) lies within sqrt(3) (m + 1) c when the (2m + 1)^3 cells around its cell hold k points:
+// that block lies inside the cube of half-width (m + 1) c around the point.
+class CellCounts {
+ public:
+  explicit CellCounts(const pcl::PointCloud<pcl::PointXYZ>& cloud) {
+    const std::size_t n = cloud.size();
+    if (n == 0) return;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d hi = -lo;
+    for (const auto& p : cloud) {
+      const Eigen::Vector3d v = p.getVector3fMap().cast<double>();
+      lo = lo.cwiseMin(v);
+      hi = hi.cwiseMax(v);
+    }
+    if (!lo.allFinite() || !hi.allFinite()) return;
+    origin_ = lo;
+    const Eigen::Vector3d extent = hi - lo;
+    // The cell size giving about two cells per point (bisection on a log scale).
+    double small = std::max(extent.maxCoeff(), 1e-300) * 1e-7, large = extent.maxCoeff() + 1e-300;
+    const auto cellsFor = [&](double c) {
+      double cells = 1.0;
+      for (int d = 0; d < 3; ++d) cells *= std::floor(extent[d] / c) + 2.0;
+      return cells;
+    };
+    for (int i = 0; i < 60; ++i) {
+      const double mid = std::sqrt(small * large);
+      (cellsFor(mid) > 2.0 * static_cast<double>(n) + 64.0 ? small : large) = mid;
+    }
+    cell_ = large;
+    for (int d = 0; d < 3; ++d) dims_[d] = static_cast<int>(std::floor(extent[d] / cell_)) + 1;
+    // Prefix sums over (dims + 1) per axis, index 0 being empty.
+    const std::size_t sx = static_cast<std::size_t>(dims_[0]) + 1;
+    const std::size_t sy = static_cast<std::size_t>(dims_[1]) + 1;
+    const std::size_t sz = static_cast<std::size_t>(dims_[2]) + 1;
+    stride_y_ = sz;
+    stride_x_ = sy * sz;
+    sums_.assign(sx * sy * sz, 0);
+    for (const auto& p : cloud) {
+      const Eigen::Vector3i c = cellOf(p);
+      ++sums_[at(c[0] + 1, c[1] + 1, c[2] + 1)];
+    }
+    for (std::size_t x = 1; x < sx; ++x)
+      for (std::size_t y = 0; y < sy; ++y)
+        for (std::size_t z = 0; z < sz; ++z) sums_[x * stride_x_ + y * stride_y_ + z] +=
+              sums_[(x - 1) * stride_x_ + y * stride_y_ + z];
+    for (std::size_t x = 0; x < sx; ++x)
+      for (std::size_t y = 1; y < sy; ++y)
+        for (std::size_t z = 0; z < sz; ++z) sums_[x * stride_x_ + y * stride_y_ + z] +=
+              sums_[x * stride_x_ + (y - 1) * stride_y_ + z];
+    for (std::size_t x = 0; x < sx; ++x)
+      for (std::size_t y = 0; y < sy; ++y)
+        for (std::size_t z = 1; z < sz; ++z) sums_[x * stride_x_ + y * stride_y_ + z] +=
+              sums_[x * stride_x_ + y * stride_y_ + z - 1];
+    ready_ = true;
+  }
+
+  /** An upper bound of the distance of q's k-th neighbour among the points (q one of them),
+   *  above the kd-tree's float rounding; infinity when no block of up to 7^3 cells holds k. */
+  double kthNeighbourBound(const pcl::PointXYZ& q, int k) const {
+    if (!ready_) return std::numeric_limits<double>::infinity();
+    const Eigen::Vector3i c = cellOf(q);
+    for (int m = 1; m <= 3; ++m) {
+      Eigen::Vector3i a, b;  // the block [a, b] of cells, clamped to the grid
+      for (int d = 0; d < 3; ++d) {
+        a[d] = std::max(c[d] - m, 0);
+        b[d] = std::min(c[d] + m, dims_[d] - 1);
+      }
+      if (blockCount(a, b) >= k) return std::sqrt(3.0) * (m + 1) * cell_ * (1.0 + 1e-4);
+    }
+    return std::numeric_limits<double>::infinity();
+  }
+
+ private:
+  Eigen::Vector3i cellOf(const pcl::PointXYZ& p) const {
+    Eigen::Vector3i c;
+    for (int d = 0; d < 3; ++d) {
+      const double v = std::floor((static_cast<double>(p.data[d]) - origin_[d]) / cell_);
+      c[d] = static_cast<int>(std::clamp(v, 0.0, static_cast<double>(dims_[d] - 1)));
+    }
+    return c;
+  }
+  std::size_t at(int x, int y, int z) const {
+    return static_cast<std::size_t>(x) * stride_x_ + static_cast<std::size_t>(y) * stride_y_ +
+           static_cast<std::size_t>(z);
+  }
+  // Points in cells a..b inclusive (inclusion-exclusion on the prefix sums).
+  std::int64_t blockCount(const Eigen::Vector3i& a, const Eigen::Vector3i& b) const {
+    const int x0 = a[0], y0 = a[1], z0 = a[2], x1 = b[0] + 1, y1 = b[1] + 1, z1 = b[2] + 1;
+    return static_cast<std::int64_t>(sums_[at(x1, y1, z1)]) - sums_[at(x0, y1, z1)] -
+           sums_[at(x1, y0, z1)] - sums_[at(x1, y1, z0)] + sums_[at(x0, y0, z1)] +
+           sums_[at(x0, y1, z0)] + sums_[at(x1, y0, z0)] - sums_[at(x0, y0, z0)];
+  }
+
+  bool ready_ = false;
+  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
+  double cell_ = 1.0;
+  int dims_[3] = {1, 1, 1};
+  std::size_t stride_x_ = 0, stride_y_ = 0;
+  std::vector<std::int32_t> sums_;
+};
+
+/**
+ * Fits the `own` points of a gathered tile (points in the merged cloud's order, so that the
+ * kd-tree's ties break as on the whole cloud). mode "certified": a point is fitted only when its k-th
+ * neighbour among the gathered points (widened by the rounding margin) is nearer than the halo
+ * box's edge (`reach`); the others come back uncertified, with how far they look, for a wider
+ * gather ("look": the same without fitting; "all": every own point is fitted). Radius searches
+ * are certified by a halo of the radius, so the check applies to k only.
+ * Returns (records (n_own, 4 or 9) float32: nx ny nz curvature [pc1 pc2 k1 direction],
+ * certified, looking distance (an upper bound where certified without a search), reach (how far
+ * each point may look inside the halo box; infinity unchecked), failed, fallback).
+ */
+py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::forcecast>& xyz,
+                  const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& own,
+                  const std::string& method, int k, double radius, unsigned int max_nn,
+                  const std::vector<double>& viewpoint, const std::string& orient,
+                  const std::optional<std::vector<double>>& up,
+                  const std::optional<std::vector<double>>& halo_box,
+                  const std::vector<double>& bounds, const std::string& mode,
+                  unsigned int threads) {
+  choice("mode", mode, {"look", "certified", "all"});
+  const bool certify = mode != "all";
+  const bool fit_any = mode != "look";
+  if (xyz.ndim() != 2 || xyz.shape(1) != 3) throw py::value_error("points must be (m, 3)");
+  const auto m = static_cast<std::size_t>(xyz.shape(0));
+  const auto n_own = static_cast<std::size_t>(own.size());
+  LocalFitOptions options;
+  options.method = choice("method", method, {"pca", "quadric"}) == "pca" ? LocalFitMethod::PCA
+                                                                         : LocalFitMethod::Quadric;
+  options.neighbourhood = NeighbourhoodKind::KdTree;
+  options.k = k;
+  options.radius = radius;
+  options.max_neighbours = radius > 0.0 ? max_nn : 0;
+  options.threads = threads;
+  if (viewpoint.size() != 3) throw py::value_error("viewpoint must be x, y, z");
+  options.viewpoint = Eigen::Vector3d(viewpoint[0], viewpoint[1], viewpoint[2]);
+  if (choice("orient", orient, {"viewpoint", "up"}) == "up") {
+    options.orientation = NormalOrientation::Up;
+    if (up) options.up = Eigen::Vector3d((*up)[0], (*up)[1], (*up)[2]).normalized();
+  }
+  const Eigen::AlignedBox3d cloud_bounds = boxOf(bounds);
+  const bool check = certify && radius == 0.0;
+  Eigen::AlignedBox3d box;
+  if (check) {
+    if (!halo_box) throw py::value_error("certify needs the halo box");
+    box = boxOf(*halo_box);
+  }
+  const int floats = options.method == LocalFitMethod::Quadric ? 9 : 4;
+  py::array_t<float> records({static_cast<py::ssize_t>(n_own), static_cast<py::ssize_t>(floats)});
+  py::array_t<bool> certified(static_cast<py::ssize_t>(n_own));
+  py::array_t<double> looking(static_cast<py::ssize_t>(n_own));
+  py::array_t<double> reaches(static_cast<py::ssize_t>(n_own));
+  double* reach_of = reaches.mutable_data();
+  float* rec = records.mutable_data();
+  bool* ok = certified.mutable_data();
+  double* look = looking.mutable_data();
+  const float* p = xyz.data();
+  const std::int64_t* own_at = own.data();
+  LocalFitResult fit;
+  {
+    py::gil_scoped_release release;
+    auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+    cloud->resize(m);
+    for (std::size_t i = 0; i < m; ++i) {
+      (*cloud)[i].x = p[3 * i];
+      (*cloud)[i].y = p[3 * i + 1];
+      (*cloud)[i].z = p[3 * i + 2];
+    }
+    for (std::size_t j = 0; j < n_own; ++j) {
+      if (own_at[j] < 0 || static_cast<std::size_t>(own_at[j]) >= m)
+        throw pcl::BadArgumentException("own position outside the gathered points");
+      ok[j] = true;
+      look[j] = 0.0;
+      reach_of[j] = std::numeric_limits<double>::infinity();
+    }
+    if (check && n_own > 0) {
+      // Most points are certified without a search: k gathered points in a block of cells around
+      // a point lie in a cube around it, which bounds its k-th neighbour's distance.
+      std::vector<std::uint8_t> searched(n_own, 1);
+      const CellCounts cells(*cloud);
+      for (std::size_t j = 0; j < n_own; ++j) {
+        const pcl::PointXYZ& q = (*cloud)[static_cast<std::size_t>(own_at[j])];
+        const double bound = cells.kthNeighbourBound(q, k);
+        reach_of[j] = reach(q.getVector3fMap().cast<double>(), box, cloud_bounds);
+        if (bound <= reach_of[j]) {
+          look[j] = bound;
+          searched[j] = 0;
+        }
+      }
+      // The others as tiled_local_fit.cpp's lookingDistances: the k-th neighbour among the
+      // gathered points (never nearer than the true one), widened by the rounding margin.
+      if (std::find(searched.begin(), searched.end(), 1) != searched.end()) {
+        KdTreeSearch<pcl::PointXYZ> search;
+        search.setInputCloud(cloud);
+        pcl::Indices neighbours;
+        std::vector<float> squared;
+        for (std::size_t j = 0; j < n_own; ++j) {
+          if (!searched[j]) continue;
+          const pcl::PointXYZ& q = (*cloud)[static_cast<std::size_t>(own_at[j])];
+          const int found = search.nearestKSearch(q, k, neighbours, squared);
+          look[j] = found < k ? std::numeric_limits<double>::infinity()
+                              : std::sqrt(static_cast<double>(squared.back())) *
+                                        (1.0 + kRoundingMargin) +
+                                    1e-30;
+          ok[j] = look[j] <= reach_of[j];
+        }
+      }
+    }
+    auto indices = std::make_shared<pcl::Indices>();
+    for (std::size_t j = 0; j < n_own; ++j)
+      if (ok[j]) indices->push_back(static_cast<pcl::index_t>(own_at[j]));
+    if (!fit_any) indices->clear();
+    if (!indices->empty()) fit = fitLocalSurfaces(cloud, nullptr, options, indices);
+    std::size_t at = 0;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (std::size_t j = 0; j < n_own; ++j) {
+      float* r = rec + j * floats;
+      if (!ok[j] || !fit_any) {
+        std::fill(r, r + floats, nan);
+        continue;
+      }
+      const pcl::Normal& n = fit.normals[at];
+      r[0] = n.normal_x;
+      r[1] = n.normal_y;
+      r[2] = n.normal_z;
+      r[3] = n.curvature;
+      if (floats == 9) {
+        const pcl::PrincipalCurvatures& c = fit.curvatures[at];
+        r[4] = c.pc1;
+        r[5] = c.pc2;
+        r[6] = c.principal_curvature_x;
+        r[7] = c.principal_curvature_y;
+        r[8] = c.principal_curvature_z;
+      }
+      ++at;
+    }
+  }
+  return py::make_tuple(records, certified, looking, reaches, fit.failed_points,
+                        fit.fallback_points);
+}
+
+// out_of_core_fit.cpp's OutputPieces: binary PCD (the header from the first piece's fields) or
+// binary PLY (each piece through the PLY writer, its header kept once with the total count).
+class OutputPieces {
+ public:
+  OutputPieces(const std::string& path, bool ply, std::int64_t points, std::int64_t width,
+               std::int64_t height, const SensorPose& pose)
+      : ply_(ply), points_(points), width_(width), height_(height), pose_(pose),
+        out_(path, std::ios::binary) {
+    if (!out_) failSystem("cannot write " + path);
+  }
+  void write(pcl::PCLPointCloud2& piece) {
+    const ColorLayout colors = ply_ ? ColorLayout::Channels : ColorLayout::PackedRGB;
+    const auto current = vertexColorLayout(piece);
+    if (current && *current != colors) setVertexColors(piece, vertexColors(piece), colors);
+    if (!ply_) {
+      while (removeVertexField(piece, "_")) {
+      }
+      if (first_) out_ << detail::binaryPCDHeader(piece, width_, height_, pose_);
+      out_.write(reinterpret_cast<const char*>(piece.data.data()),
+                 static_cast<std::streamsize>(piece.data.size()));
+    } else {
+      pcl::PolygonMesh mesh;
+      mesh.cloud = piece;
+      std::ostringstream encoded;
+      detail::writePLY(encoded, mesh, PlyEncoding::Binary);
+      const std::string bytes = encoded.str();
+      const std::size_t body = bytes.find("end_header\n") + 11;
+      if (first_) out_ << detail::plyHeaderWithVertices(bytes.substr(0, body), points_);
+      out_.write(bytes.data() + body, static_cast<std::streamsize>(bytes.size() - body));
+    }
+    first_ = false;
+    if (!out_) failSystem("cannot write the output");
+  }
+  void close() {
+    out_.close();
+    if (!out_) failSystem("cannot write the output");
+  }
+
+ private:
+  bool ply_;
+  std::int64_t points_, width_, height_;
+  SensorPose pose_;
+  std::ofstream out_;
+  bool first_ = true;
+};
+
+// The tools' fields for a fit (pcl_ddg_normals: setNormalFields; pcl_ddg_curvature -method
+// quadric: the k1 direction, the normal fields, then mean, Gauss, k1 and k2), applied the way
+// local_fit_job.cpp's outOfCoreFields does for a piece.
+void addFields(Piece& input, const std::string& output, const std::string& tool,
+               const std::vector<float>& records, int floats, FieldPrecision precision) {
+  pcl::PCLPointCloud2& piece = input.cloud;
+  const Eigen::Matrix3Xd& positions = input.positions;
+  const bool declared_double =
+      input.exact_double ||
+      std::any_of(piece.fields.begin(), piece.fields.end(), [](const pcl::PCLPointField& f) {
+        return (f.name == "x" || f.name == "y" || f.name == "z") &&
+               f.datatype == pcl::PCLPointField::FLOAT64;
+      });
+  setVertexCoordinates(piece, positions, FieldPrecision::Float);
+  const auto n = static_cast<Eigen::Index>(positions.cols());
+  Eigen::Matrix3Xd normals(3, n);
+  Eigen::VectorXd curvature(n), k1(n), k2(n);
+  Eigen::Matrix3Xd direction(3, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const float* r = records.data() + i * floats;
+    // As normalsOf: the float normal widened to double.
+    normals.col(i) = Eigen::Vector3f(r[0], r[1], r[2]).cast<double>();
+    curvature[i] = r[3];
+    if (floats == 9) {
+      k1[i] = r[4];
+      k2[i] = r[5];
+      direction.col(i) << r[6], r[7], r[8];
+    }
+  }
+  const auto setNormals = [&] {
+    const char* ply_names[] = {"nx", "ny", "nz"};
+    const char* pcd_names[] = {"normal_x", "normal_y", "normal_z"};
+    const bool pcd_naming = hasVertexField(piece, "normal_x") ? true
+                            : hasVertexField(piece, "nx")     ? false
+                                                              : fileExtension(output) == "pcd" ||
+                                                                fileExtension(output) == "las";
+    for (int d = 0; d < 3; ++d) removeVertexField(piece, pcd_naming ? ply_names[d] : pcd_names[d]);
+    const char** names = pcd_naming ? pcd_names : ply_names;
+    setVertexFields(piece, {names[0], names[1], names[2]}, normals, precision);
+    setVertexField(piece, "curvature", curvature, precision);
+  };
+  if (tool == "curvature") {
+    const char* names[] = {"k1_direction_x", "k1_direction_y", "k1_direction_z"};
+    for (int d = 0; d < 3; ++d)
+      setVertexField(piece, names[d], direction.row(d).transpose(), precision);
+    setNormals();
+    const Eigen::VectorXd mean = 0.5 * (k1 + k2);
+    const Eigen::VectorXd gauss = k1.cwiseProduct(k2);
+    setVertexField(piece, "mean_curvature", mean, precision);
+    setVertexField(piece, "gauss_curvature", gauss, precision);
+    setVertexField(piece, "k1", k1, precision);
+    setVertexField(piece, "k2", k2, precision);
+  } else {
+    setNormals();
+  }
+  const FieldPrecision coordinates =
+      declared_double || precision == FieldPrecision::Double ? FieldPrecision::Double
+                                                             : FieldPrecision::Float;
+  setVertexCoordinates(piece, positions, coordinates);
+}
+
+/**
+ * Writes `output` (binary PLY or PCD): the points of `inputs`, in their order, each with its
+ * fields and the fit's (the results file holds `floats` float32 per point of the concatenated
+ * inputs, from point `first_result` on), as the tool writes the merged cloud. Atomic.
+ */
+std::int64_t writeOutput(const std::vector<std::string>& inputs, const std::string& output,
+                         const std::string& results_path, std::int64_t first_result, int floats,
+                         const std::string& tool, const std::string& precision_name,
+                         std::int64_t piece_points, bool stream_pcd) {
+  const std::string ext = fileExtension(output);
+  if (ext != "ply" && ext != "pcd")
+    throw FileFormatException(output + ": the output must be .ply or .pcd");
+  choice("tool", tool, {"normals", "curvature"});
+  const FieldPrecision precision =
+      choice("precision", precision_name, {"float", "double"}) == "double" ? FieldPrecision::Double
+                                                                           : FieldPrecision::Float;
+  py::gil_scoped_release release;
+  std::int64_t total = 0;
+  std::vector<detail::BinaryCloudLayout> layouts;
+  for (const std::string& input : inputs) {
+    layouts.push_back(Pieces(input).layout());
+    total += layouts.back().points;
+  }
+  if (inputs.empty()) throw pcl::BadArgumentException("no input");
+  const int fd = ::open(results_path.c_str(), O_RDONLY);
+  if (fd < 0) failSystem("cannot open " + results_path);
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  const bool single = inputs.size() == 1;
+  const std::int64_t width = single ? layouts[0].width : total;
+  const std::int64_t height = single ? layouts[0].height : 1;
+  // A PCD as the tool writes it in memory (binary_compressed, which compresses the whole cloud
+  // at once): the pieces are joined and saved by saveMesh. Else streamed (binary PLY, or binary
+  // PCD as -memory writes it).
+  const bool whole = ext == "pcd" && !stream_pcd;
+  std::unique_ptr<AtomicFile> file;
+  std::unique_ptr<OutputPieces> out;
+  pcl::PolygonMesh joined;
+  if (!whole) {
+    file = std::make_unique<AtomicFile>(output);
+    out = std::make_unique<OutputPieces>(file->temporaryPath(), ext == "ply", total, width, height,
+                                         layouts[0].sensor_pose);
+  }
+  std::int64_t at = first_result;
+  std::vector<float> records;
+  for (std::size_t f = 0; f < inputs.size(); ++f) {
+    Pieces pieces(inputs[f]);
+    const std::int64_t points = layouts[f].points;
+    for (std::int64_t first = 0; first < points; first += piece_points) {
+      const std::int64_t count = std::min(piece_points, points - first);
+      Piece input = pieces.read(first, count);
+      pcl::PCLPointCloud2& piece = input.cloud;
+      records.resize(static_cast<std::size_t>(count * floats));
+      const std::size_t bytes = records.size() * sizeof(float);
+      if (::pread(fd, records.data(), bytes, static_cast<off_t>(at * floats * 4)) !=
+          static_cast<ssize_t>(bytes))
+        failSystem("cannot read the results " + results_path);
+      addFields(input, output, tool, records, floats, precision);
+      at += count;
+      if (!whole) {
+        out->write(piece);
+        continue;
+      }
+      if (joined.cloud.data.empty() && joined.cloud.fields.empty()) {
+        joined.cloud = std::move(piece);
+        joined.cloud.data.reserve(static_cast<std::size_t>(total) * joined.cloud.point_step);
+      } else {
+        const auto same = [](const pcl::PCLPointField& a, const pcl::PCLPointField& b) {
+          return a.name == b.name && a.offset == b.offset && a.datatype == b.datatype &&
+                 a.count == b.count;
+        };
+        if (piece.point_step != joined.cloud.point_step ||
+            !std::equal(piece.fields.begin(), piece.fields.end(), joined.cloud.fields.begin(),
+                        joined.cloud.fields.end(), same))
+          throw FileFormatException(inputs[f] + ": its fields differ from the first input's");
+        joined.cloud.data.insert(joined.cloud.data.end(), piece.data.begin(), piece.data.end());
+        joined.cloud.is_dense = joined.cloud.is_dense && piece.is_dense;
+      }
+    }
+  }
+  if (!whole) {
+    out->close();
+    file->commit();
+    return total;
+  }
+  joined.cloud.width = static_cast<std::uint32_t>(width);
+  joined.cloud.height = static_cast<std::uint32_t>(height);
+  joined.cloud.row_step = joined.cloud.point_step * joined.cloud.width;
+  MeshWriteOptions write_options;
+  write_options.sensor_pose = layouts[0].sensor_pose;
+  saveMesh(output, joined, write_options);
+  return total;
+}
+
+}  // namespace
+
+void bindDistributed(py::module_& m) {
+  m.def("_cloud_layout", &cloudLayout, py::arg("path"),
+        "How a binary PCD/PLY cloud lies on disk (header only): points, header_bytes, "
+        "point_bytes, width, height, viewpoint, orientation, fields.");
+  m.def("_read_xyz", &readXYZ, py::arg("path"), py::arg("first"), py::arg("count"),
+        "Points [first, first + count) of a binary PCD/PLY file as float32 (n, 3), read by "
+        "their byte range and converted as the tools convert them.");
+  m.def("_gather_chunk", &gatherChunk, py::arg("path"), py::arg("first"), py::arg("count"),
+        py::arg("lo"), py::arg("hi"), py::arg("origin"), py::arg("size"), py::arg("dims"),
+        py::arg("tile"),
+        "A chunk's points inside the box [lo, hi] and the tile's own (grid cells of the given "
+        "origin, size and dims): (float32 points, positions in the chunk, own mask).");
+  m.def("_fit_tile", &fitTile, py::arg("points"), py::arg("own"), py::arg("method"),
+        py::arg("k"), py::arg("radius"), py::arg("max_nn"), py::arg("viewpoint"),
+        py::arg("orient"), py::arg("up"), py::arg("halo_box"), py::arg("bounds"),
+        py::arg("mode"), py::arg("threads"),
+        "Fits a tile's own points among its gathered points (merged-cloud order); mode "
+        "'certified': only the points whose k-th neighbour is nearer than the halo's edge, "
+        "'all': every own point, 'look': no fit, the looking distances and the mask only.");
+  m.def("_write_output", &writeOutput, py::arg("inputs"), py::arg("output"),
+        py::arg("results"), py::arg("first_result"), py::arg("floats"), py::arg("tool"),
+        py::arg("precision"), py::arg("piece_points") = std::int64_t{1} << 18,
+        py::arg("stream_pcd") = false,
+        "Writes the inputs' points with the fitted fields as the tool writes the merged cloud.");
+}
+
+}  // namespace python
+}  // namespace pcl_ddg

@@ -1,0 +1,316 @@
+"""pcl_ddg.distributed on a LocalCluster of 2 worker processes: a shared scan split into 4 files by
+a grid (written here, in a temporary folder) gives, merged, the bytes pcl_ddg_normals /
+pcl_ddg_curvature write for the merged cloud; batch mode equals the tool per file; a worker
+killed in the middle of a tile, a resumed run, bad inputs, and a worker's peak memory."""
+
+import os
+import signal
+import struct
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import pcl_ddg
+from conftest import run_tool, shared_data
+
+distributed = pytest.importorskip("distributed")
+import pcl_ddg.distributed as dd  # noqa: E402
+
+# Small tiles, so that the 131k-point scan is cut into several tiles (the workers hold about
+# 100M before any point; the tiles get what is left).
+MEMORY = "140M"
+
+
+@pytest.fixture(scope="module")
+def client():
+    c = dd.connect(workers=2)
+    yield c
+    cluster = c.cluster
+    c.close()
+    cluster.close()
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory):
+    """terrain_CSite1 (aerial LiDAR, UTM, duplicate points) cut into 4 binary PLY files by a
+    grid off its median, and their concatenation, the merged cloud."""
+    folder = tmp_path_factory.mktemp("scene")
+    mesh = pcl_ddg.read(shared_data() / "clouds" / "terrain_CSite1_red2-utm.pcd")
+    p = mesh.points[np.isfinite(mesh.points).all(axis=1)]
+    cut = np.median(p[:, :2], axis=0) + 13.0
+    quadrant = (p[:, 0] >= cut[0]).astype(int) * 2 + (p[:, 1] >= cut[1]).astype(int)
+    parts = [p[quadrant == i] for i in range(4)]
+    parts[1][[7, 4000]] = np.nan  # rows without a point: NaN out, as the tool
+    (folder / "tiles").mkdir()
+    paths = []
+    for i, part in enumerate(parts):
+        paths.append(folder / "tiles" / f"part{i}.ply")
+        pcl_ddg.write(paths[-1], part)
+    merged = folder / "merged.ply"
+    pcl_ddg.write(merged, np.concatenate(parts))
+    return paths, merged
+
+
+@pytest.fixture(scope="module")
+def las_scene(tmp_path_factory):
+    """autzen_trim.las (LAS 1.2, format 3, scale 0.01) cut into 4 LAS files by a grid, and their
+    concatenation: the header and VLRs kept, the count set, the records copied byte for byte."""
+    folder = tmp_path_factory.mktemp("las")
+    data = (shared_data() / "las" / "autzen_trim.las").read_bytes()
+    offset, = struct.unpack_from("<I", data, 96)
+    length, = struct.unpack_from("<H", data, 105)
+    count, = struct.unpack_from("<I", data, 107)
+    records = np.frombuffer(data, np.uint8, count * length, offset).reshape(count, length)
+    X = records[:, 0:4].copy().view("<i4").ravel()
+    Y = records[:, 4:8].copy().view("<i4").ravel()
+    quadrant = (X >= np.median(X) + 1300).astype(int) * 2 + (Y >= np.median(Y) + 1300)
+
+    def write(path, part):
+        head = bytearray(data[:offset])
+        struct.pack_into("<I", head, 107, len(part))
+        path.write_bytes(bytes(head) + part.tobytes())
+
+    (folder / "tiles").mkdir()
+    parts = [records[quadrant == i] for i in range(4)]
+    paths = [folder / "tiles" / f"part{i}.las" for i in range(4)]
+    for path, part in zip(paths, parts):
+        write(path, part)
+    write(folder / "merged.las", np.concatenate(parts))
+    return paths, folder / "merged.las"
+
+
+def keywords(args):
+    names = {"-k": "k", "-radius": "radius", "-method": "method", "-max_nn": "max_nn"}
+    out = {}
+    for flag, value in zip(args[::2], args[1::2]):
+        out[names[flag]] = value if flag == "-method" else float(value) if flag == "-radius" \
+            else int(value)
+    return out
+
+
+@pytest.mark.parametrize("args", [["-k", "16"], ["-radius", "2.5"],
+                                  ["-method", "quadric", "-k", "20"],
+                                  ["-method", "quadric", "-radius", "3", "-max_nn", "40"]])
+def test_merged_normals_equal_the_tool_on_the_merged_cloud(tmp_path, client, scene, args):
+    paths, merged = scene
+    expected = tmp_path / "tool.ply"
+    run_tool("pcl_ddg_normals", merged, expected, *args)
+    out = tmp_path / "out"
+    summary = dd.estimate_normals(paths, out, client=client, merge=str(out / "merged.ply"),
+                                  memory_per_worker=MEMORY, **keywords(args))
+    assert summary["tiles"] >= 4 and summary["points"] == 131622
+    assert (out / "merged.ply").read_bytes() == expected.read_bytes()
+
+
+@pytest.mark.parametrize("args,suffix", [(["-k", "16", "-orient", "up"], ".ply"),
+                                         (["-method", "quadric", "-radius", "8"], ".pcd")])
+def test_las_tiles_equal_the_tool_on_the_merged_las(tmp_path, client, las_scene, args, suffix):
+    paths, merged = las_scene
+    expected = tmp_path / ("tool" + suffix)
+    run_tool("pcl_ddg_normals", merged, expected, *args)
+    out = tmp_path / "out"
+    options = keywords([a for a in args if a not in ("-orient", "up")])
+    if "up" in args:
+        options["orient"] = "up"
+    dd.estimate_normals(paths, out, client=client, merge=str(out / ("m" + suffix)),
+                        memory_per_worker=MEMORY, **options)
+    assert (out / ("m" + suffix)).read_bytes() == expected.read_bytes()
+
+
+def test_curvature_pcd_and_per_file_outputs(tmp_path, client, scene):
+    paths, merged = scene
+    expected = tmp_path / "tool.pcd"
+    run_tool("pcl_ddg_curvature", merged, expected, "-method", "quadric", "-k", "20")
+    out = tmp_path / "out"
+    dd.principal_curvatures(paths, out, client=client, merge=str(tmp_path / "merged.pcd"),
+                            memory_per_worker=MEMORY, k=20)
+    assert (tmp_path / "merged.pcd").read_bytes() == expected.read_bytes()
+    # Without --merge: one file per input, its points with the scene's neighbours (the merged
+    # result's rows of that file).
+    summary = dd.estimate_normals(paths, out, client=client, memory_per_worker=MEMORY, k=16)
+    run_tool("pcl_ddg_normals", merged, tmp_path / "tool.ply", "-k", "16", "-precision", "double")
+    whole = pcl_ddg.read(tmp_path / "tool.ply").fields
+    first = 0
+    for path, output in zip(paths, summary["outputs"]):
+        part = pcl_ddg.read(output)
+        n = len(part.points)
+        np.testing.assert_array_equal(part.points, pcl_ddg.read(path).points)
+        for name in ("nx", "ny", "nz", "curvature"):
+            np.testing.assert_array_equal(part.fields[name], whole[name][first:first + n])
+        first += n
+
+
+def test_command_line(tmp_path, scene):
+    paths, merged = scene
+    expected = tmp_path / "tool.ply"
+    run_tool("pcl_ddg_normals", merged, expected, "-k", "12")
+    out = tmp_path / "out"
+    result = subprocess.run(
+        [sys.executable, "-m", "pcl_ddg.distributed", "normals", *map(str, paths), str(out),
+         "-k", "12", "--workers", "2", "--memory-per-worker", MEMORY, "--merge",
+         str(out / "m.ply")], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert "dashboard" in result.stderr and "points/s" in result.stderr
+    assert (out / "m.ply").read_bytes() == expected.read_bytes()
+
+
+def test_batch_equals_the_tool_per_file(tmp_path, client, scene):
+    paths, _ = scene
+    out = tmp_path / "out"
+    summary = dd.batch(str(paths[0].parent / "part[01].ply"), out, "normals",
+                       ["-method", "quadric", "-k", "20"], client=client)
+    assert summary["files_run"] == 2
+    for path in paths[:2]:
+        run_tool("pcl_ddg_normals", path, tmp_path / path.name, "-method", "quadric", "-k", "20")
+        assert (out / path.name).read_bytes() == (tmp_path / path.name).read_bytes()
+    again = dd.batch(str(paths[0].parent / "part[01].ply"), out, "normals",
+                     ["-method", "quadric", "-k", "20"], client=client)
+    assert again["files_run"] == 0 and again["files_skipped"] == 2
+
+
+def test_worker_killed_in_a_tile(tmp_path, scene, monkeypatch):
+    paths, merged = scene
+    expected = tmp_path / "tool.ply"
+    run_tool("pcl_ddg_normals", merged, expected, "-k", "16")
+    monkeypatch.setenv("PCL_DDG_DISTRIBUTED_TILE_DELAY", "1.0")  # tiles long enough to kill
+    own = dd.connect(workers=2)
+    out = tmp_path / "out"
+    attempts = out / dd.STATE_FOLDER / "normals" / "attempts"
+    killed = []
+
+    def killer():
+        deadline = time.time() + 60
+        while time.time() < deadline and not killed:
+            try:
+                names = os.listdir(attempts)
+            except OSError:
+                names = []
+            for name in names:
+                pid = int(name.split(".")[1])
+                os.kill(pid, signal.SIGKILL)  # in the middle of the tile's delay
+                killed.append(pid)
+                break
+            time.sleep(0.02)
+
+    thread = threading.Thread(target=killer)
+    thread.start()
+    try:
+        summary = dd.estimate_normals(paths, out, client=own, merge=str(out / "m.ply"),
+                                      memory_per_worker=MEMORY, k=16, retries=3)
+    finally:
+        thread.join()
+        cluster = own.cluster
+        own.close()
+        cluster.close()
+    assert killed, "no tile was started"
+    print(f"killed worker {killed[0]}: {summary['retries']} retries, {summary['tiles']} tiles")
+    assert summary["retries"] >= 1
+    assert (out / "m.ply").read_bytes() == expected.read_bytes()
+
+
+def test_resume_does_only_the_missing_tiles(tmp_path, client, scene):
+    paths, merged = scene
+    out = tmp_path / "out"
+    first = dd.estimate_normals(paths, out, client=client, merge=str(out / "m.ply"),
+                                memory_per_worker=MEMORY, k=16)
+    state = out / dd.STATE_FOLDER / "normals" / "tiles"
+    tiles = sorted(state.glob("tile_*.bin"))
+    assert len(tiles) == first["tiles"] >= 4
+    # A run stopped after half its tiles: the other half's results are missing, one of them
+    # torn (present, but not what its checksum says).
+    half = tiles[len(tiles) // 2:]
+    for t in half[1:]:
+        t.unlink()
+    half[0].write_bytes(half[0].read_bytes()[:-4])
+    (out / "m.ply").unlink()
+    second = dd.estimate_normals(paths, out, client=client, merge=str(out / "m.ply"),
+                                 memory_per_worker=MEMORY, k=16)
+    assert second["tiles_run"] == len(half)
+    assert second["tiles_skipped"] == len(tiles) - len(half)
+    run_tool("pcl_ddg_normals", merged, tmp_path / "tool.ply", "-k", "16")
+    assert (out / "m.ply").read_bytes() == (tmp_path / "tool.ply").read_bytes()
+
+
+def test_bad_inputs(tmp_path, client, scene):
+    paths, _ = scene
+    with pytest.raises(FileNotFoundError, match="missing.ply"):
+        dd.estimate_normals([paths[0], tmp_path / "missing.ply"], tmp_path / "o", client=client)
+    # Different fields: refused, naming both files.
+    other = tmp_path / "other.ply"
+    pts = pcl_ddg.read(paths[1]).points
+    pcl_ddg.write(other, pts, fields={"intensity": np.ones(len(pts))})
+    with pytest.raises(ValueError, match="incompatible inputs.*other.ply"):
+        dd.estimate_normals([paths[0], other], tmp_path / "o", client=client)
+    # LAS files of different scales.
+    las = shared_data() / "las"
+    with pytest.raises(ValueError, match="scale"):
+        dd.estimate_normals([las / "autzen_trim.las", las / "test1_4.las"], tmp_path / "o",
+                            client=client)
+    with pytest.raises(ValueError, match="incompatible inputs"):
+        dd.estimate_normals([las / "autzen_trim.las", paths[0]], tmp_path / "o", client=client)
+    with pytest.raises(ValueError, match="LAZ"):
+        dd.estimate_normals([las / "simple.laz"], tmp_path / "o", client=client)
+    # The output folder is an input's folder.
+    with pytest.raises(ValueError, match="output folder"):
+        dd.estimate_normals(paths, paths[0].parent, client=client)
+    # A scheduler nobody listens at: a clear error, quickly.
+    start = time.perf_counter()
+    with pytest.raises(dd.DistributedError, match="cannot reach the Dask scheduler"):
+        dd.estimate_normals(paths, tmp_path / "o", scheduler="tcp://127.0.0.1:9")
+    assert time.perf_counter() - start < 10
+
+
+def test_worker_peak_memory_stays_under_the_limit(tmp_path):
+    """A synthetic survey (a height field in flight-line order) of 600k points: fitted at once
+    it takes about 10x the room the limit leaves above a worker's own ~100M."""
+    side = 775
+    u, v = np.meshgrid(np.arange(side, dtype=float), np.arange(side, dtype=float))
+    z = 2.0 * np.sin(u / 40.0) * np.cos(v / 55.0)
+    points = np.stack([u.ravel(), v.ravel() + 0.25 * (u.ravel() % 2), z.ravel()], 1)
+    survey = tmp_path / "in" / "survey.ply"
+    survey.parent.mkdir()
+    pcl_ddg.write(survey, points.astype(np.float32))
+    own = dd.connect(workers=2)
+    try:
+        resident = max(own.run(dd._resident_bytes).values())
+        limit = resident + (24 << 20) + (32 << 20)  # ~24M of tile room above the rounding
+        room = limit - ((resident // (16 << 20) + 2) * (16 << 20))
+        assert len(points) * dd.BYTES_PER_POINT >= 9 * room
+        out = tmp_path / "out"
+        summary = dd.estimate_normals([survey], out, client=own, memory_per_worker=int(limit),
+                                      k=16)
+    finally:
+        cluster = own.cluster
+        own.close()
+        cluster.close()
+    print(f"memory: limit {limit >> 20} MiB, worker peak {summary['worker_peak_bytes'] >> 20} MiB, "
+          f"{summary['tiles']} tiles, largest gather {summary['largest_gather']} points")
+    assert summary["tiles"] >= 8
+    assert 0 < summary["worker_peak_bytes"] <= limit, (summary["worker_peak_bytes"], limit)
+    n = pcl_ddg.read(out / "survey.ply").fields["nz"]
+    assert np.isfinite(n).all() and (np.abs(n) > 0.9).all()
+
+
+def test_starting_a_local_cluster_leaves_the_callers_environment_alone():
+    """Dask's nannies set OMP_NUM_THREADS=1 and the like for their workers in the process that
+    starts them, at every (re)spawn; a tool the caller runs afterwards must not inherit them (it
+    would compute on one thread). The workers still get them."""
+    def environment():  # DASK_PARENT only marks the process for Dask's process titles
+        return {k: v for k, v in os.environ.items() if k != "DASK_PARENT"}
+
+    before = environment()
+    c = dd.connect(workers=1)
+    try:
+        assert environment() == before
+        c.restart()  # the nanny spawns the worker again
+        assert environment() == before
+        assert c.run(lambda: os.environ.get("OMP_NUM_THREADS")) == {
+            address: "1" for address in c.scheduler_info()["workers"]}
+    finally:
+        cluster = c.cluster
+        c.close()
+        cluster.close()

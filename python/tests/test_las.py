@@ -1,0 +1,247 @@
+"""LAS through the module: exact coordinates and fields against an independent reader written
+here from the ASPRS LAS 1.4 R15 tables, read -> write round trips of the records, the LAZ and
+truncated-file refusals, and normals equal to pcl_ddg_normals' on the same file."""
+
+import struct
+
+import numpy as np
+import pytest
+
+import pcl_ddg
+from conftest import run_tool, shared_data
+
+FILES = ["autzen_trim.las", "extrabytes.las", "test1_4.las"]
+
+
+def las_path(name):
+    path = shared_data() / "las" / name
+    if not path.exists():
+        pytest.skip(f"{path} is not in the shared data")
+    return path
+
+
+# --- an independent reader: the specification's header offsets and record tables -------------
+
+
+def header_of(raw: bytes) -> dict:
+    major, minor = raw[24], raw[25]
+    header = {
+        "version": (major, minor),
+        "header_size": struct.unpack_from("<H", raw, 94)[0],
+        "point_offset": struct.unpack_from("<I", raw, 96)[0],
+        "vlr_count": struct.unpack_from("<I", raw, 100)[0],
+        "format": raw[104] & 0x3F,
+        "record_length": struct.unpack_from("<H", raw, 105)[0],
+        "count": struct.unpack_from("<I", raw, 107)[0],
+        "scale": np.frombuffer(raw, "<f8", 3, 131),
+        "offset": np.frombuffer(raw, "<f8", 3, 155),
+    }
+    if (major, minor) >= (1, 4):
+        legacy = header["count"]
+        header["count"] = struct.unpack_from("<Q", raw, 247)[0]
+        assert legacy in (0, header["count"])
+    return header
+
+
+# Per point format: (name, numpy type, byte offset) of the whole-byte fields.
+_COMMON = [("X", "<i4", 0), ("Y", "<i4", 4), ("Z", "<i4", 8), ("intensity", "<u2", 12)]
+_LEGACY = _COMMON + [("bits", "u1", 14), ("class_byte", "u1", 15), ("scan_angle_rank", "i1", 16),
+                     ("user_data", "u1", 17), ("point_source_id", "<u2", 18)]
+_EXTENDED = _COMMON + [("returns", "u1", 14), ("flags", "u1", 15), ("classification", "u1", 16),
+                       ("user_data", "u1", 17), ("scan_angle", "<i2", 18),
+                       ("point_source_id", "<u2", 20), ("gps_time", "<f8", 22)]
+_RGB = [("red", "<u2", 0), ("green", "<u2", 2), ("blue", "<u2", 4)]
+LAYOUTS = {
+    0: _LEGACY,
+    1: _LEGACY + [("gps_time", "<f8", 20)],
+    2: _LEGACY + [(n, t, 20 + o) for n, t, o in _RGB],
+    3: _LEGACY + [("gps_time", "<f8", 20)] + [(n, t, 28 + o) for n, t, o in _RGB],
+    6: _EXTENDED,
+    7: _EXTENDED + [(n, t, 30 + o) for n, t, o in _RGB],
+}
+
+
+def records_of(raw: bytes, header: dict) -> np.ndarray:
+    fields = LAYOUTS[header["format"]]
+    dtype = np.dtype({"names": [f[0] for f in fields], "formats": [f[1] for f in fields],
+                      "offsets": [f[2] for f in fields], "itemsize": header["record_length"]})
+    return np.frombuffer(raw, dtype, header["count"], header["point_offset"])
+
+
+def record_block(raw: bytes) -> bytes:
+    h = header_of(raw)
+    start = h["point_offset"]
+    return raw[start:start + h["count"] * h["record_length"]]
+
+
+def expected_fields(records: np.ndarray, point_format: int) -> dict:
+    r = records
+    if point_format < 6:
+        return {
+            "return_number": r["bits"] & 7, "number_of_returns": (r["bits"] >> 3) & 7,
+            "scan_direction_flag": (r["bits"] >> 6) & 1, "edge_of_flight_line": r["bits"] >> 7,
+            "classification": r["class_byte"] & 31, "classification_flags": r["class_byte"] >> 5,
+            "scan_angle_rank": r["scan_angle_rank"],
+        }
+    return {
+        "return_number": r["returns"] & 15, "number_of_returns": r["returns"] >> 4,
+        "classification_flags": r["flags"] & 15, "scanner_channel": (r["flags"] >> 4) & 3,
+        "scan_direction_flag": (r["flags"] >> 6) & 1, "edge_of_flight_line": r["flags"] >> 7,
+        "classification": r["classification"], "scan_angle": r["scan_angle"],
+    }
+
+
+# --- tests -------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", FILES)
+def test_coordinates_and_fields_equal_the_specification(name):
+    path = las_path(name)
+    raw = path.read_bytes()
+    header = header_of(raw)
+    records = records_of(raw, header)
+    m = pcl_ddg.read(path)
+
+    assert m.las is not None
+    assert m.las.version == header["version"]
+    assert m.las.point_format == header["format"]
+    assert m.las.record_length == header["record_length"]
+    assert m.las.scale == tuple(header["scale"]) and m.las.offset == tuple(header["offset"])
+    assert len(m.las.vlrs) == header["vlr_count"]
+    assert m.precision == "double" and m.points.dtype == np.float64
+
+    integers = np.stack([records["X"], records["Y"], records["Z"]], axis=1).astype(np.float64)
+    expected = integers * header["scale"] + header["offset"]  # X * scale + offset, in double
+    assert m.points.shape == (header["count"], 3)
+    np.testing.assert_array_equal(m.points, expected)
+
+    for field in ("intensity", "user_data", "point_source_id", "gps_time", "red", "green",
+                  "blue"):
+        if field in records.dtype.names:
+            np.testing.assert_array_equal(m.fields[field], records[field], err_msg=field)
+            assert m.fields[field].dtype == records.dtype[field].newbyteorder("=")
+    for field, values in expected_fields(records, header["format"]).items():
+        np.testing.assert_array_equal(m.fields[field], values, err_msg=field)
+
+
+def test_extra_bytes_dimensions():
+    path = las_path("extrabytes.las")
+    raw = path.read_bytes()
+    header = header_of(raw)
+    m = pcl_ddg.read(path)
+    base = 34  # format 3
+    assert header["record_length"] == 61
+    # Colors (3 x uint16), Reserved (7 bytes), Flags (2 x int8), Intensity (uint32), Time (uint64)
+    layout = [("Colors", "<u2", (3,), 0), ("Reserved", "u1", (7,), 6), ("Flags", "i1", (2,), 13),
+              ("Intensity", "<u4", (), 15), ("Time", "<u8", (), 19)]
+    dtype = np.dtype({"names": [f[0] for f in layout],
+                      "formats": [(f[1], f[2]) if f[2] else f[1] for f in layout],
+                      "offsets": [base + f[3] for f in layout], "itemsize": 61})
+    extra = np.frombuffer(raw, dtype, header["count"], header["point_offset"])
+    for name, *_ in layout:
+        np.testing.assert_array_equal(m.fields[name], extra[name], err_msg=name)
+    assert [d[0] for d in m.las.extra_bytes] == [f[0] for f in layout]
+    assert all(len(d[1]) == 192 for d in m.las.extra_bytes)
+
+
+@pytest.mark.parametrize("name", FILES)
+def test_read_write_read_keeps_records_and_vlrs(name, tmp_path):
+    path = las_path(name)
+    raw = path.read_bytes()
+    m = pcl_ddg.read(path)
+    out = tmp_path / name
+    pcl_ddg.write(out, m.points, fields=m.fields, las=m.las)
+    written = out.read_bytes()
+    assert header_of(written)["format"] == header_of(raw)["format"]
+    assert header_of(written)["record_length"] == header_of(raw)["record_length"]
+    assert record_block(written) == record_block(raw)  # every record, bit for bit
+
+    again = pcl_ddg.read(out)
+    assert again.las.version == m.las.version and again.las.point_format == m.las.point_format
+    assert again.las.scale == m.las.scale and again.las.offset == m.las.offset
+    assert again.las.vlrs == m.las.vlrs and again.las.evlrs == m.las.evlrs
+    np.testing.assert_array_equal(again.points, m.points)
+    assert list(again.fields) == list(m.fields)
+    for key, values in m.fields.items():
+        assert again.fields[key].dtype == values.dtype, key
+        np.testing.assert_array_equal(again.fields[key], values, err_msg=key)
+
+    # ... and once more: the rewritten file rewrites to the same records
+    out2 = tmp_path / ("again_" + name)
+    pcl_ddg.write(out2, again.points, fields=again.fields, las=again.las)
+    assert record_block(out2.read_bytes()) == record_block(raw)
+
+
+def test_new_file_and_normals_as_extra_bytes(tmp_path):
+    m = pcl_ddg.read(las_path("test1_4.las"))
+    n = pcl_ddg.estimate_normals(m.points, k=16)
+    out = tmp_path / "normals.las"
+    fields = dict(m.fields, normals=n.normals, curvature=n.curvature)
+    pcl_ddg.write(out, m.points, fields=fields, las=m.las)
+    back = pcl_ddg.read(out)
+    assert record_block(out.read_bytes())[:30] == record_block(las_path("test1_4.las").read_bytes())[:30]
+    # NormalX NormalY NormalZ Curvature in the file (PDAL's names); normal_x ... in the cloud
+    assert [d[0] for d in back.las.extra_bytes] == ["normal_x", "normal_y", "normal_z", "curvature"]
+    assert [d[1][4:13] for d in back.las.extra_bytes[:3]] == [b"NormalX\0\0", b"NormalY\0\0",
+                                                              b"NormalZ\0\0"]
+    got = np.stack([back.fields["normal_x"], back.fields["normal_y"], back.fields["normal_z"]], 1)
+    assert got.dtype == n.normals.dtype
+    assert np.array_equal(got, n.normals, equal_nan=True)
+    assert np.array_equal(back.fields["curvature"], n.curvature, equal_nan=True)
+
+    # Without a layout: LAS 1.4 format 6, exact enough coordinates, the fields kept.
+    fresh = tmp_path / "fresh.las"
+    pcl_ddg.write(fresh, m.points, fields={"intensity": m.fields["intensity"]})
+    f = pcl_ddg.read(fresh)
+    assert f.las.version == (1, 4) and f.las.point_format == 6
+    np.testing.assert_array_equal(f.fields["intensity"], m.fields["intensity"])
+    np.testing.assert_allclose(f.points, m.points, rtol=0, atol=np.max(f.las.scale))
+
+
+def test_normals_equal_the_tool(tmp_path):
+    path = las_path("autzen_trim.las")
+    out = tmp_path / "tool.las"
+    run_tool("pcl_ddg_normals", path, out, "-k", "16")
+    tool = pcl_ddg.read(out)
+    m = pcl_ddg.read(path)
+    np.testing.assert_array_equal(tool.points, m.points)
+    n = pcl_ddg.estimate_normals(m.points, k=16)
+    got = np.stack([tool.fields["normal_x"], tool.fields["normal_y"], tool.fields["normal_z"]], 1)
+    assert [d[1][4:13] for d in tool.las.extra_bytes[:3]] == [b"NormalX\0\0", b"NormalY\0\0",
+                                                              b"NormalZ\0\0"]
+    assert got.dtype == np.float32
+    mine = n.normals.astype(np.float32)
+    assert np.array_equal(got, mine, equal_nan=True)  # bit for bit
+    assert np.array_equal(tool.fields["curvature"], n.curvature.astype(np.float32), equal_nan=True)
+    # the input's records are the output's, the normals appended as Extra Bytes
+    assert tool.las.point_format == m.las.point_format
+    for key, values in m.fields.items():
+        np.testing.assert_array_equal(tool.fields[key], values, err_msg=key)
+
+
+def test_truncated_file_is_refused():
+    path = las_path("1.2-with-color-clipped.las")
+    with pytest.raises((OSError, ValueError)) as error:
+        pcl_ddg.read(path)
+    message = str(error.value)
+    assert "1.2-with-color-clipped.las" in message
+    assert "1065" in message.replace(",", "") or "1064" in message.replace(",", ""), message
+
+
+def test_laz_is_refused_with_the_decompress_hint():
+    path = las_path("simple.laz")
+    with pytest.raises((OSError, ValueError)) as error:
+        pcl_ddg.read(path)
+    message = str(error.value)
+    assert "LAZ" in message and "laszip -i in.laz -o out.las" in message, message
+    assert "pdal translate" in message, message
+
+
+def test_bad_fields_are_refused(tmp_path):
+    m = pcl_ddg.read(las_path("test1_4.las"))
+    with pytest.raises(ValueError, match="one row per point"):
+        pcl_ddg.write(tmp_path / "x.las", m.points, fields={"intensity": np.zeros(3, np.uint16)})
+    with pytest.raises(ValueError, match="numbers"):
+        pcl_ddg.write(tmp_path / "x.las", m.points,
+                      fields={"name": np.array(["a"] * len(m.points))})
+    assert not (tmp_path / "x.las").exists()
