@@ -97,8 +97,8 @@ class Pieces {
     if (first < 0 || count < 0 || first + count > layout_.points)
       throw pcl::BadArgumentException(path_ + ": points " + std::to_string(first) + ".." +
                                       std::to_string(first + count) + " are not in the file");
-    std::string file = ext_ == "las" ? lasHeaderFor(count)
-                                     : layout_.header_for(layout_.header, count);
+    std::string file =
+        ext_ == "las" ? lasHeaderFor(count) : layout_.header_for(layout_.header, count);
     const std::size_t header = file.size();
     file.resize(header + static_cast<std::size_t>(count * layout_.point_bytes));
     in_.seekg(layout_.header_bytes + first * layout_.point_bytes);
@@ -129,8 +129,9 @@ class Pieces {
     if (in_.gcount() < 227 || head.compare(0, 4, "LASF") != 0)
       throw FileFormatException(path_ + ": not a LAS file (no LASF signature)");
     if ((static_cast<std::uint8_t>(head[104]) & 0xC0) != 0)
-      throw FileFormatException(path_ + ": LAZ (compressed LAS) is not supported: decompress it "
-                                        "first (laszip -i in.laz -o out.las)");
+      throw FileFormatException(path_ +
+                                ": LAZ (compressed LAS) is not supported: decompress it "
+                                "first (laszip -i in.laz -o out.las)");
     las_minor_ = static_cast<std::uint8_t>(head[25]);
     const auto point_offset = getLE<std::uint32_t>(head, 96);
     layout_.header_bytes = point_offset;
@@ -202,8 +203,8 @@ py::dict cloudLayout(const std::string& path) {
 // Points [first, first + count) of a binary PCD/PLY file as PCL's float points (the tools' toXYZ:
 // exact coordinates, then float); NaN rows stay.
 py::array_t<float> readXYZ(const std::string& path, std::int64_t first, std::int64_t count) {
-  py::array_t<float> out({static_cast<py::ssize_t>(std::max<std::int64_t>(count, 0)),
-                          py::ssize_t{3}});
+  py::array_t<float> out(
+      {static_cast<py::ssize_t>(std::max<std::int64_t>(count, 0)), py::ssize_t{3}});
   float* data = out.mutable_data();
   {
     py::gil_scoped_release release;
@@ -248,8 +249,7 @@ py::tuple gatherChunk(const std::string& path, std::int64_t first, std::int64_t 
         std::int64_t cell[3];
         for (int d = 0; d < 3; ++d) {
           const double c = std::floor((v[d] - origin[d]) / size[d]);
-          cell[d] = static_cast<std::int64_t>(
-              std::clamp(c, 0.0, static_cast<double>(dims[d] - 1)));
+          cell[d] = static_cast<std::int64_t>(std::clamp(c, 0.0, static_cast<double>(dims[d] - 1)));
         }
         mine = (cell[0] * dims[1] + cell[1]) * dims[2] + cell[2] == tile;
       }
@@ -327,16 +327,18 @@ class CellCounts {
     }
     for (std::size_t x = 1; x < sx; ++x)
       for (std::size_t y = 0; y < sy; ++y)
-        for (std::size_t z = 0; z < sz; ++z) sums_[x * stride_x_ + y * stride_y_ + z] +=
+        for (std::size_t z = 0; z < sz; ++z)
+          sums_[x * stride_x_ + y * stride_y_ + z] +=
               sums_[(x - 1) * stride_x_ + y * stride_y_ + z];
     for (std::size_t x = 0; x < sx; ++x)
       for (std::size_t y = 1; y < sy; ++y)
-        for (std::size_t z = 0; z < sz; ++z) sums_[x * stride_x_ + y * stride_y_ + z] +=
+        for (std::size_t z = 0; z < sz; ++z)
+          sums_[x * stride_x_ + y * stride_y_ + z] +=
               sums_[x * stride_x_ + (y - 1) * stride_y_ + z];
     for (std::size_t x = 0; x < sx; ++x)
       for (std::size_t y = 0; y < sy; ++y)
-        for (std::size_t z = 1; z < sz; ++z) sums_[x * stride_x_ + y * stride_y_ + z] +=
-              sums_[x * stride_x_ + y * stride_y_ + z - 1];
+        for (std::size_t z = 1; z < sz; ++z)
+          sums_[x * stride_x_ + y * stride_y_ + z] += sums_[x * stride_x_ + y * stride_y_ + z - 1];
     ready_ = true;
   }
 
@@ -387,8 +389,8 @@ class CellCounts {
 
 /**
  * Fits the `own` points of a gathered tile (points in the merged cloud's order, so that the
- * kd-tree's ties break as on the whole cloud). mode "certified": a point is fitted only when its k-th
- * neighbour among the gathered points (widened by the rounding margin) is nearer than the halo
+ * kd-tree's ties break as on the whole cloud). mode "certified": a point is fitted only when its
+ * k-th neighbour among the gathered points (widened by the rounding margin) is nearer than the halo
  * box's edge (`reach`); the others come back uncertified, with how far they look, for a wider
  * gather ("look": the same without fitting; "all": every own point is fitted). Radius searches
  * are certified by a halo of the radius, so the check applies to k only.
@@ -484,10 +486,10 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
           if (!searched[j]) continue;
           const pcl::PointXYZ& q = (*cloud)[static_cast<std::size_t>(own_at[j])];
           const int found = search.nearestKSearch(q, k, neighbours, squared);
-          look[j] = found < k ? std::numeric_limits<double>::infinity()
-                              : std::sqrt(static_cast<double>(squared.back())) *
-                                        (1.0 + kRoundingMargin) +
-                                    1e-30;
+          look[j] = found < k
+                        ? std::numeric_limits<double>::infinity()
+                        : std::sqrt(static_cast<double>(squared.back())) * (1.0 + kRoundingMargin) +
+                              1e-30;
           ok[j] = look[j] <= reach_of[j];
         }
       }
@@ -531,7 +533,11 @@ class OutputPieces {
  public:
   OutputPieces(const std::string& path, bool ply, std::int64_t points, std::int64_t width,
                std::int64_t height, const SensorPose& pose)
-      : ply_(ply), points_(points), width_(width), height_(height), pose_(pose),
+      : ply_(ply),
+        points_(points),
+        width_(width),
+        height_(height),
+        pose_(pose),
         out_(path, std::ios::binary) {
     if (!out_) failSystem("cannot write " + path);
   }
@@ -604,9 +610,9 @@ void addFields(Piece& input, const std::string& output, const std::string& tool,
     const char* ply_names[] = {"nx", "ny", "nz"};
     const char* pcd_names[] = {"normal_x", "normal_y", "normal_z"};
     const bool pcd_naming = hasVertexField(piece, "normal_x") ? true
-                            : hasVertexField(piece, "nx")     ? false
-                                                              : fileExtension(output) == "pcd" ||
-                                                                fileExtension(output) == "las";
+                            : hasVertexField(piece, "nx")
+                                ? false
+                                : fileExtension(output) == "pcd" || fileExtension(output) == "las";
     for (int d = 0; d < 3; ++d) removeVertexField(piece, pcd_naming ? ply_names[d] : pcd_names[d]);
     const char** names = pcd_naming ? pcd_names : ply_names;
     setVertexFields(piece, {names[0], names[1], names[2]}, normals, precision);
@@ -626,9 +632,9 @@ void addFields(Piece& input, const std::string& output, const std::string& tool,
   } else {
     setNormals();
   }
-  const FieldPrecision coordinates =
-      declared_double || precision == FieldPrecision::Double ? FieldPrecision::Double
-                                                             : FieldPrecision::Float;
+  const FieldPrecision coordinates = declared_double || precision == FieldPrecision::Double
+                                         ? FieldPrecision::Double
+                                         : FieldPrecision::Float;
   setVertexCoordinates(piece, positions, coordinates);
 }
 
@@ -742,17 +748,15 @@ void bindDistributed(py::module_& m) {
         py::arg("tile"),
         "A chunk's points inside the box [lo, hi] and the tile's own (grid cells of the given "
         "origin, size and dims): (float32 points, positions in the chunk, own mask).");
-  m.def("_fit_tile", &fitTile, py::arg("points"), py::arg("own"), py::arg("method"),
-        py::arg("k"), py::arg("radius"), py::arg("max_nn"), py::arg("viewpoint"),
-        py::arg("orient"), py::arg("up"), py::arg("halo_box"), py::arg("bounds"),
-        py::arg("mode"), py::arg("threads"),
+  m.def("_fit_tile", &fitTile, py::arg("points"), py::arg("own"), py::arg("method"), py::arg("k"),
+        py::arg("radius"), py::arg("max_nn"), py::arg("viewpoint"), py::arg("orient"),
+        py::arg("up"), py::arg("halo_box"), py::arg("bounds"), py::arg("mode"), py::arg("threads"),
         "Fits a tile's own points among its gathered points (merged-cloud order); mode "
         "'certified': only the points whose k-th neighbour is nearer than the halo's edge, "
         "'all': every own point, 'look': no fit, the looking distances and the mask only.");
-  m.def("_write_output", &writeOutput, py::arg("inputs"), py::arg("output"),
-        py::arg("results"), py::arg("first_result"), py::arg("floats"), py::arg("tool"),
-        py::arg("precision"), py::arg("piece_points") = std::int64_t{1} << 18,
-        py::arg("stream_pcd") = false,
+  m.def("_write_output", &writeOutput, py::arg("inputs"), py::arg("output"), py::arg("results"),
+        py::arg("first_result"), py::arg("floats"), py::arg("tool"), py::arg("precision"),
+        py::arg("piece_points") = std::int64_t{1} << 18, py::arg("stream_pcd") = false,
         "Writes the inputs' points with the fitted fields as the tool writes the merged cloud.");
 }
 
