@@ -19,7 +19,7 @@
 #include <memory>
 
 #include "bench_support.h"
-#include "common/local_fit_job.h"
+#include "common/tool_input.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "viewer/viewer_window.h"
 
@@ -70,7 +70,7 @@ Session& meshSession() {
   static Session session = [] {
     Session s;
     const std::string& path = torusFile(true);
-    s.model = std::make_unique<viewer::ViewerModel>(tools::loadSurfaceInput(path, "bench"), path);
+    s.model = std::make_unique<viewer::ViewerModel>(tools::ToolInput(path, "bench"), path);
     s.window = std::make_unique<viewer::ViewerWindow>(*s.model, 1024, 768);
     s.window->runUntilIdle(600.0);
     return s;
@@ -142,7 +142,7 @@ BENCHMARK(pcaNewK)->Name("ours/pca_new_k")->Unit(benchmark::kMillisecond)->Itera
 void firstFrame(benchmark::State& state) {
   const std::string& path = torusFile(false);
   for (auto _ : state) {
-    viewer::ViewerModel model(tools::loadSurfaceInput(path, "bench"), path);
+    viewer::ViewerModel model(tools::ToolInput(path, "bench"), path);
     viewer::ViewerWindow window(model, 1024, 768);
     if (!window.runUntilIdle(600.0)) throw std::runtime_error("timed out");
   }

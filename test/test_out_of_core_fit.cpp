@@ -69,6 +69,10 @@ TEST_F(OutOfCore, EverySharedCloudGivesTheInMemoryOutputByteForByte) {
   expectSameOutput(path("in.ply"), "-method quadric -k 20", "4M", PCL_DDG_CURVATURE_TOOL);
   saveMesh(path("room.ply"), loadMesh(sharedData("clouds/tutorials_room_scan1.pcd")));
   expectSameOutput(path("room.ply"), "-radius 0.05 -max_nn 32", "3M");
+  // LAS: X * scale + offset in double, written as double coordinates, from pieces of the records.
+  expectSameOutput(sharedData("las/autzen_trim.las"), "-k 16", "4M");
+  expectSameOutput(sharedData("las/test1_4.las"), "-method quadric -k 12", "2M",
+                   PCL_DDG_CURVATURE_TOOL);
   expectNoScratchLeft();
 }
 
@@ -98,7 +102,8 @@ TEST_F(OutOfCore, InputsThatCannotBeReadInPiecesAndBadOptionsAreRefused) {
       {sharedData("clouds/rs1.pcd"), "only an uncompressed binary PCD"},
       {sharedData("clouds/bun0.pcd"), "only an uncompressed binary PCD"},
       {sharedData("meshes/horse.ply"), "only a cloud"},
-      {sharedData("meshes/cow.off"), "only .pcd and .ply"},
+      {sharedData("meshes/cow.off"), "clouds are read in pieces"},
+      {sharedData("las/simple.laz"), "LAZ (compressed LAS) is not supported"},
   };
   for (const auto& [input, message] : refused) {
     const ToolRun run = runTool(normals, input + " " + path("out.ply") + " -memory 64M");

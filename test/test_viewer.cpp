@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "analytic_surfaces.h"
-#include "common/local_fit_job.h"
+#include "common/tool_input.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "test_data.h"
 #include "tool_runner.h"
@@ -114,7 +114,7 @@ class Viewer : public ::testing::Test {
     dir_ = scratchFolder(::testing::UnitTest::GetInstance()->current_test_info()->name());
   }
   std::unique_ptr<ViewerModel> open(const std::string& path) {
-    return std::make_unique<ViewerModel>(tools::loadSurfaceInput(path, "test_viewer"), path);
+    return std::make_unique<ViewerModel>(tools::ToolInput(path, "test_viewer"), path);
   }
   Image screenshot(ViewerWindow& window, const std::string& name) {
     EXPECT_TRUE(window.runUntilIdle(120.0));

@@ -3,9 +3,9 @@
 // neighbour sets differ, per point.
 #include <cstdio>
 
-#include "common/local_fit_job.h"
-#include "common/mesh_job.h"
+#include "common/fit_steps.h"
 #include "common/tool_common.h"
+#include "common/tool_output.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/render/color_map.h"
@@ -38,8 +38,8 @@ int run(int argc, char** argv) {
   tools::checkLocalFitArguments(args);
   return tools::forEachInput(
       args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
-        tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
-        const bool organized = !in.topology && in.points->height > 1;
+        tools::ToolInput in(input, kName);
+        const bool organized = !in.topology && in.points()->height > 1;
         if (!in.topology && !organized)
           throw std::runtime_error(input +
                                    " has no faces and no pixel grid: no topological "
@@ -52,9 +52,9 @@ int run(int argc, char** argv) {
                            (organized ? "the pixel grid" : "mesh rings") + " and from a kd-tree");
         const NeighbourhoodComparison c = [&] {
           const tools::QuietPCLWarnings quiet;
-          return compareNeighbourhoods(in.points, in.topology, options);
+          return compareNeighbourhoods(in.points(), in.topology, options);
         }();
-        timer.done(in.points->size());
+        timer.done(in.points()->size());
         tools::warnAboutLocalFit(kName, c.topological);
         tools::warnAboutLocalFit(kName, c.kd_tree);
         const NeighbourhoodComparison::Summary& s = c.summary;

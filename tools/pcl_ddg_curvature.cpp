@@ -1,9 +1,10 @@
 // pcl_ddg_curvature: curvatures of a mesh (discrete: cotangent Laplacian and angle defect) or of a
 // mesh or point cloud (fitted: a quadric through each point's neighbours), as vertex properties
 // and optionally as colours.
-#include "common/local_fit_job.h"
-#include "common/mesh_job.h"
+#include "common/fit_steps.h"
+#include "common/operator_options.h"
 #include "common/tool_common.h"
+#include "common/tool_output.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/operators/curvature.h"
@@ -110,7 +111,7 @@ int run(int argc, char** argv) {
 
   return tools::forEachInput(
       args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
-        tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
+        tools::ToolInput in(input, kName);
         const std::string method =
             !requested.empty() ? requested : (in.topology ? "cotan" : "quadric");
         CurvatureFields curvatures;
@@ -144,9 +145,9 @@ int run(int argc, char** argv) {
           tools::Timer timer("Fitting quadrics");
           LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
-            return fitLocalSurfaces(in.points, in.topology, options);
+            return fitLocalSurfaces(in.points(), in.topology, options);
           }();
-          timer.done(in.points->size());
+          timer.done(in.points()->size());
           result.failed_points -= left_out;  // -classes: not fitted by request
           tools::warnAboutLocalFit(kName, result);
           tools::warnAboutRadius(kName, sampling, options, result);
@@ -155,7 +156,7 @@ int run(int argc, char** argv) {
         if (args.has("smooth")) {
           if (!in.topology)
             throw tools::UsageError("-smooth needs a mesh; this input is a point cloud");
-          const double h = meanEdgeLength(*in.topology, in.positions);
+          const double h = in.spacing();
           if (!(h > 0.0)) {
             throw std::runtime_error(
                 "-smooth: the mesh has no edge of positive length to measure the "

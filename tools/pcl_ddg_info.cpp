@@ -5,8 +5,9 @@
 #include <map>
 #include <sstream>
 
-#include "common/local_fit_job.h"
+#include "common/fit_steps.h"
 #include "common/tool_common.h"
+#include "common/tool_input.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/cloud_report.h"
 #include "pcl_ddg/mesh/mesh_report.h"

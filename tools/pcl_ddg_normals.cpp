@@ -1,8 +1,8 @@
 // pcl_ddg_normals: per-vertex normals of a mesh (face-weighted or mean-curvature), or of a mesh or
 // point cloud by a plane (pca) or quadric fit to each point's neighbours.
-#include "common/local_fit_job.h"
-#include "common/mesh_job.h"
+#include "common/fit_steps.h"
 #include "common/tool_common.h"
+#include "common/tool_output.h"
 #include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/ring_surface_variation.h"
 #include "pcl_ddg/io/mesh_io.h"
@@ -150,7 +150,7 @@ int run(int argc, char** argv) {
   return tools::forEachInput(
       args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
         if (args.has("normal_map")) tools::checkOutputFile(*args.value("normal_map"), {input});
-        tools::SurfaceInput in = tools::loadSurfaceInput(input, kName);
+        tools::ToolInput in(input, kName);
         if (orient == "mesh" && !in.topology)
           throw tools::UsageError("-orient mesh needs a mesh; this input is a point cloud");
         const std::string method =
@@ -196,7 +196,7 @@ int run(int argc, char** argv) {
                                                       : NormalOrientation::MeshFaces;
           // An organized frame has one sensor: it decides the tree's signs (unless -up does).
           options.seed_facing_viewpoint =
-              !args.has("up") && (args.has("viewpoint") || in.points->height > 1);
+              !args.has("up") && (args.has("viewpoint") || in.points()->height > 1);
           const std::int64_t left_out = tools::keepOnlyClasses(kName, args, in);
           const tools::SamplingCheck sampling = tools::checkSampling(kName, in, options);
           tools::Timer timer("Computing " + method + " normals (" +
@@ -204,9 +204,9 @@ int run(int argc, char** argv) {
                              (orient == "mst" ? ", oriented along a spanning tree)" : ")"));
           LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
-            return fitLocalSurfaces(in.points, in.topology, options);
+            return fitLocalSurfaces(in.points(), in.topology, options);
           }();
-          timer.done(in.points->size());
+          timer.done(in.points()->size());
           result.failed_points -= left_out;  // -classes: not fitted by request
           tools::warnAboutLocalFit(kName, result);
           tools::warnAboutRadius(kName, sampling, options, result);

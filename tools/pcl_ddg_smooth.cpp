@@ -5,8 +5,10 @@
 #include <cmath>
 #include <iostream>
 
-#include "common/mesh_job.h"
+#include "common/operator_options.h"
 #include "common/tool_common.h"
+#include "common/tool_input.h"
+#include "common/tool_output.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
@@ -70,11 +72,12 @@ int run(int argc, char** argv) {
 
   return tools::forEachInput(
       args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
-        tools::SurfaceMesh in = tools::loadSurfaceMesh(input, kName);
-        const double h = meanEdgeLength(in.topology, in.positions);
+        tools::ToolInput in(input, kName, tools::InputKind::Mesh);
+        const double h = in.spacing();
         if (!(h > 0.0)) throw std::runtime_error("the mesh has no edge of positive length");
         if (p.scheme == SmoothingScheme::Explicit) {
-          const double bound = explicitStabilityLimit(in.topology, in.positions, p.weights, p.mass);
+          const double bound =
+              explicitStabilityLimit(*in.topology, in.positions, p.weights, p.mass);
           p.time_step = args.has("lambda_dt")
                             ? (args.has("absolute_time") ? lambda_dt : lambda_dt * h * h)
                             : 0.5 * bound;
@@ -102,7 +105,7 @@ int run(int argc, char** argv) {
         MeshSmoothingReport report;
         const Eigen::Matrix3Xd smoothed = [&] {
           try {
-            return smoothMeshPositions(in.topology, in.positions, p, &report,
+            return smoothMeshPositions(*in.topology, in.positions, p, &report,
                                        [&](int done, int total) { progress.update(done, total); });
           } catch (const SurfaceCollapseException& e) {
             throw std::runtime_error(errorDescription(e) + ": use a smaller -lambda_dt (" +
@@ -121,7 +124,7 @@ int run(int argc, char** argv) {
             std::cerr << toString(report.solver) << "\n";
           }
         }
-        if (report.fixed_vertices == in.topology.numVertices()) {
+        if (report.fixed_vertices == in.topology->numVertices()) {
           tools::warn(kName,
                       "no vertex is free to move (all on the fixed boundary or without area): "
                       "the output equals the input");
@@ -150,7 +153,7 @@ int run(int argc, char** argv) {
                        : ")"));
         }
         const double area_loss = 1.0 - report.area_after / report.area_before;
-        if (p.boundary == BoundaryCondition::Free && in.topology.counts().boundary_edges > 0 &&
+        if (p.boundary == BoundaryCondition::Free && in.topology->counts().boundary_edges > 0 &&
             area_loss > 0.01) {
           tools::warn(kName, "the free boundary of this open mesh shrank its area by " +
                                  std::to_string(static_cast<int>(100.0 * area_loss + 0.5)) +

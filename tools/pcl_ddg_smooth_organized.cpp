@@ -7,8 +7,9 @@
 
 #include <string>
 
-#include "common/mesh_job.h"
+#include "common/operator_options.h"
 #include "common/tool_common.h"
+#include "common/tool_output.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/surface/grid_smoothing.h"

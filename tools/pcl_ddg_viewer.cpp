@@ -5,8 +5,8 @@
 #include <iostream>
 #include <sstream>
 
-#include "common/local_fit_job.h"
 #include "common/tool_common.h"
+#include "common/tool_input.h"
 #include "viewer/viewer_window.h"
 
 namespace {
@@ -69,7 +69,7 @@ int run(int argc, char** argv) {
     throw std::runtime_error(problem);
   }
 
-  viewer::ViewerModel model(tools::loadSurfaceInput(args.positional().front(), kName),
+  viewer::ViewerModel model(tools::ToolInput(args.positional().front(), kName),
                             args.positional().front());
   // -do actions are checked before the window opens, so that a typo is the tool's error line.
   viewer::ViewerState check = viewer::initialState(model.capabilities());

@@ -17,11 +17,11 @@
 #include <limits>
 #include <sstream>
 
-#include "../../src/io/formats.h"  // the binary layouts and writers of the out-of-core path
 #include "binding_common.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/io/atomic_file.h"
+#include "pcl_ddg/io/cloud_pieces.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -38,149 +38,13 @@ constexpr double kRoundingMargin = 1e-5;
   throw FileFormatException(what + ": " + std::strerror(errno));
 }
 
-// A piece of an input: its records parsed as the whole file is (so every value converts exactly as
-// it does in memory), and its points' exact coordinates.
-struct Piece {
-  pcl::PCLPointCloud2 cloud;
-  Eigen::Matrix3Xd positions;
-  bool exact_double = false;  ///< LAS: X * scale + offset, written as doubles (as the tools do)
-};
-
-template <typename T>
-void putLE(std::string& bytes, std::size_t at, T value) {
-  std::memcpy(bytes.data() + at, &value, sizeof(T));
-}
-template <typename T>
-T getLE(const std::string& bytes, std::size_t at) {
-  T value;
-  std::memcpy(&value, bytes.data() + at, sizeof(T));
-  return value;
-}
-
-// An input read a piece at a time: out_of_core_fit.cpp's CloudPieces for binary PCD and PLY, and
-// for LAS the header and VLRs with the piece's count, before the piece's records.
-class Pieces {
- public:
-  explicit Pieces(const std::string& path) : path_(path), ext_(fileExtension(path)) {
-    if (ext_ != "pcd" && ext_ != "ply" && ext_ != "las")
-      throw FileFormatException(path +
-                                ": only binary .pcd, binary .ply and .las clouds are read by "
-                                "ranges");
-    in_.open(path, std::ios::binary);
-    if (!in_) failSystem(path);
-    const auto size = static_cast<std::int64_t>(std::filesystem::file_size(path));
-    if (ext_ == "las") {
-      openLAS(size);
-      return;
-    }
-    for (const std::int64_t want : {std::int64_t{64} << 10, std::int64_t{4} << 20}) {
-      std::string head(static_cast<std::size_t>(std::min(want, size)), '\0');
-      in_.seekg(0);
-      in_.read(head.data(), static_cast<std::streamsize>(head.size()));
-      head.resize(static_cast<std::size_t>(in_.gcount()));
-      in_.clear();
-      try {
-        layout_ = ext_ == "pcd" ? detail::pcdBinaryLayout(head) : detail::plyBinaryLayout(head);
-        break;
-      } catch (const pcl::PCLException& e) {
-        if (want < (std::int64_t{4} << 20) && size > want) continue;  // a longer header?
-        throw FileFormatException(path + ": " + errorDescription(e));
-      }
-    }
-    if (size - layout_.header_bytes < layout_.points * layout_.point_bytes)
-      throw FileFormatException(path + ": shorter than its points (truncated?)");
-  }
-
-  const detail::BinaryCloudLayout& layout() const { return layout_; }
-
-  Piece read(std::int64_t first, std::int64_t count) {
-    if (first < 0 || count < 0 || first + count > layout_.points)
-      throw pcl::BadArgumentException(path_ + ": points " + std::to_string(first) + ".." +
-                                      std::to_string(first + count) + " are not in the file");
-    std::string file =
-        ext_ == "las" ? lasHeaderFor(count) : layout_.header_for(layout_.header, count);
-    const std::size_t header = file.size();
-    file.resize(header + static_cast<std::size_t>(count * layout_.point_bytes));
-    in_.seekg(layout_.header_bytes + first * layout_.point_bytes);
-    in_.read(file.data() + header, static_cast<std::streamsize>(file.size() - header));
-    if (in_.gcount() != static_cast<std::streamsize>(file.size() - header))
-      throw FileFormatException(path_ + ": cannot read points " + std::to_string(first) + "..");
-    Piece piece;
-    try {
-      if (ext_ == "las") {
-        detail::LasCloud las = detail::parseLAS(file);
-        piece.cloud = std::move(las.mesh.cloud);
-        piece.positions = std::move(las.positions);
-        piece.exact_double = true;
-        return piece;
-      }
-      piece.cloud = (ext_ == "pcd" ? detail::parsePCD(file) : detail::parsePLY(file)).cloud;
-    } catch (const pcl::PCLException& e) {
-      throw FileFormatException(path_ + ": " + errorDescription(e));
-    }
-    piece.positions = vertexPositions(piece.cloud, NonFinitePolicy::Keep);
-    return piece;
-  }
-
- private:
-  void openLAS(std::int64_t size) {
-    std::string head(static_cast<std::size_t>(std::min<std::int64_t>(375, size)), '\0');
-    in_.read(head.data(), static_cast<std::streamsize>(head.size()));
-    if (in_.gcount() < 227 || head.compare(0, 4, "LASF") != 0)
-      throw FileFormatException(path_ + ": not a LAS file (no LASF signature)");
-    if ((static_cast<std::uint8_t>(head[104]) & 0xC0) != 0)
-      throw FileFormatException(path_ +
-                                ": LAZ (compressed LAS) is not supported: decompress it "
-                                "first (laszip -i in.laz -o out.las)");
-    las_minor_ = static_cast<std::uint8_t>(head[25]);
-    const auto point_offset = getLE<std::uint32_t>(head, 96);
-    layout_.header_bytes = point_offset;
-    layout_.point_bytes = getLE<std::uint16_t>(head, 105);
-    legacy_count_ = getLE<std::uint32_t>(head, 107) != 0;
-    layout_.points = getLE<std::uint32_t>(head, 107);
-    if (las_minor_ >= 4 && head.size() >= 255) {
-      layout_.points = static_cast<std::int64_t>(getLE<std::uint64_t>(head, 247));
-      if (getLE<std::uint32_t>(head, 243) != 0)
-        throw FileFormatException(path_ + ": LAS EVLRs are not read by ranges yet");
-    }
-    if (point_offset > size || layout_.point_bytes == 0 ||
-        size - point_offset < layout_.points * layout_.point_bytes)
-      throw FileFormatException(path_ + ": shorter than its points (truncated?)");
-    layout_.header.resize(point_offset);
-    in_.seekg(0);
-    in_.read(layout_.header.data(), static_cast<std::streamsize>(point_offset));
-    if (in_.gcount() != static_cast<std::streamsize>(point_offset))
-      throw FileFormatException(path_ + ": cannot read its header");
-    layout_.width = static_cast<std::uint32_t>(layout_.points);
-    layout_.height = 1;
-  }
-  // The header and VLRs of a file of `count` of these records (no waveform data, no EVLRs).
-  std::string lasHeaderFor(std::int64_t count) const {
-    std::string header = layout_.header;
-    if (legacy_count_) putLE<std::uint32_t>(header, 107, static_cast<std::uint32_t>(count));
-    if (las_minor_ >= 3) putLE<std::uint64_t>(header, 227, 0);
-    if (las_minor_ >= 4) {
-      putLE<std::uint64_t>(header, 235, 0);
-      putLE<std::uint32_t>(header, 243, 0);
-      putLE<std::uint64_t>(header, 247, static_cast<std::uint64_t>(count));
-    }
-    return header;
-  }
-
-  std::string path_, ext_;
-  std::ifstream in_;
-  detail::BinaryCloudLayout layout_;
-  std::uint8_t las_minor_ = 0;
-  bool legacy_count_ = false;
-};
-
 py::dict cloudLayout(const std::string& path) {
   py::list fields;
-  detail::BinaryCloudLayout layout;
+  CloudFileLayout layout;
   pcl::PCLPointCloud2 empty;
   {
     py::gil_scoped_release release;
-    Pieces pieces(path);
+    CloudPieceReader pieces(path);
     layout = pieces.layout();
     empty = pieces.read(0, std::min<std::int64_t>(1, layout.points)).cloud;
   }
@@ -208,7 +72,7 @@ py::array_t<float> readXYZ(const std::string& path, std::int64_t first, std::int
   float* data = out.mutable_data();
   {
     py::gil_scoped_release release;
-    Pieces pieces(path);
+    CloudPieceReader pieces(path);
     const Eigen::Matrix3Xd positions = pieces.read(first, count).positions;
     for (Eigen::Index i = 0; i < positions.cols(); ++i)
       for (int d = 0; d < 3; ++d) data[3 * i + d] = static_cast<float>(positions(d, i));
@@ -231,7 +95,7 @@ py::tuple gatherChunk(const std::string& path, std::int64_t first, std::int64_t 
   std::vector<std::uint8_t> own;
   {
     py::gil_scoped_release release;
-    Pieces pieces(path);
+    CloudPieceReader pieces(path);
     const Eigen::Matrix3Xd positions = pieces.read(first, count).positions;
     for (Eigen::Index i = 0; i < positions.cols(); ++i) {
       float f[3];
@@ -527,69 +391,13 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
                         fit.fallback_points);
 }
 
-// out_of_core_fit.cpp's OutputPieces: binary PCD (the header from the first piece's fields) or
-// binary PLY (each piece through the PLY writer, its header kept once with the total count).
-class OutputPieces {
- public:
-  OutputPieces(const std::string& path, bool ply, std::int64_t points, std::int64_t width,
-               std::int64_t height, const SensorPose& pose)
-      : ply_(ply),
-        points_(points),
-        width_(width),
-        height_(height),
-        pose_(pose),
-        out_(path, std::ios::binary) {
-    if (!out_) failSystem("cannot write " + path);
-  }
-  void write(pcl::PCLPointCloud2& piece) {
-    const ColorLayout colors = ply_ ? ColorLayout::Channels : ColorLayout::PackedRGB;
-    const auto current = vertexColorLayout(piece);
-    if (current && *current != colors) setVertexColors(piece, vertexColors(piece), colors);
-    if (!ply_) {
-      while (removeVertexField(piece, "_")) {
-      }
-      if (first_) out_ << detail::binaryPCDHeader(piece, width_, height_, pose_);
-      out_.write(reinterpret_cast<const char*>(piece.data.data()),
-                 static_cast<std::streamsize>(piece.data.size()));
-    } else {
-      pcl::PolygonMesh mesh;
-      mesh.cloud = piece;
-      std::ostringstream encoded;
-      detail::writePLY(encoded, mesh, PlyEncoding::Binary);
-      const std::string bytes = encoded.str();
-      const std::size_t body = bytes.find("end_header\n") + 11;
-      if (first_) out_ << detail::plyHeaderWithVertices(bytes.substr(0, body), points_);
-      out_.write(bytes.data() + body, static_cast<std::streamsize>(bytes.size() - body));
-    }
-    first_ = false;
-    if (!out_) failSystem("cannot write the output");
-  }
-  void close() {
-    out_.close();
-    if (!out_) failSystem("cannot write the output");
-  }
-
- private:
-  bool ply_;
-  std::int64_t points_, width_, height_;
-  SensorPose pose_;
-  std::ofstream out_;
-  bool first_ = true;
-};
-
 // The tools' fields for a fit (pcl_ddg_normals: setNormalFields; pcl_ddg_curvature -method
 // quadric: the k1 direction, the normal fields, then mean, Gauss, k1 and k2), applied the way
-// local_fit_job.cpp's outOfCoreFields does for a piece.
-void addFields(Piece& input, const std::string& output, const std::string& tool,
+// fit_steps.cpp's outOfCoreFields does for a piece.
+void addFields(CloudPiece& input, const std::string& output, const std::string& tool,
                const std::vector<float>& records, int floats, FieldPrecision precision) {
   pcl::PCLPointCloud2& piece = input.cloud;
   const Eigen::Matrix3Xd& positions = input.positions;
-  const bool declared_double =
-      input.exact_double ||
-      std::any_of(piece.fields.begin(), piece.fields.end(), [](const pcl::PCLPointField& f) {
-        return (f.name == "x" || f.name == "y" || f.name == "z") &&
-               f.datatype == pcl::PCLPointField::FLOAT64;
-      });
   setVertexCoordinates(piece, positions, FieldPrecision::Float);
   const auto n = static_cast<Eigen::Index>(positions.cols());
   Eigen::Matrix3Xd normals(3, n);
@@ -632,9 +440,10 @@ void addFields(Piece& input, const std::string& output, const std::string& tool,
   } else {
     setNormals();
   }
-  const FieldPrecision coordinates = declared_double || precision == FieldPrecision::Double
-                                         ? FieldPrecision::Double
-                                         : FieldPrecision::Float;
+  const FieldPrecision coordinates =
+      input.coordinate_precision == FieldPrecision::Double || precision == FieldPrecision::Double
+          ? FieldPrecision::Double
+          : FieldPrecision::Float;
   setVertexCoordinates(piece, positions, coordinates);
 }
 
@@ -656,9 +465,9 @@ std::int64_t writeOutput(const std::vector<std::string>& inputs, const std::stri
                                                                            : FieldPrecision::Float;
   py::gil_scoped_release release;
   std::int64_t total = 0;
-  std::vector<detail::BinaryCloudLayout> layouts;
+  std::vector<CloudFileLayout> layouts;
   for (const std::string& input : inputs) {
-    layouts.push_back(Pieces(input).layout());
+    layouts.push_back(CloudPieceReader(input).layout());
     total += layouts.back().points;
   }
   if (inputs.empty()) throw pcl::BadArgumentException("no input");
@@ -676,21 +485,22 @@ std::int64_t writeOutput(const std::vector<std::string>& inputs, const std::stri
   // PCD as -memory writes it).
   const bool whole = ext == "pcd" && !stream_pcd;
   std::unique_ptr<AtomicFile> file;
-  std::unique_ptr<OutputPieces> out;
+  std::unique_ptr<CloudPieceWriter> out;
   pcl::PolygonMesh joined;
   if (!whole) {
     file = std::make_unique<AtomicFile>(output);
-    out = std::make_unique<OutputPieces>(file->temporaryPath(), ext == "ply", total, width, height,
-                                         layouts[0].sensor_pose);
+    out = std::make_unique<CloudPieceWriter>(
+        file->temporaryPath(), ext == "ply", total, static_cast<std::uint32_t>(width),
+        static_cast<std::uint32_t>(height), layouts[0].sensor_pose);
   }
   std::int64_t at = first_result;
   std::vector<float> records;
   for (std::size_t f = 0; f < inputs.size(); ++f) {
-    Pieces pieces(inputs[f]);
+    CloudPieceReader pieces(inputs[f]);
     const std::int64_t points = layouts[f].points;
     for (std::int64_t first = 0; first < points; first += piece_points) {
       const std::int64_t count = std::min(piece_points, points - first);
-      Piece input = pieces.read(first, count);
+      CloudPiece input = pieces.read(first, count);
       pcl::PCLPointCloud2& piece = input.cloud;
       records.resize(static_cast<std::size_t>(count * floats));
       const std::size_t bytes = records.size() * sizeof(float);

@@ -14,10 +14,8 @@
 #include <limits>
 #include <sstream>
 
-#include "../io/formats.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
-#include "pcl_ddg/mesh/vertex_positions.h"
 
 namespace pcl_ddg {
 namespace {
@@ -25,52 +23,6 @@ namespace {
 [[noreturn]] void failSystem(const std::string& what) {
   throw FileFormatException(what + ": " + std::strerror(errno));
 }
-
-// The input, a piece at a time, each piece read by the same parser as the whole file would be
-// (so every value converts exactly as it does in memory).
-class CloudPieces {
- public:
-  explicit CloudPieces(const std::string& path) : path_(path), ext_(fileExtension(path)) {
-    if (ext_ != "pcd" && ext_ != "ply")
-      throw FileFormatException(path + ": only .pcd and .ply clouds are read a piece at a time");
-    in_.open(path, std::ios::binary);
-    if (!in_) failSystem(path);
-    std::string head(4 << 20, '\0');
-    in_.read(head.data(), static_cast<std::streamsize>(head.size()));
-    head.resize(static_cast<std::size_t>(in_.gcount()));
-    in_.clear();
-    try {
-      layout_ = ext_ == "pcd" ? detail::pcdBinaryLayout(head) : detail::plyBinaryLayout(head);
-    } catch (const pcl::PCLException& e) {
-      throw FileFormatException(path + ": " + errorDescription(e));
-    }
-    const auto size = static_cast<std::int64_t>(std::filesystem::file_size(path));
-    if (size - layout_.header_bytes < layout_.points * layout_.point_bytes)
-      throw FileFormatException(path + ": shorter than its points (truncated?)");
-  }
-
-  const detail::BinaryCloudLayout& layout() const { return layout_; }
-
-  pcl::PCLPointCloud2 read(std::int64_t first, std::int64_t count) {
-    std::string file = layout_.header_for(layout_.header, count);
-    const std::size_t header = file.size();
-    file.resize(header + static_cast<std::size_t>(count * layout_.point_bytes));
-    in_.seekg(layout_.header_bytes + first * layout_.point_bytes);
-    in_.read(file.data() + header, static_cast<std::streamsize>(file.size() - header));
-    if (in_.gcount() != static_cast<std::streamsize>(file.size() - header))
-      throw FileFormatException(path_ + ": cannot read points " + std::to_string(first) + "..");
-    try {
-      return (ext_ == "pcd" ? detail::parsePCD(file) : detail::parsePLY(file)).cloud;
-    } catch (const pcl::PCLException& e) {
-      throw FileFormatException(path_ + ": " + errorDescription(e));
-    }
-  }
-
- private:
-  std::string path_, ext_;
-  std::ifstream in_;
-  detail::BinaryCloudLayout layout_;
-};
 
 // What the tools hand PCL: float coordinates from the exact ones (as toXYZ in memory does).
 pcl::PointXYZ floatPoint(const Eigen::Matrix3Xd& positions, Eigen::Index i) {
@@ -235,52 +187,6 @@ class ScratchFolder {
   std::string path_;
 };
 
-// Writes the output a piece at a time: binary PCD (the header from the first piece's fields) or
-// binary PLY (each piece through the PLY writer, its header kept once with the total count).
-class OutputPieces {
- public:
-  OutputPieces(const std::string& path, bool ply, const detail::BinaryCloudLayout& layout)
-      : ply_(ply), layout_(layout), out_(path, std::ios::binary) {
-    if (!out_) failSystem("cannot write " + path);
-  }
-  void write(pcl::PCLPointCloud2& piece) {
-    // Colours in the format's layout and no padding in a PCD, as saveMesh writes them.
-    const ColorLayout colors = ply_ ? ColorLayout::Channels : ColorLayout::PackedRGB;
-    const auto current = vertexColorLayout(piece);
-    if (current && *current != colors) setVertexColors(piece, vertexColors(piece), colors);
-    if (!ply_) {
-      while (removeVertexField(piece, "_")) {
-      }
-      if (first_) {
-        out_ << detail::binaryPCDHeader(piece, layout_.width, layout_.height, layout_.sensor_pose);
-      }
-      out_.write(reinterpret_cast<const char*>(piece.data.data()),
-                 static_cast<std::streamsize>(piece.data.size()));
-    } else {
-      pcl::PolygonMesh mesh;
-      mesh.cloud = piece;
-      std::ostringstream encoded;
-      detail::writePLY(encoded, mesh, PlyEncoding::Binary);
-      const std::string bytes = encoded.str();
-      const std::size_t body = bytes.find("end_header\n") + 11;
-      if (first_) out_ << detail::plyHeaderWithVertices(bytes.substr(0, body), layout_.points);
-      out_.write(bytes.data() + body, static_cast<std::streamsize>(bytes.size() - body));
-    }
-    first_ = false;
-    if (!out_) failSystem("cannot write the output");
-  }
-  void close() {
-    out_.close();
-    if (!out_) failSystem("cannot write the output");
-  }
-
- private:
-  bool ply_;
-  const detail::BinaryCloudLayout& layout_;
-  std::ofstream out_;
-  bool first_ = true;
-};
-
 }  // namespace
 
 OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::string& output,
@@ -290,8 +196,8 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
     throw pcl::BadArgumentException("a cloud out of core is fitted with kd-tree neighbourhoods");
   if (fileExtension(output) != "ply" && fileExtension(output) != "pcd")
     throw FileFormatException(output + ": the output must be .ply or .pcd");
-  CloudPieces pieces(input);
-  const detail::BinaryCloudLayout& layout = pieces.layout();
+  CloudPieceReader pieces(input);
+  const CloudFileLayout& layout = pieces.layout();
   OutOfCoreReport report;
   report.points = layout.points;
   report.sensor_pose = layout.sensor_pose;
@@ -307,19 +213,18 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
       std::int64_t{1} << 22);
   if (report.points_per_tile < 4096)
     throw pcl::BadArgumentException("a memory budget of at least 2M is needed");
-  const auto forEachPiece = [&](const std::function<void(std::int64_t, pcl::PCLPointCloud2&,
-                                                         const Eigen::Matrix3Xd&)>& visit) {
+  const auto forEachPiece = [&](const std::function<void(std::int64_t, CloudPiece&)>& visit) {
     for (std::int64_t first = 0; first < layout.points; first += report.points_per_piece) {
-      const std::int64_t count = std::min(report.points_per_piece, layout.points - first);
-      pcl::PCLPointCloud2 piece = pieces.read(first, count);
-      const Eigen::Matrix3Xd positions = vertexPositions(piece, NonFinitePolicy::Keep);
-      visit(first, piece, positions);
+      CloudPiece piece =
+          pieces.read(first, std::min(report.points_per_piece, layout.points - first));
+      visit(first, piece);
     }
   };
 
   // 1. Bounds of the finite points (as PCL's float points, which is what is fitted).
   Eigen::AlignedBox3d bounds;
-  forEachPiece([&](std::int64_t first, pcl::PCLPointCloud2&, const Eigen::Matrix3Xd& positions) {
+  forEachPiece([&](std::int64_t first, CloudPiece& piece) {
+    const Eigen::Matrix3Xd& positions = piece.positions;
     for (Eigen::Index i = 0; i < positions.cols(); ++i) {
       if (positions.col(i).allFinite() &&
           positions.col(i).cwiseAbs().maxCoeff() > std::numeric_limits<float>::max())
@@ -342,9 +247,9 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
   if (!bounds.isEmpty()) {
     // 2. The plan, from a histogram of a second pass.
     PointHistogram histogram(bounds, 128);
-    forEachPiece([&](std::int64_t, pcl::PCLPointCloud2&, const Eigen::Matrix3Xd& positions) {
-      for (Eigen::Index i = 0; i < positions.cols(); ++i) {
-        const pcl::PointXYZ p = floatPoint(positions, i);
+    forEachPiece([&](std::int64_t, CloudPiece& piece) {
+      for (Eigen::Index i = 0; i < piece.positions.cols(); ++i) {
+        const pcl::PointXYZ p = floatPoint(piece.positions, i);
         if (p.getVector3fMap().allFinite()) histogram.add(position(p));
       }
     });
@@ -355,9 +260,9 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
     const std::size_t buffer_records = std::clamp<std::size_t>(
         limits.memory_budget / 8 / sizeof(TileRecord) / plan.tiles.size(), 256, 65536);
     TileFiles tiles(scratch.path(), plan.tiles.size(), buffer_records);
-    forEachPiece([&](std::int64_t first, pcl::PCLPointCloud2&, const Eigen::Matrix3Xd& positions) {
-      for (Eigen::Index i = 0; i < positions.cols(); ++i) {
-        const pcl::PointXYZ p = floatPoint(positions, i);
+    forEachPiece([&](std::int64_t first, CloudPiece& piece) {
+      for (Eigen::Index i = 0; i < piece.positions.cols(); ++i) {
+        const pcl::PointXYZ p = floatPoint(piece.positions, i);
         if (p.getVector3fMap().allFinite()) tiles.add(plan.tileOf(position(p)), first + i, p);
       }
     });
@@ -403,11 +308,11 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
 
   // 5. The input's pieces with the results beside them.
   AtomicFile file(output);
-  OutputPieces out(file.temporaryPath(), fileExtension(output) == "ply", layout);
-  forEachPiece([&](std::int64_t first, pcl::PCLPointCloud2& piece, const Eigen::Matrix3Xd&) {
-    const auto count = static_cast<std::int64_t>(piece.width) * piece.height;
-    add_fields(piece, results.get(first, count));
-    out.write(piece);
+  CloudPieceWriter out(file.temporaryPath(), fileExtension(output) == "ply", layout.points,
+                       layout.width, layout.height, layout.sensor_pose);
+  forEachPiece([&](std::int64_t first, CloudPiece& piece) {
+    add_fields(piece, results.get(first, piece.positions.cols()));
+    out.write(piece.cloud);
   });
   out.close();
   file.commit();

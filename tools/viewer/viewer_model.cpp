@@ -5,6 +5,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "common/fit_steps.h"
+#include "common/tool_output.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -53,15 +55,15 @@ std::string count(std::int64_t n, const std::string& what) {
 
 }  // namespace
 
-ViewerModel::ViewerModel(tools::SurfaceInput input, std::string path)
+ViewerModel::ViewerModel(tools::ToolInput input, std::string path)
     : input_(std::move(input)), path_(std::move(path)) {
   capabilities_.is_mesh = static_cast<bool>(input_.topology);
   capabilities_.points = static_cast<int>(input_.positions.cols());
   capabilities_.properties = colourableProperties(input_.mesh.cloud);
-  spacing_ = input_.topology ? input_.spacing : tools::meanSpacing(input_.points);
+  spacing_ = input_.spacing();
   if (!(spacing_ > 0.0)) spacing_ = 1.0;
   positions_["input;"] = std::make_shared<const Eigen::Matrix3Xd>(input_.positions);
-  points_["input;"] = input_.points;
+  points_["input;"] = input_.points();
 }
 
 ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingStep>& steps,
@@ -74,7 +76,7 @@ ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingSt
   if (refused) return start;
 
   const SmoothingStep& step = steps.back();
-  const double h2 = input_.spacing * input_.spacing;
+  const double h2 = spacing_ * spacing_;
   MeshSmoothingParameters parameters;
   parameters.scheme = step.implicit ? SmoothingScheme::Implicit : SmoothingScheme::Explicit;
   parameters.weights = step.cotan ? LaplacianWeights::Cotangent : LaplacianWeights::Uniform;

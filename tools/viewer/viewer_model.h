@@ -12,7 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "common/local_fit_job.h"
+#include "common/tool_input.h"
+#include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/render/color_map.h"
 #include "viewer/viewer_state.h"
@@ -37,8 +38,8 @@ struct Frame {
 
 class ViewerModel {
  public:
-  /** Takes a loaded input (tools::loadSurfaceInput). */
-  ViewerModel(tools::SurfaceInput input, std::string path);
+  /** Takes a loaded input. */
+  ViewerModel(tools::ToolInput input, std::string path);
 
   const InputCapabilities& capabilities() const { return capabilities_; }
   const std::string& path() const { return path_; }
@@ -71,7 +72,7 @@ class ViewerModel {
   pcl::PointCloud<pcl::PointXYZ>::Ptr pointsOf(const std::string& version,
                                                const Positions& positions);
 
-  tools::SurfaceInput input_;
+  tools::ToolInput input_;
   std::string path_;
   InputCapabilities capabilities_;
   double spacing_ = 0.0;

@@ -10,8 +10,8 @@
  *   3. each tile is gathered from the tile files its halo touches, fitted, and its results are
  *      written at their points' places in a results file
  *   4. a last pass joins the input's pieces and the results into the output
- * Input: an uncompressed binary PCD or a binary PLY cloud (other encodings cannot be read in
- * pieces). Output: binary PCD or binary PLY, by extension.
+ * Input: what io/cloud_pieces.h reads in pieces (binary PCD, binary PLY, LAS). Output: binary PCD
+ * or binary PLY, by extension.
  */
 #include <pcl/PCLPointCloud2.h>
 
@@ -20,7 +20,7 @@
 #include <string>
 
 #include "pcl_ddg/features/local_fit.h"
-#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/io/cloud_pieces.h"
 #include "pcl_ddg/tiling/tiled_local_fit.h"
 
 namespace pcl_ddg {
@@ -42,7 +42,7 @@ struct OutOfCoreReport {
 
 /** Adds the fit's fields to a piece of the input (the fit has one entry per point of the piece):
  *  the caller's output convention, the same as for a cloud in memory. */
-using ResultFields = std::function<void(pcl::PCLPointCloud2& piece, const LocalFitResult& fit)>;
+using ResultFields = std::function<void(CloudPiece& piece, const LocalFitResult& fit)>;
 
 /**
  * Fits options' estimator to every point of the cloud file `input` and writes `output`. The

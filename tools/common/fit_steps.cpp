@@ -1,4 +1,4 @@
-#include "common/local_fit_job.h"
+#include "common/fit_steps.h"
 
 #include <pcl/common/point_tests.h>
 #include <pcl/search/kdtree.h>
@@ -10,7 +10,7 @@
 #include <limits>
 #include <optional>
 
-#include "common/mesh_job.h"
+#include "common/tool_output.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
@@ -19,45 +19,6 @@
 
 namespace pcl_ddg {
 namespace tools {
-
-SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name) {
-  SurfaceInput input;
-  MeshFile file;
-  {
-    Timer timer("Loading " + path);
-    file = readMeshFile(path);
-    timer.done(static_cast<std::size_t>(file.positions.cols()));
-  }
-  input.sensor_pose = file.sensor_pose;
-  input.las = file.las;
-  input.coordinate_precision = file.coordinate_precision;
-  if (!file.mesh.polygons.empty()) {
-    SurfaceMesh mesh = checkSurfaceMesh(std::move(file), tool_name);
-    input.points = toXYZ(mesh.positions);
-    input.spacing = meanEdgeLength(mesh.topology, mesh.positions);
-    input.topology = std::make_shared<const MeshTopology>(std::move(mesh.topology));
-    input.positions = std::move(mesh.positions);
-    input.mesh = std::move(mesh.mesh);
-    return input;
-  }
-  input.mesh = std::move(file.mesh);
-  input.positions = std::move(file.positions);
-  const Eigen::Matrix3Xd& positions = input.positions;
-  const NonFiniteVertices bad = findNonFiniteVertices(positions);
-  if (bad.count == positions.cols()) throw std::runtime_error(path + " has no finite point");
-  if (bad.count > 0)
-    warn(tool_name, std::to_string(bad.count) + " non-finite points (NaN output there)");
-  input.points = toXYZ(positions);
-  // An organized cloud (a frame, a range image) keeps its pixel grid and its sensor.
-  if (input.mesh.cloud.height > 1) {
-    input.points->width = input.mesh.cloud.width;
-    input.points->height = input.mesh.cloud.height;
-  }
-  input.points->sensor_origin_.head<3>() = input.sensor_pose.origin.cast<float>();
-  input.points->sensor_orientation_ = input.sensor_pose.orientation.cast<float>();
-  return input;  // the spacing of a cloud costs a kd-tree: measured only when asked for
-                 // (-radius 2.5h)
-}
 
 namespace {
 
@@ -116,49 +77,6 @@ std::optional<Eigen::Vector3d> upArgument(const ToolArguments& args) {
 
 }  // namespace
 
-double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) {
-  pcl::Indices finite;
-  for (std::size_t i = 0; i < points->size(); ++i) {
-    if (pcl::isXYZFinite((*points)[i])) finite.push_back(static_cast<pcl::index_t>(i));
-  }
-  if (finite.size() < 2) return 0.0;
-  pcl::search::KdTree<pcl::PointXYZ> tree;
-  tree.setInputCloud(points, std::make_shared<const pcl::Indices>(finite));
-  const std::size_t step = std::max<std::size_t>(1, finite.size() / 10000);
-  double sum = 0.0;
-  std::size_t counted = 0;
-  pcl::Indices found;
-  std::vector<float> distances;
-  for (std::size_t i = 0; i < finite.size(); i += step) {
-    // Exact duplicates are skipped: the spacing is between distinct samples.
-    if (tree.nearestKSearch((*points)[finite[i]], 8, found, distances) < 2) continue;
-    for (const float d : distances) {
-      if (d > 0.0f) {
-        sum += std::sqrt(d);
-        ++counted;
-        break;
-      }
-    }
-  }
-  return counted > 0 ? sum / counted : 0.0;
-}
-
-pcl::PointCloud<pcl::PointXYZ>::Ptr toXYZ(const Eigen::Matrix3Xd& positions) {
-  auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  points->resize(positions.cols());
-  for (Eigen::Index i = 0; i < positions.cols(); ++i)
-    (*points)[i].getVector3fMap() = positions.col(i).cast<float>();
-  points->is_dense = positions.allFinite();
-  return points;
-}
-
-Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals) {
-  Eigen::Matrix3Xd n(3, normals.size());
-  for (std::size_t i = 0; i < normals.size(); ++i)
-    n.col(i) = normals[i].getNormalVector3fMap().cast<double>();
-  return n;
-}
-
 std::string describeNeighbourhood(const LocalFitOptions& options) {
   if (options.neighbourhood == NeighbourhoodKind::Grid && options.method == LocalFitMethod::PCA &&
       options.radius == 0.0) {
@@ -193,12 +111,12 @@ void checkLocalFitArguments(const ToolArguments& args) {
     throw UsageError("-max_depth_jump must be > 0 (a relative range change per pixel)");
 }
 
-LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput& input,
+LocalFitOptions localFitArguments(const ToolArguments& args, ToolInput& input,
                                   LocalFitMethod method) {
   checkLocalFitArguments(args);
   LocalFitOptions options;
   options.method = method;
-  const bool organized = !input.topology && input.points->height > 1;
+  const bool organized = !input.topology && input.points()->height > 1;
   const std::string neighbours = args.choice("neighbours", {"bfs", "knn", "grid"},
                                              input.topology ? "bfs"
                                              : organized    ? "grid"
@@ -226,13 +144,14 @@ LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput&
   options.up = upArgument(args);
   const RadiusArgument radius = radiusArgument(args);
   if (radius.value > 0.0) {
-    double spacing = input.spacing;
+    double spacing = 1.0;
+    if (radius.in_spacings && input.topology) spacing = input.spacing();
     if (radius.in_spacings && !input.topology) {
       Timer timer("Measuring the point spacing");
-      spacing = meanSpacing(input.points);
-      timer.done(input.points->size());
+      spacing = input.spacing();
+      timer.done(input.points()->size());
     }
-    options.radius = radius.value * (radius.in_spacings ? spacing : 1.0);
+    options.radius = radius.value * spacing;
     options.max_neighbours =
         static_cast<unsigned int>(args.integer("max_nn", kDefaultMaxNeighbours));
     options.min_neighbours = static_cast<unsigned int>(args.integer("min_nn", 0));
@@ -262,11 +181,11 @@ PointSpacing warnAboutQuantisation(const char* tool_name,
   return spacing;
 }
 
-SamplingCheck checkSampling(const char* tool_name, const SurfaceInput& input,
+SamplingCheck checkSampling(const char* tool_name, ToolInput& input,
                             const LocalFitOptions& options) {
   SamplingCheck check;
   if (input.topology) return check;  // a mesh's faces orient it; its edges are its spacing
-  const pcl::PointCloud<pcl::PointXYZ>& points = *input.points;
+  const pcl::PointCloud<pcl::PointXYZ>& points = *input.points();
   warnAboutQuantisation(tool_name, points);
   const bool by_viewpoint =
       options.orientation == NormalOrientation::Viewpoint ||
@@ -359,8 +278,7 @@ std::vector<int> classesArgument(const ToolArguments& args) {
   return classes;
 }
 
-std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args,
-                             SurfaceInput& input) {
+std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args, ToolInput& input) {
   const std::vector<int> classes = classesArgument(args);
   if (classes.empty()) return 0;
   if (input.topology) throw UsageError("-classes applies to point clouds (a LAS file), not meshes");
@@ -374,14 +292,14 @@ std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args,
     if (std::find(classes.begin(), classes.end(), static_cast<int>(classification[i])) !=
         classes.end())
       continue;
-    pcl::PointXYZ& p = (*input.points)[static_cast<std::size_t>(i)];
+    pcl::PointXYZ& p = (*input.points())[static_cast<std::size_t>(i)];
     p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
     ++left_out;
   }
   const std::int64_t fitted = classification.size() - left_out;
   if (fitted == 0)
     throw std::runtime_error("no point is of the classes -classes " + *args.value("classes"));
-  input.points->is_dense = false;
+  input.points()->is_dense = false;
   std::fprintf(stderr, "%s: -classes %s: fitting %lld of %lld points (NaN elsewhere)\n", tool_name,
                args.value("classes")->c_str(), static_cast<long long>(fitted),
                static_cast<long long>(classification.size()));
@@ -426,20 +344,12 @@ void fitOutOfCore(const char* tool_name, const ToolArguments& args, const std::s
 
 ResultFields outOfCoreFields(const std::string& output_path, FieldPrecision precision,
                              const PieceFields& add) {
-  return [output_path, precision, add](pcl::PCLPointCloud2& piece, const LocalFitResult& fit) {
-    const Eigen::Matrix3Xd positions = vertexPositions(piece, NonFinitePolicy::Keep);
-    const bool declared_double =
-        std::any_of(piece.fields.begin(), piece.fields.end(), [](const pcl::PCLPointField& f) {
-          return (f.name == "x" || f.name == "y" || f.name == "z") &&
-                 f.datatype == pcl::PCLPointField::FLOAT64;
-        });
+  return [output_path, precision, add](CloudPiece& piece, const LocalFitResult& fit) {
     // As loading (float x y z for PCL), adding the fields, and saving do in memory.
-    setVertexCoordinates(piece, positions, FieldPrecision::Float);
-    add(piece, output_path, fit);
-    setVertexCoordinates(
-        piece, positions,
-        coordinatePrecision(declared_double ? FieldPrecision::Double : FieldPrecision::Float,
-                            precision));
+    setVertexCoordinates(piece.cloud, piece.positions, FieldPrecision::Float);
+    add(piece.cloud, output_path, fit);
+    setVertexCoordinates(piece.cloud, piece.positions,
+                         coordinatePrecision(piece.coordinate_precision, precision));
   };
 }
 
@@ -454,14 +364,6 @@ int fitEachInputOutOfCore(const char* tool_name, const ToolArguments& args,
                         fitOutOfCore(tool_name, args, input, output, options,
                                      outOfCoreFields(output, precision, add));
                       });
-}
-
-void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
-                     const pcl::PointCloud<pcl::Normal>& normals, FieldPrecision precision) {
-  setNormalTriple(cloud, output_path, normalsOf(normals), precision);
-  Eigen::VectorXd values(normals.size());
-  for (std::size_t i = 0; i < normals.size(); ++i) values[i] = normals[i].curvature;
-  setVertexField(cloud, "curvature", values, precision);
 }
 
 QuietPCLWarnings::QuietPCLWarnings() : level_(pcl::console::getVerbosityLevel()) {

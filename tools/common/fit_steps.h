@@ -1,7 +1,6 @@
 #pragma once
-// The shared shape of the tools that fit local surfaces (pca, quadric): input that is a mesh or a
-// point cloud, the neighbourhood options, and normals written under the names the output format
-// expects.
+// The steps the fitting tools (pca, quadric) share: the neighbourhood options, the checks of the
+// sampling before a fit, the out-of-core run (-memory) and the warnings after a fit.
 #include <pcl/PolygonMesh.h>
 #include <pcl/console/print.h>
 #include <pcl/point_cloud.h>
@@ -13,6 +12,7 @@
 #include <string>
 
 #include "common/tool_common.h"
+#include "common/tool_input.h"
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
@@ -22,34 +22,6 @@
 
 namespace pcl_ddg {
 namespace tools {
-
-/** A mesh (topology set, coordinates finite) or a point cloud (no topology, NaN points kept). */
-struct SurfaceInput {
-  pcl::PolygonMesh mesh;  ///< x, y, z as float (PCL's point types); positions holds them exactly
-  std::shared_ptr<const MeshTopology> topology;
-  Eigen::Matrix3Xd positions;                  ///< double, as read
-  pcl::PointCloud<pcl::PointXYZ>::Ptr points;  ///< the same, as PCL points
-  /** Mean edge length of a mesh (a cloud's mean nearest-neighbour distance costs a kd-tree, and
-   *  is measured by localFitArguments when -radius asks for it). */
-  double spacing = 0.0;
-  SensorPose sensor_pose;                ///< a PCD's VIEWPOINT (kept for the output)
-  std::shared_ptr<const LasLayout> las;  ///< a LAS input's layout (kept for a .las output)
-  FieldPrecision coordinate_precision = FieldPrecision::Float;  ///< as the file declares them
-};
-
-/** Mean distance from a point to its nearest other point (exact duplicates skipped), over up to
- *  10,000 finite points: a cloud's h. */
-double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points);
-
-/** positions as PCL points (float; NaN kept, is_dense when all are finite). */
-pcl::PointCloud<pcl::PointXYZ>::Ptr toXYZ(const Eigen::Matrix3Xd& positions);
-
-/** The normals of a PCL estimator as a 3 x N matrix (NaN kept). */
-Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals);
-
-/** Loads a mesh or a cloud, with the warnings of loadSurfaceMesh for meshes and a count of
- *  non-finite points for clouds. */
-SurfaceInput loadSurfaceInput(const std::string& path, const char* tool_name);
 
 /** "mesh rings, k = 16", "pixel grid, 5 x 5 window", "kd-tree, radius 0.01", ... */
 std::string describeNeighbourhood(const LocalFitOptions& options);
@@ -63,7 +35,7 @@ void checkLocalFitArguments(const ToolArguments& args);
  *  written like 2.5h, with at most -max_nn N neighbours (default 64, Open3D's hybrid search) and,
  *  with -min_nn N, the N nearest where the ball holds fewer; -viewpoint x,y,z orients cloud
  *  normals (default: the file's VIEWPOINT); -up x,y,z is the up direction of -orient up and mst. */
-LocalFitOptions localFitArguments(const ToolArguments& args, const SurfaceInput& input,
+LocalFitOptions localFitArguments(const ToolArguments& args, ToolInput& input,
                                   LocalFitMethod method);
 
 /** The options of localFitArguments for a cloud file fitted out of core (-memory): kd-tree
@@ -82,7 +54,7 @@ std::vector<int> classesArgument(const ToolArguments& args);
  * many were left out (to subtract from the fit's failures). Throws when the input has no
  * classification or no point of those classes.
  */
-std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args, SurfaceInput& input);
+std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args, ToolInput& input);
 
 /** -memory SIZE (like 2G, 512M), checked before any file is read (UsageError). */
 std::uint64_t memoryArgument(const ToolArguments& args);
@@ -101,11 +73,6 @@ using PieceFields = std::function<void(pcl::PCLPointCloud2& piece, const std::st
 int fitEachInputOutOfCore(const char* tool_name, const ToolArguments& args,
                           const LocalFitOptions& options, FieldPrecision precision,
                           const PieceFields& add);
-
-/** Writes normals as nx ny nz (PLY) or normal_x normal_y normal_z (PCD), and PCL's curvature
- *  (surface variation) as "curvature". */
-void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
-                     const pcl::PointCloud<pcl::Normal>& normals, FieldPrecision precision);
 
 /** While alive, PCL prints errors only: the estimators' own warnings would repeat, in the middle
  *  of a timing line, the counts that warnAboutLocalFit reports after it. */
@@ -136,7 +103,7 @@ struct SamplingCheck {
  * data than 10 times its bounding box's diagonal; with -radius, prints how many points the ball
  * holds (min, median, share under 3). Meshes: nothing.
  */
-SamplingCheck checkSampling(const char* tool_name, const SurfaceInput& input,
+SamplingCheck checkSampling(const char* tool_name, ToolInput& input,
                             const LocalFitOptions& options);
 
 /** After a radius fit that left points without an estimate: the radius that would give 90 % of

@@ -1,7 +1,9 @@
 #pragma once
-// The shared shape of the mesh tools: load and check a surface mesh (warning about its defects),
-// then save the result with its new vertex fields.
+// What the tools write: new vertex fields under the names the output format expects, in the
+// precision asked for, and the result saved atomically with the input's layout.
 #include <pcl/PolygonMesh.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
 
 #include <Eigen/Core>
 #include <string>
@@ -9,39 +11,9 @@
 #include "common/tool_common.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
-#include "pcl_ddg/mesh/mesh_topology.h"
-#include "pcl_ddg/operators/mass_matrix.h"
-#include "pcl_ddg/operators/sparse_cholesky.h"
-#include "pcl_ddg/surface/implicit_solver.h"
 
 namespace pcl_ddg {
 namespace tools {
-
-struct SurfaceMesh {
-  pcl::PolygonMesh mesh;  ///< x, y, z as float (PCL's point types); positions holds them exactly
-  MeshTopology topology;
-  Eigen::Matrix3Xd positions;
-  FieldPrecision coordinate_precision = FieldPrecision::Float;  ///< as the file declares them
-};
-
-/** Loads a mesh with faces; throws on out-of-range indices or non-finite coordinates, prints one
- *  warning line per kind of defect (degenerate, duplicate, non-manifold, unreferenced). */
-SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name);
-
-/** The checks and warnings of loadSurfaceMesh, for a file already loaded. */
-SurfaceMesh checkSurfaceMesh(MeshFile file, const char* tool_name);
-
-/** A vertex-area option (-area or -mass): mixed|voronoi|barycentric, default mixed. */
-MassType massTypeArgument(const ToolArguments& args, const std::string& option);
-
-struct SolverChoice {
-  ImplicitSolver method;
-  CholeskyBackend backend;
-};
-
-/** -solver auto|cholmod|ldlt|cg: auto picks the cheaper of Cholesky and conjugate gradients for
- *  the run; cholmod and ldlt factorise with that backend; cg always iterates. */
-SolverChoice solverArgument(const ToolArguments& args);
 
 /** -precision float|double. */
 FieldPrecision precisionArgument(const ToolArguments& args);
@@ -55,6 +27,14 @@ FieldPrecision precisionArgument(const ToolArguments& args);
  */
 void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
                      const Eigen::Matrix3Xd& normals, FieldPrecision precision);
+
+/** Writes normals as nx ny nz (PLY) or normal_x normal_y normal_z (PCD), and PCL's curvature
+ *  (surface variation) as "curvature". */
+void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
+                     const pcl::PointCloud<pcl::Normal>& normals, FieldPrecision precision);
+
+/** The normals of a PCL estimator as a 3 x N matrix (NaN kept). */
+Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals);
 
 /**
  * Colours the output by a colour map of `values` (the field `field_name`), replacing the input's

@@ -1,4 +1,4 @@
-#include "common/mesh_job.h"
+#include "common/tool_output.h"
 
 #include <iostream>
 
@@ -8,53 +8,6 @@
 
 namespace pcl_ddg {
 namespace tools {
-
-SurfaceMesh loadSurfaceMesh(const std::string& path, const char* tool_name) {
-  Timer timer("Loading " + path);
-  MeshFile file = readMeshFile(path);
-  if (file.mesh.polygons.empty()) throw std::runtime_error(path + " has no faces (a point cloud?)");
-  timer.done(static_cast<std::size_t>(file.positions.cols()));
-  return checkSurfaceMesh(std::move(file), tool_name);
-}
-
-SurfaceMesh checkSurfaceMesh(MeshFile file, const char* tool_name) {
-  Timer timer("Building the mesh topology");
-  requireFinite(file.positions);
-  MeshTopology topology(file.mesh);
-  Eigen::Matrix3Xd& positions = file.positions;
-  // Only the defects worth a warning (pcl_ddg_info makes the whole MeshReport).
-  const TopologyCounts& counts = topology.counts();
-  const std::int64_t degenerate =
-      counts.repeated_index_polygons + countZeroAreaFaces(topology, positions);
-  timer.done(static_cast<std::size_t>(positions.cols()));
-
-  const std::pair<std::int64_t, const char*> defects[] = {
-      {degenerate, "degenerate faces (no weight)"},
-      {counts.duplicate_polygons, "duplicate faces"},
-      {counts.nonmanifold_edges, "non-manifold edges"},
-      {counts.nonmanifold_vertices, "non-manifold (bow-tie) vertices"},
-      {counts.unreferenced_vertices, "unreferenced vertices (NaN results)"}};
-  for (const auto& [count, what] : defects) {
-    if (count > 0) warn(tool_name, std::to_string(count) + " " + what);
-  }
-  return {std::move(file.mesh), std::move(topology), std::move(positions),
-          file.coordinate_precision};
-}
-
-MassType massTypeArgument(const ToolArguments& args, const std::string& option) {
-  const std::string area = args.choice(option, {"mixed", "voronoi", "barycentric"}, "mixed");
-  return area == "voronoi"       ? MassType::Voronoi
-         : area == "barycentric" ? MassType::Barycentric
-                                 : MassType::MixedVoronoi;
-}
-
-SolverChoice solverArgument(const ToolArguments& args) {
-  const std::string solver = args.choice("solver", {"auto", "cholmod", "ldlt", "cg"}, "auto");
-  if (solver == "cholmod") return {ImplicitSolver::Cholesky, CholeskyBackend::Cholmod};
-  if (solver == "ldlt") return {ImplicitSolver::Cholesky, CholeskyBackend::SimplicialLDLT};
-  if (solver == "cg") return {ImplicitSolver::ConjugateGradient, CholeskyBackend::Automatic};
-  return {ImplicitSolver::Automatic, CholeskyBackend::Automatic};
-}
 
 FieldPrecision precisionArgument(const ToolArguments& args) {
   return args.choice("precision", {"float", "double"}, "float") == "double" ? FieldPrecision::Double
@@ -72,6 +25,21 @@ void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
   for (int d = 0; d < 3; ++d) removeVertexField(cloud, pcd_naming ? ply_names[d] : pcd_names[d]);
   const char** names = pcd_naming ? pcd_names : ply_names;
   setVertexFields(cloud, {names[0], names[1], names[2]}, normals, precision);
+}
+
+void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
+                     const pcl::PointCloud<pcl::Normal>& normals, FieldPrecision precision) {
+  setNormalTriple(cloud, output_path, normalsOf(normals), precision);
+  Eigen::VectorXd values(normals.size());
+  for (std::size_t i = 0; i < normals.size(); ++i) values[i] = normals[i].curvature;
+  setVertexField(cloud, "curvature", values, precision);
+}
+
+Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals) {
+  Eigen::Matrix3Xd n(3, normals.size());
+  for (std::size_t i = 0; i < normals.size(); ++i)
+    n.col(i) = normals[i].getNormalVector3fMap().cast<double>();
+  return n;
 }
 
 void setColorMapFields(const char* tool_name, pcl::PCLPointCloud2& cloud,

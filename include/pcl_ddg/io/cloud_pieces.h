@@ -1,0 +1,85 @@
+#pragma once
+/** \file
+ * A cloud file read and written a piece at a time, for clouds larger than memory (the out-of-core
+ * fit, tiling/out_of_core_fit.h) and for workers that each read their own points of a shared file
+ * (the Python module's Dask runner). A piece is parsed by the same parser as the whole file would
+ * be, so every value converts exactly as it does when the file is read at once.
+ *
+ * Read: binary PCD (uncompressed), binary PLY clouds (one vertex element, no faces) and LAS 1.0-1.4
+ * without EVLRs. Written: binary PCD or binary PLY, by extension, with the header of the whole.
+ */
+#include <pcl/PCLPointCloud2.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/io/vertex_fields.h"
+
+namespace pcl_ddg {
+
+/** Where a cloud file's points lie and what the whole file holds. */
+struct CloudFileLayout {
+  std::int64_t points = 0;
+  std::int64_t header_bytes = 0;  ///< the first point's record starts here
+  std::int64_t point_bytes = 0;   ///< one point's record
+  std::uint32_t width = 0, height = 0;
+  SensorPose sensor_pose;  ///< a PCD's VIEWPOINT
+};
+
+/** Points [first, first + count) of a file. */
+struct CloudPiece {
+  pcl::PCLPointCloud2 cloud;   ///< every field as the file stores it (LAS: x, y, z as FLOAT32)
+  Eigen::Matrix3Xd positions;  ///< the exact coordinates (LAS: X * scale + offset), NaN kept
+  FieldPrecision coordinate_precision = FieldPrecision::Float;  ///< as MeshFile's
+};
+
+class CloudPieceReader {
+ public:
+  /** Reads the header; FileFormatException for a file that cannot be read in pieces (text or
+   *  compressed encodings, meshes, EVLRs) or that is shorter than its points. */
+  explicit CloudPieceReader(const std::string& path);
+  ~CloudPieceReader();
+  CloudPieceReader(const CloudPieceReader&) = delete;
+  CloudPieceReader& operator=(const CloudPieceReader&) = delete;
+
+  const CloudFileLayout& layout() const;
+  /** pcl::BadArgumentException when the range is not in the file. */
+  CloudPiece read(std::int64_t first, std::int64_t count);
+
+ private:
+  struct Format;
+  std::string path_;
+  std::ifstream in_;
+  CloudFileLayout layout_;
+  std::unique_ptr<Format> format_;
+};
+
+/** Writes a cloud of `points` points a piece at a time into `path` (the caller's temporary file:
+ *  see atomic_file.h): binary PLY when `ply`, else binary PCD, as saveMesh writes them (colours
+ *  in the format's layout, no padding fields in a PCD). The first piece's fields make the header;
+ *  every piece must have them. */
+class CloudPieceWriter {
+ public:
+  CloudPieceWriter(const std::string& path, bool ply, std::int64_t points, std::uint32_t width,
+                   std::uint32_t height, const SensorPose& sensor_pose);
+  void write(pcl::PCLPointCloud2& piece);
+  /** Flushes and closes; FileFormatException when the output could not be written. */
+  void close();
+
+ private:
+  bool ply_;
+  std::int64_t points_;
+  std::uint32_t width_, height_;
+  SensorPose sensor_pose_;
+  std::ofstream out_;
+  bool first_ = true;
+  std::vector<pcl::PCLPointField> fields_;  ///< the first piece's
+  std::uint32_t point_step_ = 0;
+};
+
+}  // namespace pcl_ddg

@@ -1,0 +1,238 @@
+#include "pcl_ddg/io/cloud_pieces.h"
+
+#include <pcl/exceptions.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+
+#include "formats.h"
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+
+namespace pcl_ddg {
+namespace {
+
+[[noreturn]] void failSystem(const std::string& what) {
+  throw FileFormatException(what + ": " + std::strerror(errno));
+}
+
+template <typename T>
+T getLE(const std::string& bytes, std::size_t at) {
+  T value;
+  std::memcpy(&value, bytes.data() + at, sizeof(T));
+  return value;
+}
+template <typename T>
+void putLE(std::string& bytes, std::size_t at, T value) {
+  std::memcpy(bytes.data() + at, &value, sizeof(T));
+}
+
+bool declaresDoubleCoordinates(const pcl::PCLPointCloud2& cloud) {
+  return std::any_of(cloud.fields.begin(), cloud.fields.end(), [](const pcl::PCLPointField& f) {
+    return (f.name == "x" || f.name == "y" || f.name == "z") &&
+           f.datatype == pcl::PCLPointField::FLOAT64;
+  });
+}
+
+}  // namespace
+
+// How a piece's file is made: the header rewritten for its count, and the parser of the whole.
+struct CloudPieceReader::Format {
+  bool las = false, pcd = false;
+  std::string header;  // PCD/PLY: the header text; LAS: the header and VLRs
+  std::string (*header_for)(const std::string&, std::int64_t) = nullptr;
+  std::uint8_t las_minor = 0;
+  bool las_legacy_count = false;
+
+  std::string headerFor(std::int64_t count) const {
+    if (!las) return header_for(header, count);
+    // A LAS file of `count` of these records: no waveform data, no EVLRs.
+    std::string out = header;
+    if (las_legacy_count) putLE<std::uint32_t>(out, 107, static_cast<std::uint32_t>(count));
+    if (las_minor >= 3) putLE<std::uint64_t>(out, 227, 0);
+    if (las_minor >= 4) {
+      putLE<std::uint64_t>(out, 235, 0);
+      putLE<std::uint32_t>(out, 243, 0);
+      putLE<std::uint64_t>(out, 247, static_cast<std::uint64_t>(count));
+    }
+    return out;
+  }
+};
+
+CloudPieceReader::CloudPieceReader(const std::string& path)
+    : path_(path), format_(std::make_unique<Format>()) {
+  const std::string ext = fileExtension(path);
+  if (ext == "laz") {
+    throw FileFormatException(path +
+                              ": LAZ (compressed LAS) is not supported: decompress it first "
+                              "(laszip -i in.laz -o out.las)");
+  }
+  if (ext != "pcd" && ext != "ply" && ext != "las") {
+    throw FileFormatException(path +
+                              ": only binary .pcd, binary .ply and .las clouds are read in pieces");
+  }
+  in_.open(path, std::ios::binary);
+  if (!in_) failSystem(path);
+  const auto size = static_cast<std::int64_t>(std::filesystem::file_size(path));
+  if (ext == "las") {
+    // The public header block (LAS 1.4: 375 bytes), then the header and VLRs up to the points.
+    std::string head(static_cast<std::size_t>(std::min<std::int64_t>(375, size)), '\0');
+    in_.read(head.data(), static_cast<std::streamsize>(head.size()));
+    if (in_.gcount() < 227 || head.compare(0, 4, "LASF") != 0)
+      throw FileFormatException(path + ": not a LAS file (no LASF signature)");
+    if ((static_cast<std::uint8_t>(head[104]) & 0xC0) != 0) {
+      throw FileFormatException(path +
+                                ": LAZ (compressed LAS) is not supported: decompress it first "
+                                "(laszip -i in.laz -o out.las)");
+    }
+    Format& f = *format_;
+    f.las = true;
+    f.las_minor = static_cast<std::uint8_t>(head[25]);
+    const auto point_offset = getLE<std::uint32_t>(head, 96);
+    layout_.header_bytes = point_offset;
+    layout_.point_bytes = getLE<std::uint16_t>(head, 105);
+    f.las_legacy_count = getLE<std::uint32_t>(head, 107) != 0;
+    layout_.points = getLE<std::uint32_t>(head, 107);
+    if (f.las_minor >= 4 && head.size() >= 255) {
+      layout_.points = static_cast<std::int64_t>(getLE<std::uint64_t>(head, 247));
+      if (getLE<std::uint32_t>(head, 243) != 0)
+        throw FileFormatException(path + ": a LAS file with EVLRs is not read in pieces");
+    }
+    if (point_offset > size || layout_.point_bytes == 0 || layout_.points < 0 ||
+        (size - point_offset) / layout_.point_bytes < layout_.points)
+      throw FileFormatException(path + ": shorter than its points (truncated?)");
+    f.header.resize(point_offset);
+    in_.seekg(0);
+    in_.read(f.header.data(), static_cast<std::streamsize>(point_offset));
+    if (in_.gcount() != static_cast<std::streamsize>(point_offset))
+      throw FileFormatException(path + ": cannot read its header");
+    layout_.width = static_cast<std::uint32_t>(layout_.points);
+    layout_.height = 1;
+    return;
+  }
+  // A header is read from the file's first 64 KiB, or 4 MiB when it is longer (many comments).
+  detail::BinaryCloudLayout binary;
+  for (const std::int64_t want : {std::int64_t{64} << 10, std::int64_t{4} << 20}) {
+    std::string head(static_cast<std::size_t>(std::min(want, size)), '\0');
+    in_.seekg(0);
+    in_.read(head.data(), static_cast<std::streamsize>(head.size()));
+    head.resize(static_cast<std::size_t>(in_.gcount()));
+    in_.clear();
+    try {
+      binary = ext == "pcd" ? detail::pcdBinaryLayout(head) : detail::plyBinaryLayout(head);
+      break;
+    } catch (const pcl::PCLException& e) {
+      if (want < (std::int64_t{4} << 20) && size > want) continue;
+      throw FileFormatException(path + ": " + errorDescription(e));
+    }
+  }
+  if (binary.point_bytes <= 0 || (size - binary.header_bytes) / binary.point_bytes < binary.points)
+    throw FileFormatException(path + ": shorter than its points (truncated?)");
+  layout_.points = binary.points;
+  layout_.header_bytes = binary.header_bytes;
+  layout_.point_bytes = binary.point_bytes;
+  layout_.width = binary.width;
+  layout_.height = binary.height;
+  layout_.sensor_pose = binary.sensor_pose;
+  format_->header = std::move(binary.header);
+  format_->header_for = binary.header_for;
+  format_->pcd = ext == "pcd";
+}
+
+CloudPieceReader::~CloudPieceReader() = default;
+
+const CloudFileLayout& CloudPieceReader::layout() const {
+  return layout_;
+}
+
+CloudPiece CloudPieceReader::read(std::int64_t first, std::int64_t count) {
+  if (first < 0 || count < 0 || first > layout_.points || count > layout_.points - first) {
+    throw pcl::BadArgumentException(path_ + ": points " + std::to_string(first) + ".." +
+                                    std::to_string(first + count) + " are not in the file");
+  }
+  std::string file = format_->headerFor(count);
+  const std::size_t header = file.size();
+  file.resize(header + static_cast<std::size_t>(count * layout_.point_bytes));
+  in_.clear();
+  in_.seekg(layout_.header_bytes + first * layout_.point_bytes);
+  in_.read(file.data() + header, static_cast<std::streamsize>(file.size() - header));
+  if (in_.gcount() != static_cast<std::streamsize>(file.size() - header))
+    throw FileFormatException(path_ + ": cannot read points " + std::to_string(first) + "..");
+  CloudPiece piece;
+  try {
+    if (format_->las) {
+      detail::LasCloud las = detail::parseLAS(file);
+      piece.cloud = std::move(las.mesh.cloud);
+      piece.positions = std::move(las.positions);
+      piece.coordinate_precision = FieldPrecision::Double;  // X * scale + offset
+      return piece;
+    }
+    piece.cloud = (format_->pcd ? detail::parsePCD(file) : detail::parsePLY(file)).cloud;
+  } catch (const pcl::PCLException& e) {
+    throw FileFormatException(path_ + ": " + errorDescription(e));
+  }
+  piece.positions = vertexPositions(piece.cloud, NonFinitePolicy::Keep);
+  if (declaresDoubleCoordinates(piece.cloud)) piece.coordinate_precision = FieldPrecision::Double;
+  return piece;
+}
+
+CloudPieceWriter::CloudPieceWriter(const std::string& path, bool ply, std::int64_t points,
+                                   std::uint32_t width, std::uint32_t height,
+                                   const SensorPose& sensor_pose)
+    : ply_(ply),
+      points_(points),
+      width_(width),
+      height_(height),
+      sensor_pose_(sensor_pose),
+      out_(path, std::ios::binary) {
+  if (!out_) failSystem("cannot write " + path);
+}
+
+void CloudPieceWriter::write(pcl::PCLPointCloud2& piece) {
+  // Colours in the format's layout and no padding in a PCD, as saveMesh writes them.
+  const ColorLayout colors = ply_ ? ColorLayout::Channels : ColorLayout::PackedRGB;
+  const auto current = vertexColorLayout(piece);
+  if (current && *current != colors) setVertexColors(piece, vertexColors(piece), colors);
+  if (!ply_) {
+    while (removeVertexField(piece, "_")) {
+    }
+  }
+  const auto same = [](const pcl::PCLPointField& a, const pcl::PCLPointField& b) {
+    return a.name == b.name && a.offset == b.offset && a.datatype == b.datatype &&
+           a.count == b.count;
+  };
+  if (first_) {
+    fields_ = piece.fields;
+    point_step_ = piece.point_step;
+  } else if (piece.point_step != point_step_ ||
+             !std::equal(piece.fields.begin(), piece.fields.end(), fields_.begin(), fields_.end(),
+                         same)) {
+    throw FileFormatException("a piece's fields differ from the first piece's");
+  }
+  if (!ply_) {
+    if (first_) out_ << detail::binaryPCDHeader(piece, width_, height_, sensor_pose_);
+    out_.write(reinterpret_cast<const char*>(piece.data.data()),
+               static_cast<std::streamsize>(piece.data.size()));
+  } else {
+    pcl::PolygonMesh mesh;
+    mesh.cloud = piece;
+    std::ostringstream encoded;
+    detail::writePLY(encoded, mesh, PlyEncoding::Binary);
+    const std::string bytes = encoded.str();
+    const std::size_t body = bytes.find("end_header\n") + 11;
+    if (first_) out_ << detail::plyHeaderWithVertices(bytes.substr(0, body), points_);
+    out_.write(bytes.data() + body, static_cast<std::streamsize>(bytes.size() - body));
+  }
+  first_ = false;
+  if (!out_) failSystem("cannot write the output");
+}
+
+void CloudPieceWriter::close() {
+  out_.close();
+  if (!out_) failSystem("cannot write the output");
+}
+
+}  // namespace pcl_ddg

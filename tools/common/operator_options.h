@@ -1,0 +1,27 @@
+#pragma once
+// The options that pick an operator's variant: the vertex areas (-area, -mass) and the implicit
+// solver (-solver).
+#include <string>
+
+#include "common/tool_common.h"
+#include "pcl_ddg/operators/mass_matrix.h"
+#include "pcl_ddg/operators/sparse_cholesky.h"
+#include "pcl_ddg/surface/implicit_solver.h"
+
+namespace pcl_ddg {
+namespace tools {
+
+/** A vertex-area option (-area or -mass): mixed|voronoi|barycentric, default mixed. */
+MassType massTypeArgument(const ToolArguments& args, const std::string& option);
+
+struct SolverChoice {
+  ImplicitSolver method;
+  CholeskyBackend backend;
+};
+
+/** -solver auto|cholmod|ldlt|cg: auto picks the cheaper of Cholesky and conjugate gradients for
+ *  the run; cholmod and ldlt factorise with that backend; cg always iterates. */
+SolverChoice solverArgument(const ToolArguments& args);
+
+}  // namespace tools
+}  // namespace pcl_ddg

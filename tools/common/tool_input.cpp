@@ -1,0 +1,114 @@
+#include "common/tool_input.h"
+
+#include <pcl/common/point_tests.h>
+#include <pcl/search/kdtree.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "common/tool_common.h"
+#include "pcl_ddg/mesh/mesh_geometry.h"
+#include "pcl_ddg/mesh/mesh_report.h"
+#include "pcl_ddg/mesh/vertex_positions.h"
+
+namespace pcl_ddg {
+namespace tools {
+
+ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind kind) {
+  MeshFile file;
+  {
+    Timer timer("Loading " + path);
+    file = readMeshFile(path);
+    timer.done(static_cast<std::size_t>(file.positions.cols()));
+  }
+  if (kind == InputKind::Mesh && file.mesh.polygons.empty())
+    throw std::runtime_error(path + " has no faces (a point cloud?)");
+  mesh = std::move(file.mesh);
+  positions = std::move(file.positions);
+  sensor_pose = file.sensor_pose;
+  las = std::move(file.las);
+  coordinate_precision = file.coordinate_precision;
+  if (mesh.polygons.empty()) {
+    const NonFiniteVertices bad = findNonFiniteVertices(positions);
+    if (bad.count == positions.cols()) throw std::runtime_error(path + " has no finite point");
+    if (bad.count > 0)
+      warn(tool_name, std::to_string(bad.count) + " non-finite points (NaN output there)");
+    return;
+  }
+  Timer timer("Building the mesh topology");
+  requireFinite(positions);
+  topology = std::make_shared<const MeshTopology>(mesh);
+  // Only the defects worth a warning (pcl_ddg_info makes the whole MeshReport).
+  const TopologyCounts& counts = topology->counts();
+  const std::int64_t degenerate =
+      counts.repeated_index_polygons + countZeroAreaFaces(*topology, positions);
+  timer.done(static_cast<std::size_t>(positions.cols()));
+
+  const std::pair<std::int64_t, const char*> defects[] = {
+      {degenerate, "degenerate faces (no weight)"},
+      {counts.duplicate_polygons, "duplicate faces"},
+      {counts.nonmanifold_edges, "non-manifold edges"},
+      {counts.nonmanifold_vertices, "non-manifold (bow-tie) vertices"},
+      {counts.unreferenced_vertices, "unreferenced vertices (NaN results)"}};
+  for (const auto& [count, what] : defects) {
+    if (count > 0) warn(tool_name, std::to_string(count) + " " + what);
+  }
+}
+
+const pcl::PointCloud<pcl::PointXYZ>::Ptr& ToolInput::points() {
+  if (points_) return points_;
+  points_ = toXYZ(positions);
+  if (topology) return points_;
+  // An organized cloud (a frame, a range image) keeps its pixel grid and its sensor.
+  if (mesh.cloud.height > 1) {
+    points_->width = mesh.cloud.width;
+    points_->height = mesh.cloud.height;
+  }
+  points_->sensor_origin_.head<3>() = sensor_pose.origin.cast<float>();
+  points_->sensor_orientation_ = sensor_pose.orientation.cast<float>();
+  return points_;
+}
+
+double ToolInput::spacing() {
+  if (!spacing_) spacing_ = topology ? meanEdgeLength(*topology, positions) : meanSpacing(points());
+  return *spacing_;
+}
+
+double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) {
+  pcl::Indices finite;
+  for (std::size_t i = 0; i < points->size(); ++i) {
+    if (pcl::isXYZFinite((*points)[i])) finite.push_back(static_cast<pcl::index_t>(i));
+  }
+  if (finite.size() < 2) return 0.0;
+  pcl::search::KdTree<pcl::PointXYZ> tree;
+  tree.setInputCloud(points, std::make_shared<const pcl::Indices>(finite));
+  const std::size_t step = std::max<std::size_t>(1, finite.size() / 10000);
+  double sum = 0.0;
+  std::size_t counted = 0;
+  pcl::Indices found;
+  std::vector<float> distances;
+  for (std::size_t i = 0; i < finite.size(); i += step) {
+    // Exact duplicates are skipped: the spacing is between distinct samples.
+    if (tree.nearestKSearch((*points)[finite[i]], 8, found, distances) < 2) continue;
+    for (const float d : distances) {
+      if (d > 0.0f) {
+        sum += std::sqrt(d);
+        ++counted;
+        break;
+      }
+    }
+  }
+  return counted > 0 ? sum / counted : 0.0;
+}
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr toXYZ(const Eigen::Matrix3Xd& positions) {
+  auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  points->resize(positions.cols());
+  for (Eigen::Index i = 0; i < positions.cols(); ++i)
+    (*points)[i].getVector3fMap() = positions.col(i).cast<float>();
+  points->is_dense = positions.allFinite();
+  return points;
+}
+
+}  // namespace tools
+}  // namespace pcl_ddg

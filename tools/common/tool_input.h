@@ -1,0 +1,59 @@
+#pragma once
+// An input file as every tool loads it: the file (mesh or cloud, exact coordinates, what the format
+// declares), a mesh's topology checked once with one warning line per kind of defect, and what
+// only some tools need (PCL's float points, the sampling's spacing) made on first use.
+#include <pcl/PolygonMesh.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/mesh_topology.h"
+
+namespace pcl_ddg {
+namespace tools {
+
+enum class InputKind {
+  Any,  ///< a mesh or a point cloud
+  Mesh  ///< faces required: a cloud is refused
+};
+
+class ToolInput {
+ public:
+  /** Loads with a timing line. A mesh: non-finite coordinates and out-of-range indices throw, its
+   *  defects are warned about (degenerate, duplicate, non-manifold, unreferenced). A cloud: the
+   *  non-finite points are counted in a warning (kept: NaN output there); none finite throws. */
+  ToolInput(const std::string& path, const char* tool_name, InputKind kind = InputKind::Any);
+
+  pcl::PolygonMesh mesh;  ///< x, y, z as float (PCL's point types); positions holds them exactly
+  Eigen::Matrix3Xd positions;                    ///< double, as read (LAS: X * scale + offset)
+  std::shared_ptr<const MeshTopology> topology;  ///< null for a cloud
+  SensorPose sensor_pose;                        ///< a PCD's VIEWPOINT (kept for the output)
+  std::shared_ptr<const LasLayout> las;          ///< a LAS input's layout (for a .las output)
+  FieldPrecision coordinate_precision = FieldPrecision::Float;  ///< as the file declares them
+
+  /** positions as PCL points (float, NaN kept); an organized cloud keeps its grid, and the
+   *  sensor pose is the cloud's sensor_origin_ / sensor_orientation_. Made on the first call. */
+  const pcl::PointCloud<pcl::PointXYZ>::Ptr& points();
+  /** h: a mesh's mean edge length, a cloud's mean distance to the nearest other point (over up to
+   *  10,000 points, exact duplicates skipped: it costs a kd-tree). Measured on the first call. */
+  double spacing();
+
+ private:
+  pcl::PointCloud<pcl::PointXYZ>::Ptr points_;
+  std::optional<double> spacing_;
+};
+
+/** Mean distance from a point to its nearest other point (exact duplicates skipped), over up to
+ *  10,000 finite points: a cloud's h. */
+double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points);
+
+/** positions as PCL points (float; NaN kept, is_dense when all are finite). */
+pcl::PointCloud<pcl::PointXYZ>::Ptr toXYZ(const Eigen::Matrix3Xd& positions);
+
+}  // namespace tools
+}  // namespace pcl_ddg
