@@ -131,7 +131,7 @@ BENCHMARK_CAPTURE(onNewPositions, cotan, "field=mean")
 void pcaNewK(benchmark::State& state) {
   Session& s = meshSession();
   act(*s.window, "field=none");
-  act(*s.window, "neighbours=knn");
+  act(*s.window, "neighbours=kdtree");
   act(*s.window, "method=pca");
   int k = 10;
   for (auto _ : state) act(*s.window, "k=" + std::to_string(k++));

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 
 #include <cmath>
 #include <cstdio>
@@ -142,7 +143,7 @@ TEST_F(MeshTools, BadInputGivesOneLineNonZeroExitAndNoOutput) {
 TEST_F(MeshTools, FaceMethodsOnACloudOrBFSWithoutAMeshAreUsageErrors) {
   writeText(path("cloud.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0.1\n");
   for (const char* options :
-       {" -method area", " -method mean_curvature", " -method pca -neighbours bfs"}) {
+       {" -method area", " -method mean_curvature", " -method pca -neighbours rings"}) {
     const ToolRun run =
         runTool(PCL_DDG_NORMALS_TOOL, path("cloud.obj") + " " + path("out.ply") + options);
     EXPECT_EQ(run.exit_code, 2) << options;
@@ -201,7 +202,7 @@ TEST_F(MeshTools, OrganizedFramesUseTheGridAndStayOrganized) {
   // The grid needs an organized cloud; -max_depth_jump is for the grid; -orient mesh for meshes.
   for (const std::string& options :
        {sharedData("clouds/bun0.pcd") + " " + path("out.pcd") + " -neighbours grid",
-        frame + " " + path("out.pcd") + " -neighbours knn -max_depth_jump 0.1",
+        frame + " " + path("out.pcd") + " -neighbours kdtree -max_depth_jump 0.1",
         frame + " " + path("out.pcd") + " -max_depth_jump 0",
         frame + " " + path("out.pcd") + " -orient mesh",
         sharedData("clouds/bun0.pcd") + " " + path("out.pcd") + " -normal_map " + path("n.png"),
@@ -287,7 +288,8 @@ int checkUnitNormals(const pcl::PCLPointCloud2& cloud, const char* x, const char
 
 TEST_F(MeshTools, FittedNormalsOnEverySharedMesh) {
   for (const char* file : kSharedMeshes) {
-    for (const char* options : {" -method pca", " -method quadric -neighbours knn -radius 2.5h"}) {
+    for (const char* options :
+         {" -method pca", " -method quadric -neighbours kdtree -radius 2.5h"}) {
       SCOPED_TRACE(std::string(file) + options);
       const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, sharedData(std::string("meshes/") + file) +
                                                             " " + path("out.ply") + options);
@@ -327,11 +329,31 @@ TEST_F(MeshTools, FittedNormalsOnEverySharedCloud) {
   checkUnitNormals(loadMesh(path("range.ply")).cloud, "nx", "ny", "nz");
 }
 
+TEST_F(MeshTools, TheFormerNeighbourhoodSpellingsGiveTheSameBytes) {
+  // -neighbours bfs and knn (before rings and kdtree) keep working, as the same neighbourhoods.
+  saveMesh(path("sphere.ply"), polygonMeshOf(makeIcosphere(3, 1.0)));
+  const auto bytesOf = [&](const std::string& neighbours) {
+    const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, path("sphere.ply") + " " + path("n.ply") +
+                                                          " -method pca -neighbours " + neighbours);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    std::ifstream in(path("n.ply"), std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string rings = bytesOf("rings"), kdtree = bytesOf("kdtree");
+  EXPECT_NE(rings, kdtree);
+  EXPECT_EQ(bytesOf("bfs"), rings);
+  EXPECT_EQ(bytesOf("knn"), kdtree);
+  EXPECT_EQ(runTool(PCL_DDG_NORMALS_TOOL,
+                    path("sphere.ply") + " " + path("n.ply") + " -method pca -neighbours octree")
+                .exit_code,
+            2);
+}
+
 TEST_F(MeshTools, QuadricCurvatureOfASphereFileIsItsInverseRadius) {
   const SurfaceSample sphere = makeIcosphere(4, 2.0);
   const pcl::PolygonMesh mesh = polygonMeshOf(sphere);
   saveMesh(path("sphere.ply"), mesh);
-  for (const char* neighbours : {"bfs", "knn"}) {
+  for (const char* neighbours : {"rings", "kdtree"}) {
     const ToolRun run =
         runTool(PCL_DDG_CURVATURE_TOOL, path("sphere.ply") + " " + path("k.ply") +
                                             " -method quadric -color k1 -neighbours " + neighbours);

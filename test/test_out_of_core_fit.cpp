@@ -35,7 +35,7 @@ class OutOfCore : public ::testing::Test {
     SCOPED_TRACE(input + options);
     // Out of core is the kd-tree's path; in memory an organized cloud would take the grid.
     const ToolRun whole =
-        runTool(tool, input + " " + path("whole.ply") + " " + options + " -neighbours knn");
+        runTool(tool, input + " " + path("whole.ply") + " " + options + " -neighbours kdtree");
     ASSERT_EQ(whole.exit_code, 0) << whole.err;
     const ToolRun tiled =
         runTool(tool, input + " " + path("tiled.ply") + " " + options + " -memory " + memory);
@@ -81,7 +81,7 @@ TEST_F(OutOfCore, APcdOutputHoldsTheSameValuesAndStaysOrganized) {
   ASSERT_EQ(pcl::io::loadPCDFile(sharedData("clouds/office1.pcd"), cloud), 0);
   ASSERT_EQ(pcl::PCDWriter().writeBinary(path("office.pcd"), cloud), 0);
   ASSERT_EQ(runTool(PCL_DDG_NORMALS_TOOL,
-                    path("office.pcd") + " " + path("whole.pcd") + " -neighbours knn")
+                    path("office.pcd") + " " + path("whole.pcd") + " -neighbours kdtree")
                 .exit_code,
             0);
   ASSERT_EQ(
@@ -112,7 +112,7 @@ TEST_F(OutOfCore, InputsThatCannotBeReadInPiecesAndBadOptionsAreRefused) {
     EXPECT_FALSE(std::filesystem::exists(path("out.ply")));
   }
   for (const char* options : {"-memory lots", "-memory 0", "-memory 1k", "-memory 64M -radius 2h",
-                              "-memory 64M -method area", "-memory 64M -neighbours bfs"}) {
+                              "-memory 64M -method area", "-memory 64M -neighbours rings"}) {
     EXPECT_EQ(
         runTool(normals, path("missing.pcd") + " " + path("out.ply") + " " + options).exit_code,
         std::string(options) == "-memory 1k" ? 1 : 2)

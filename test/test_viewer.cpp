@@ -158,7 +158,7 @@ TEST_F(Viewer, KeysReachTheSameStateAsTheEquivalentDoLine) {
 
   ViewerWindow by_actions(*model, 400, 300);
   for (const std::string& action : viewer::splitActions(
-           "method=mean_curvature k=20 k=25 k=20 neighbours=knn field=gauss normals=on "
+           "method=mean_curvature k=20 k=25 k=20 neighbours=kdtree field=gauss normals=on "
            "shading=flat step=2 smooth=implicit weights=uniform frozen=off step=1 smooth=explicit "
            "undo smooth=implicit")) {
     by_actions.enqueue(action);
@@ -351,12 +351,26 @@ TEST_F(Viewer, FiftyKeyPressesDuringAFitAreAllApplied) {
   EXPECT_EQ(window.frame().normals->cols(), model->capabilities().points);
 }
 
+TEST(ViewerActions, NeighboursByTheirNamesAndTheFormerSpellings) {
+  const viewer::InputCapabilities mesh{true, 100, {}};
+  ViewerState state = viewer::initialState(mesh);
+  for (const auto& [value, expected] : {std::pair{"kdtree", viewer::Neighbours::KdTree},
+                                        {"rings", viewer::Neighbours::MeshRings},
+                                        {"knn", viewer::Neighbours::KdTree},
+                                        {"bfs", viewer::Neighbours::MeshRings}}) {
+    viewer::applyAction(state, mesh, std::string("neighbours=") + value);
+    EXPECT_EQ(state.neighbours, expected) << value;
+  }
+}
+
 TEST(ViewerActions, RefuseWhatTheInputCannotDoAndClampK) {
   viewer::InputCapabilities cloud{false, 100, {"intensity"}};
   ViewerState state = viewer::initialState(cloud);
   EXPECT_EQ(state.method, viewer::NormalMethod::PCA);
   EXPECT_THROW(viewer::applyAction(state, cloud, "method=area"), std::invalid_argument);
+  EXPECT_THROW(viewer::applyAction(state, cloud, "neighbours=rings"), std::invalid_argument);
   EXPECT_THROW(viewer::applyAction(state, cloud, "neighbours=bfs"), std::invalid_argument);
+  EXPECT_THROW(viewer::applyAction(state, cloud, "neighbours=octree"), std::invalid_argument);
   EXPECT_THROW(viewer::applyAction(state, cloud, "smooth=implicit"), std::invalid_argument);
   EXPECT_THROW(viewer::applyAction(state, cloud, "field=compare"), std::invalid_argument);
   EXPECT_THROW(viewer::applyAction(state, cloud, "k=two"), std::invalid_argument);

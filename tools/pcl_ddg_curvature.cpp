@@ -27,7 +27,7 @@ constexpr const char* kSyntax =
     "cotan on "
     "meshes)]\n"
     "         [-area mixed|voronoi|barycentric (cotan)]\n"
-    "         [-neighbours bfs|knn] [-k N (default 20)] [-radius r or 2.5h] [-max_nn N]\n"
+    "         [-neighbours rings|kdtree] [-k N (default 20)] [-radius r or 2.5h] [-max_nn N]\n"
     "         [-viewpoint x,y,z] [-classes 2,6 (fit only these classes, NaN elsewhere)] "
     "(quadric)\n"
     "         [-smooth t (heat flow time in h^2, meshes)]\n"

@@ -22,7 +22,7 @@ std::string syntax() {
          "         [-screenshot out.png (draw, write the picture, exit)] [-size WxH (default "
          "1024x768)]\n"
          "Actions (also what the keys send):\n"
-         "  method=uniform|area|angle|mean_curvature|pca|quadric  k=N  neighbours=bfs|knn\n"
+         "  method=uniform|area|angle|mean_curvature|pca|quadric  k=N  neighbours=rings|kdtree\n"
          "  field=none|mean|gauss|k1|k2|angle|compare|<property of the file>\n"
          "  reference=auto|<method> (what field=angle compares with)\n"
          "  smooth=explicit|implicit[:t] (t: step in h^2)  step=t  weights=uniform|cotan\n"

@@ -344,9 +344,10 @@ def estimate_normals(
     k: neighbours (default 16, quadric 20; at least 3, at most the point count).
     radius: a radius search instead of k, keeping at most ``max_nn`` (default 64) nearest;
         ``min_nn``: the min_nn nearest where the ball holds fewer.
-    neighbours: ``"knn"`` (kd-tree; clouds' default), ``"bfs"`` (rings of the mesh ``faces``; the
+    neighbours: ``"kdtree"`` (clouds' default), ``"rings"`` (rings of the mesh ``faces``; the
         default when faces are given) or ``"grid"`` (an organized cloud's pixels; its default,
-        never across a depth jump above ``max_depth_jump``, default 0.02).
+        never across a depth jump above ``max_depth_jump``, default 0.02). The former ``"knn"``
+        and ``"bfs"`` still mean ``"kdtree"`` and ``"rings"``.
     viewpoint: the sensor: normals face it (default the origin, as PCL).
     orient: ``"viewpoint"`` (clouds' default), ``"mesh"`` (like the faces; meshes' default),
         ``"up"`` (n . up >= 0; ``up`` default +z) or ``"mst"`` (consistent along a minimum

@@ -941,7 +941,7 @@ def _parser(tool: str) -> argparse.ArgumentParser:
     p.add_argument("-orient", choices=["viewpoint", "up"])
     p.add_argument("-up", type=_vector)
     p.add_argument("-precision", choices=["float", "double"], default="float")
-    p.add_argument("-neighbours", choices=["knn"], default="knn",
+    p.add_argument("-neighbours", choices=["kdtree", "knn"], default="kdtree",
                    help="kd-tree neighbours (mesh rings and pixel grids need the whole input)")
     p.add_argument("--scheduler", help="tcp://HOST:8786 (default: a LocalCluster)")
     p.add_argument("--workers", type=int, help="LocalCluster worker processes (default: cores)")

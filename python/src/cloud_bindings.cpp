@@ -158,18 +158,19 @@ LocalFitOptions fitOptions(const FitArguments& a, Cloud& cloud,
         std::make_shared<const MeshTopology>(topologyOf(static_cast<int>(cloud.size()), a.faces));
   }
   const bool organized = !topology && cloud.height > 1;
-  const std::string neighbours = choice("neighbours",
-                                        a.neighbours.value_or(topology    ? "bfs"
-                                                              : organized ? "grid"
-                                                                          : "knn"),
-                                        {"knn", "bfs", "grid"});
-  if (neighbours == "bfs" && !topology)
-    throw py::value_error("neighbours='bfs' needs faces; these points are a cloud (use 'knn')");
+  // bfs and knn: the former spellings of rings and kdtree.
+  std::string requested = a.neighbours.value_or(topology ? "rings" : organized ? "grid" : "kdtree");
+  if (requested == "bfs") requested = "rings";
+  if (requested == "knn") requested = "kdtree";
+  const std::string neighbours = choice("neighbours", requested, {"kdtree", "rings", "grid"});
+  if (neighbours == "rings" && !topology)
+    throw py::value_error(
+        "neighbours='rings' needs faces; these points are a cloud (use 'kdtree')");
   if (neighbours == "grid" && !organized)
     throw py::value_error("neighbours='grid' needs an organized cloud of shape (h, w, 3)");
   if (a.max_depth_jump && neighbours != "grid")
     throw py::value_error("max_depth_jump applies to neighbours='grid'");
-  options.neighbourhood = neighbours == "bfs"    ? NeighbourhoodKind::MeshRings
+  options.neighbourhood = neighbours == "rings"  ? NeighbourhoodKind::MeshRings
                           : neighbours == "grid" ? NeighbourhoodKind::Grid
                                                  : NeighbourhoodKind::KdTree;
   if (a.max_depth_jump) options.max_depth_jump = *a.max_depth_jump;

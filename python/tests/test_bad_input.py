@@ -63,6 +63,7 @@ CASES = {
     "k and radius": ("pcl_ddg.estimate_normals(P, k=8, radius=0.1)", "ValueError"),
     "max_nn without radius": ("pcl_ddg.estimate_normals(P, max_nn=10)", "ValueError"),
     "unknown method": ("pcl_ddg.estimate_normals(P, method='svd')", "ValueError"),
+    "rings without faces": ("pcl_ddg.estimate_normals(P, neighbours='rings')", "ValueError"),
     "bfs without faces": ("pcl_ddg.estimate_normals(P, neighbours='bfs')", "ValueError"),
     "grid on a flat cloud": ("pcl_ddg.estimate_normals(P, neighbours='grid')", "ValueError"),
     "viewpoint of 2": ("pcl_ddg.estimate_normals(P, viewpoint=[0, 0])", "ValueError"),

@@ -41,11 +41,16 @@ def test_quadric_principal_curvatures_of_a_sphere():
 
 def test_mesh_neighbourhoods_with_faces():
     V, F = icosphere(4, 1.0)
-    r = pcl_ddg.estimate_normals(V, faces=F)  # bfs rings, oriented like the faces (outward)
+    r = pcl_ddg.estimate_normals(V, faces=F)  # mesh rings, oriented like the faces (outward)
     assert r.valid.all()
     assert np.min(np.einsum("ij,ij->i", r.normals, V)) > 0.999
-    q = pcl_ddg.estimate_normals(V, method="quadric", faces=F, neighbours="knn")
+    q = pcl_ddg.estimate_normals(V, method="quadric", faces=F, neighbours="kdtree")
     assert np.min(np.einsum("ij,ij->i", q.normals, V)) > 0.999
+    assert not np.array_equal(r.normals, pcl_ddg.estimate_normals(V, faces=F, neighbours="kdtree").normals)
+    # The former spellings: bfs for rings, knn for kdtree.
+    for old, new in (("bfs", "rings"), ("knn", "kdtree")):
+        before = pcl_ddg.estimate_normals(V, faces=F, neighbours=old)
+        assert np.array_equal(before.normals, pcl_ddg.estimate_normals(V, faces=F, neighbours=new).normals)
 
 
 def test_grid_normals_of_a_tilted_plane_keep_the_grid():

@@ -106,9 +106,17 @@ void checkLocalFitArguments(const ToolArguments& args) {
   classesArgument(args);
   if (args.has("min_nn") && args.integer("min_nn", 3) < 3)
     throw UsageError("-min_nn must be at least 3");
-  args.choice("neighbours", {"bfs", "knn", "grid"}, "knn");
+  neighboursArgument(args, "kdtree");
   if (args.has("max_depth_jump") && !(args.number("max_depth_jump", 0.0) > 0.0))
     throw UsageError("-max_depth_jump must be > 0 (a relative range change per pixel)");
+}
+
+std::string neighboursArgument(const ToolArguments& args, const std::string& fallback) {
+  // The former spellings (the search's algorithm and query, not the neighbourhood) still work.
+  const std::optional<std::string> value = args.value("neighbours");
+  if (value == "bfs") return "rings";
+  if (value == "knn") return "kdtree";
+  return args.choice("neighbours", {"rings", "kdtree", "grid"}, fallback);
 }
 
 LocalFitOptions localFitArguments(const ToolArguments& args, ToolInput& input,
@@ -117,19 +125,18 @@ LocalFitOptions localFitArguments(const ToolArguments& args, ToolInput& input,
   LocalFitOptions options;
   options.method = method;
   const bool organized = !input.topology && input.points()->height > 1;
-  const std::string neighbours = args.choice("neighbours", {"bfs", "knn", "grid"},
-                                             input.topology ? "bfs"
-                                             : organized    ? "grid"
-                                                            : "knn");
-  if (neighbours == "bfs" && !input.topology) {
-    throw UsageError("-neighbours bfs needs a mesh; this input is a point cloud (use knn)");
+  const std::string neighbours = neighboursArgument(args, input.topology ? "rings"
+                                                          : organized    ? "grid"
+                                                                         : "kdtree");
+  if (neighbours == "rings" && !input.topology) {
+    throw UsageError("-neighbours rings needs a mesh; this input is a point cloud (use kdtree)");
   }
   if (neighbours == "grid" && !organized) {
     throw UsageError("-neighbours grid needs an organized cloud (width x height pixels)");
   }
   if (args.has("max_depth_jump") && neighbours != "grid")
     throw UsageError("-max_depth_jump applies to -neighbours grid");
-  options.neighbourhood = neighbours == "bfs"    ? NeighbourhoodKind::MeshRings
+  options.neighbourhood = neighbours == "rings"  ? NeighbourhoodKind::MeshRings
                           : neighbours == "grid" ? NeighbourhoodKind::Grid
                                                  : NeighbourhoodKind::KdTree;
   options.max_depth_jump = args.number("max_depth_jump", options.max_depth_jump);
@@ -233,8 +240,8 @@ void warnAboutRadius(const char* tool_name, const SamplingCheck& check,
 
 LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod method) {
   checkLocalFitArguments(args);
-  if (args.choice("neighbours", {"bfs", "knn", "grid"}, "knn") != "knn")
-    throw UsageError("-memory fits clouds with kd-tree neighbourhoods (-neighbours knn)");
+  if (neighboursArgument(args, "kdtree") != "kdtree")
+    throw UsageError("-memory fits clouds with kd-tree neighbourhoods (-neighbours kdtree)");
   LocalFitOptions options;
   options.method = method;
   options.neighbourhood = NeighbourhoodKind::KdTree;

@@ -23,6 +23,10 @@
 namespace pcl_ddg {
 namespace tools {
 
+/** -neighbours rings|kdtree|grid, or fallback; the former bfs and knn are read as rings and
+ *  kdtree. */
+std::string neighboursArgument(const ToolArguments& args, const std::string& fallback);
+
 /** "mesh rings, k = 16", "pixel grid, 5 x 5 window", "kd-tree, radius 0.01", ... */
 std::string describeNeighbourhood(const LocalFitOptions& options);
 
@@ -30,7 +34,8 @@ std::string describeNeighbourhood(const LocalFitOptions& options);
  *  read (UsageError): -k and -radius exclude each other, -max_nn needs -radius. */
 void checkLocalFitArguments(const ToolArguments& args);
 
-/** -neighbours bfs|knn (bfs is the default on meshes and impossible on clouds), -k N (at most the
+/** -neighbours rings|kdtree|grid (rings is the default on meshes and impossible on clouds, grid
+ *  the default on organized clouds), -k N (at most the
  *  input's point count), and -radius r, where r is a length or a multiple of the input's spacing
  *  written like 2.5h, with at most -max_nn N neighbours (default 64, Open3D's hybrid search) and,
  *  with -min_nn N, the N nearest where the ball holds fewer; -viewpoint x,y,z orients cloud

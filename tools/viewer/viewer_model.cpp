@@ -144,8 +144,8 @@ std::shared_ptr<const Eigen::Matrix3Xd> ViewerModel::normalsOf(NormalMethod meth
   const bool fitted = !isMeshMethod(method);
   std::string key = version + methodName(method);
   if (fitted) {
-    key +=
-        (state.neighbours == Neighbours::MeshRings ? "/bfs/" : "/knn/") + std::to_string(state.k);
+    key += (state.neighbours == Neighbours::MeshRings ? "/rings/" : "/kdtree/") +
+           std::to_string(state.k);
   }
   if (const auto it = normals_.find(key); it != normals_.end()) return it->second;
 
@@ -197,7 +197,7 @@ Eigen::VectorXd ViewerModel::fieldOf(const ViewerState& state, const std::string
         version + field +
         (cotan ? "/cotan"
                : "/quadric/" + std::to_string(state.k) +
-                     (state.neighbours == Neighbours::MeshRings ? "bfs" : "knn"));
+                     (state.neighbours == Neighbours::MeshRings ? "rings" : "kdtree"));
     if (const auto it = fields_.find(key); it != fields_.end()) return it->second;
     Eigen::VectorXd values[4];
     if (cotan) {

@@ -140,10 +140,12 @@ std::string applyAction(ViewerState& state, const InputCapabilities& input,
         state.neighbours == Neighbours::MeshRings ? Neighbours::KdTree : Neighbours::MeshRings;
     if (name == "neighbours") {
       needValue();
-      if (value != "bfs" && value != "knn") refuse(action, "expected bfs or knn");
-      next = value == "bfs" ? Neighbours::MeshRings : Neighbours::KdTree;
+      // bfs and knn: the former spellings.
+      if (value != "rings" && value != "kdtree" && value != "bfs" && value != "knn")
+        refuse(action, "expected rings or kdtree");
+      next = value == "rings" || value == "bfs" ? Neighbours::MeshRings : Neighbours::KdTree;
     }
-    if (next == Neighbours::MeshRings && !input.is_mesh) refuse(action, "bfs rings need a mesh");
+    if (next == Neighbours::MeshRings && !input.is_mesh) refuse(action, "mesh rings need a mesh");
     state.neighbours = next;
   } else if (action == "field+" || name == "field") {
     const std::vector<std::string> fields = fieldsOf(input);
