@@ -167,7 +167,7 @@ TEST_F(SmoothingTools, BadInputAndOptionsGiveOneLineAndNoOutput) {
   }
   const std::string cow = sharedData("meshes/cow.off");
   for (const char* options : {"-method magic", "-lambda_dt 0", "-iterations 0", "-absolute_time",
-                              "-preserve mass", "-bogus"}) {
+                              "-preserve mass", "-bogus", "-area mixed -mass voronoi"}) {
     SCOPED_TRACE(options);
     EXPECT_EQ(runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("out.ply") + " " + options).exit_code,
               2);

@@ -467,10 +467,11 @@ TEST_F(ToolOptions, SmoothEqualsTheLibraryForEveryScheme) {
        on(cow, explicit5)},
       {"-weights uniform", on(cow, uniform), cow_default},
       {"-weights cotan", cow_default, on(cow, uniform)},  // the default: the first row pins it
-      {"-mass voronoi", on(cow, voronoi), cow_default},
-      {"-mass barycentric", on(cow, barycentric), cow_default},
+      {"-area voronoi", on(cow, voronoi), cow_default},
+      {"-mass voronoi", on(cow, voronoi), cow_default},  // the former name
+      {"-area barycentric", on(cow, barycentric), cow_default},
       // The explicit default step is half the stability bound of the chosen mass.
-      {"-method explicit -mass barycentric", on(cow, explicit_barycentric),
+      {"-method explicit -area barycentric", on(cow, explicit_barycentric),
        on(cow, explicit_scheme)},
       {"-lambda_dt 3", on(cow, implicit, 3.0), cow_default},
       {"-iterations 3", cow_three, cow_default},

@@ -91,7 +91,7 @@ int run(int argc, char** argv) {
       (args.has("neighbours") || args.has("k") || args.has("radius") || args.has("classes"))) {
     throw tools::UsageError("-neighbours, -k, -radius and -classes apply to -method quadric");
   }
-  const MassType mass = tools::massTypeArgument(args, "area");  // validated before loading
+  const MassType mass = tools::vertexAreaArgument(args);  // validated before loading
   tools::checkLocalFitArguments(args);
   const double smooth_time = args.number("smooth", 1.0);
   if (!(smooth_time > 0.0)) throw tools::UsageError("-smooth must be > 0");

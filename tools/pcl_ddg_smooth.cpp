@@ -28,7 +28,7 @@ constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk} output.{ply,pcd,las}\n"
     "         [-method explicit|implicit (default implicit)] [-weights uniform|cotan (default "
     "cotan)]\n"
-    "         [-mass mixed|voronoi|barycentric] [-lambda_dt t (default: implicit 1, explicit half "
+    "         [-area mixed|voronoi|barycentric] [-lambda_dt t (default: implicit 1, explicit half "
     "the stability bound)]\n"
     "         [-iterations n (default 1)] [-absolute_time] [-freeze_weights | -rebuild_weights]\n"
     "         [-fix_boundary] [-allow_unstable]\n"
@@ -38,7 +38,8 @@ int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(
       argc, argv,
-      {"method", "weights", "mass", "lambda_dt", "iterations", "preserve", "solver", "precision"},
+      {"method", "weights", "area", "mass", "lambda_dt", "iterations", "preserve", "solver",
+       "precision"},
       {"absolute_time", "freeze_weights", "rebuild_weights", "fix_boundary", "allow_unstable"});
   MeshSmoothingParameters p;
   p.scheme = args.choice("method", {"explicit", "implicit"}, "implicit") == "explicit"
@@ -47,7 +48,7 @@ int run(int argc, char** argv) {
   p.weights = args.choice("weights", {"uniform", "cotan"}, "cotan") == "uniform"
                   ? LaplacianWeights::Uniform
                   : LaplacianWeights::Cotangent;
-  p.mass = tools::massTypeArgument(args, "mass");
+  p.mass = tools::vertexAreaArgument(args);
   p.iterations = args.integer("iterations", 1);
   if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
   // Default: stiffness frozen at the input, mass updated (see mesh_smoothing.h).

@@ -3,7 +3,9 @@
 namespace pcl_ddg {
 namespace tools {
 
-MassType massTypeArgument(const ToolArguments& args, const std::string& option) {
+MassType vertexAreaArgument(const ToolArguments& args) {
+  if (args.has("area") && args.has("mass")) throw UsageError("-mass is the former name of -area");
+  const std::string option = args.has("mass") ? "mass" : "area";
   const std::string area = args.choice(option, {"mixed", "voronoi", "barycentric"}, "mixed");
   return area == "voronoi"       ? MassType::Voronoi
          : area == "barycentric" ? MassType::Barycentric

@@ -11,8 +11,9 @@
 namespace pcl_ddg {
 namespace tools {
 
-/** A vertex-area option (-area or -mass): mixed|voronoi|barycentric, default mixed. */
-MassType massTypeArgument(const ToolArguments& args, const std::string& option);
+/** -area mixed|voronoi|barycentric (the vertex areas, the mass matrix's diagonal), default
+ *  mixed; pcl_ddg_smooth's former -mass is read as -area (both given: UsageError). */
+MassType vertexAreaArgument(const ToolArguments& args);
 
 struct SolverChoice {
   ImplicitSolver method;
