@@ -183,8 +183,8 @@ TEST(PlaneFit, RandomLinesRoundedToDoubleHaveNoPlaneAndThinPlanesDo) {
   std::vector<double> n[3], variation(kTrials);
   std::vector<std::uint8_t> valid(kTrials);
   for (auto& component : n) component.resize(kTrials);
-  fitPlaneNormals(kTrials, {c[0].data(), c[1].data(), c[2].data(), c[3].data(), c[4].data(),
-                            c[5].data()},
+  fitPlaneNormals(kTrials,
+                  {c[0].data(), c[1].data(), c[2].data(), c[3].data(), c[4].data(), c[5].data()},
                   {n[0].data(), n[1].data(), n[2].data(), variation.data(), valid.data()});
   for (const std::uint8_t v : valid) batched_on_lines += v;
   EXPECT_EQ(planes_on_lines, 0);

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <random>
 
+#include "data_catalogue.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/tiling/tiled_local_fit.h"
 #include "test_data.h"
@@ -63,10 +64,9 @@ void expectTiledEqualsWhole(const Cloud::Ptr& cloud, const LocalFitOptions& opti
 }
 
 TEST(TiledLocalFit, PCAOnEverySharedCloudEqualsTheWholeCloudBitForBit) {
-  for (const char* file :
-       {"clouds/bun0.pcd", "clouds/milk.pcd", "clouds/office1.pcd", "clouds/rs1.pcd",
-        "clouds/table_scene_mug_stereo_textured.pcd", "clouds/terrain_CSite1_red2-utm.pcd",
-        "clouds/tutorials_room_scan1.pcd", "range/bun000.ply"}) {
+  std::vector<std::string> files = {"range/bun000.ply"};
+  for (const SharedCloud& cloud : sharedClouds()) files.push_back(cloud.path);
+  for (const std::string& file : files) {
     SCOPED_TRACE(file);
     const Cloud::Ptr cloud = loadCloud(file);
     LocalFitOptions options;

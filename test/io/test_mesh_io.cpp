@@ -18,6 +18,7 @@
 
 #include <cmath>
 
+#include "data_catalogue.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
 #include "pcl_ddg/io/mesh_io.h"
@@ -30,38 +31,18 @@ namespace pcl_ddg {
 namespace test {
 namespace {
 
-struct CatalogEntry {
-  const char* file;
-  int vertices;
-  int faces;
-};
-
-// Counts from ../shared/data/CATALOG.md.
-const CatalogEntry kCatalog[] = {{"meshes/bumpy.off", 1250, 2496},
-                                 {"meshes/bun045_rangegrid_tri.ply", 40097, 79057},
-                                 {"meshes/bun_zipper.ply", 35947, 69451},
-                                 {"meshes/bun_zipper_res3.ply", 1889, 3851},
-                                 {"meshes/bun_zipper_res4.ply", 453, 948},
-                                 {"meshes/bunny.off", 3485, 6966},
-                                 {"meshes/cow.off", 2762, 5520},
-                                 {"meshes/horse.ply", 48485, 96966},
-                                 {"meshes/igea.ply", 134345, 268686},
-                                 {"meshes/rocker-arm.off", 10044, 20088},
-                                 {"meshes/tum_rabbit.vtk", 10429, 20715},
-                                 {"clouds/bun0.pcd", 397, 0},
-                                 {"clouds/milk.pcd", 13704, 0},
-                                 {"clouds/office1.pcd", 307200, 0},
-                                 {"clouds/rs1.pcd", 289541, 0},
-                                 {"clouds/terrain_CSite1_red2-utm.pcd", 131622, 0},
-                                 {"clouds/table_scene_mug_stereo_textured.pcd", 307200, 0},
-                                 {"clouds/tutorials_room_scan1.pcd", 112586, 0}};
-
 TEST(MeshIO, EverySharedFileLoadsWithItsCatalogCounts) {
-  for (const CatalogEntry& e : kCatalog) {
-    SCOPED_TRACE(e.file);
-    const pcl::PolygonMesh mesh = loadMesh(sharedData(e.file));
+  for (const SharedMesh& e : sharedMeshes()) {
+    SCOPED_TRACE(e.path);
+    const pcl::PolygonMesh mesh = loadMesh(sharedData(e.path));
     EXPECT_EQ(static_cast<int>(mesh.cloud.width * mesh.cloud.height), e.vertices);
     EXPECT_EQ(static_cast<int>(mesh.polygons.size()), e.faces);
+  }
+  for (const SharedCloud& e : sharedClouds()) {
+    SCOPED_TRACE(e.path);
+    const pcl::PolygonMesh cloud = loadMesh(sharedData(e.path));
+    EXPECT_EQ(static_cast<int>(cloud.cloud.width * cloud.cloud.height), e.points);
+    EXPECT_TRUE(cloud.polygons.empty());
   }
 }
 
@@ -154,7 +135,8 @@ void expectPCLReadsTheCoordinates(const std::string& path) {
 }
 
 TEST(MeshIO, PCLReadsFloatCoordinatesFromEveryLoadedSharedFile) {
-  for (const CatalogEntry& e : kCatalog) expectPCLReadsTheCoordinates(sharedData(e.file));
+  for (const SharedMesh& e : sharedMeshes()) expectPCLReadsTheCoordinates(sharedData(e.path));
+  for (const SharedCloud& e : sharedClouds()) expectPCLReadsTheCoordinates(sharedData(e.path));
   expectPCLReadsTheCoordinates(sharedData("range/bun000.ply"));
 }
 

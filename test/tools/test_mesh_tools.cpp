@@ -13,6 +13,7 @@
 #include <cstdio>
 
 #include "analytic_surfaces.h"
+#include "data_catalogue.h"
 #include "estimator_support.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
@@ -24,18 +25,6 @@ namespace pcl_ddg {
 namespace test {
 namespace {
 
-const char* kSharedMeshes[] = {"bumpy.off",
-                               "bun045_rangegrid_tri.ply",
-                               "bun_zipper.ply",
-                               "bun_zipper_res3.ply",
-                               "bun_zipper_res4.ply",
-                               "bunny.off",
-                               "cow.off",
-                               "horse.ply",
-                               "igea.ply",
-                               "rocker-arm.off",
-                               "tum_rabbit.vtk"};
-
 class MeshTools : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -46,10 +35,11 @@ class MeshTools : public ::testing::Test {
 };
 
 TEST_F(MeshTools, NormalsOnEverySharedMeshAreUnitWhereValid) {
-  for (const char* file : kSharedMeshes) {
+  for (const SharedMesh& mesh : sharedMeshes()) {
+    const char* file = mesh.path;
     SCOPED_TRACE(file);
-    const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, sharedData(std::string("meshes/") + file) +
-                                                          " " + path("out.ply") + " -method angle");
+    const ToolRun run =
+        runTool(PCL_DDG_NORMALS_TOOL, sharedData(file) + " " + path("out.ply") + " -method angle");
     ASSERT_EQ(run.exit_code, 0) << run.err;
     const pcl::PolygonMesh out = loadMesh(path("out.ply"));
     const MeshTopology t(out);
@@ -65,17 +55,17 @@ TEST_F(MeshTools, NormalsOnEverySharedMeshAreUnitWhereValid) {
       }
       ASSERT_NEAR(norm, 1.0, 1e-6);
     }
-    EXPECT_GE(invalid, t.counts().unreferenced_vertices);
-    EXPECT_EQ(out.polygons.size(),
-              loadMesh(sharedData(std::string("meshes/") + file)).polygons.size());
+    EXPECT_GE(invalid, mesh.unreferenced_vertices);
+    EXPECT_EQ(static_cast<int>(out.polygons.size()), mesh.faces);
   }
 }
 
 TEST_F(MeshTools, CurvatureOnEverySharedMeshWritesAllFields) {
-  for (const char* file : kSharedMeshes) {
+  for (const SharedMesh& mesh : sharedMeshes()) {
+    const char* file = mesh.path;
     SCOPED_TRACE(file);
-    const ToolRun run = runTool(PCL_DDG_CURVATURE_TOOL, sharedData(std::string("meshes/") + file) +
-                                                            " " + path("out.ply") + " -color mean");
+    const ToolRun run =
+        runTool(PCL_DDG_CURVATURE_TOOL, sharedData(file) + " " + path("out.ply") + " -color mean");
     ASSERT_EQ(run.exit_code, 0) << run.err;
     const pcl::PolygonMesh out = loadMesh(path("out.ply"));
     for (const char* field :
@@ -287,12 +277,13 @@ int checkUnitNormals(const pcl::PCLPointCloud2& cloud, const char* x, const char
 }
 
 TEST_F(MeshTools, FittedNormalsOnEverySharedMesh) {
-  for (const char* file : kSharedMeshes) {
+  for (const SharedMesh& mesh : sharedMeshes()) {
+    const char* file = mesh.path;
     for (const char* options :
          {" -method pca", " -method quadric -neighbours kdtree -radius 2.5h"}) {
       SCOPED_TRACE(std::string(file) + options);
-      const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, sharedData(std::string("meshes/") + file) +
-                                                            " " + path("out.ply") + options);
+      const ToolRun run =
+          runTool(PCL_DDG_NORMALS_TOOL, sharedData(file) + " " + path("out.ply") + options);
       ASSERT_EQ(run.exit_code, 0) << run.err;
       const pcl::PolygonMesh out = loadMesh(path("out.ply"));
       const int invalid = checkUnitNormals(out.cloud, "nx", "ny", "nz");
@@ -303,16 +294,15 @@ TEST_F(MeshTools, FittedNormalsOnEverySharedMesh) {
 }
 
 TEST_F(MeshTools, FittedNormalsOnEverySharedCloud) {
-  for (const char* file :
-       {"bun0.pcd", "milk.pcd", "office1.pcd", "rs1.pcd", "table_scene_mug_stereo_textured.pcd",
-        "terrain_CSite1_red2-utm.pcd", "tutorials_room_scan1.pcd"}) {
+  for (const SharedCloud& cloud : sharedClouds()) {
+    const char* file = cloud.path;
     SCOPED_TRACE(file);
-    const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, sharedData(std::string("clouds/") + file) +
-                                                          " " + path("out.pcd") + " -k 12");
+    const ToolRun run =
+        runTool(PCL_DDG_NORMALS_TOOL, sharedData(file) + " " + path("out.pcd") + " -k 12");
     ASSERT_EQ(run.exit_code, 0) << run.err;
     EXPECT_NE(run.err.find("[done, "), std::string::npos);
     const pcl::PolygonMesh out = loadMesh(path("out.pcd"));
-    const pcl::PolygonMesh input = loadMesh(sharedData(std::string("clouds/") + file));
+    const pcl::PolygonMesh input = loadMesh(sharedData(file));
     const Eigen::Matrix3Xd in = vertexPositions(input.cloud, NonFinitePolicy::Keep);
     EXPECT_EQ(static_cast<Eigen::Index>(out.cloud.width) * out.cloud.height, in.cols())
         << "one normal per point";

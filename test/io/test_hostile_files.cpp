@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "data_catalogue.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -272,9 +273,8 @@ TEST_F(HostileFiles, OnlyRegularFilesAreRead) {
 // Our PCD reader against PCL's on every shared cloud (PCL's is trusted on well-formed files),
 // and on binary_compressed files that PCL's writer makes.
 TEST_F(HostileFiles, PcdReaderAgreesWithPclOnWellFormedFiles) {
-  for (const char* name :
-       {"bun0.pcd", "milk.pcd", "office1.pcd", "rs1.pcd", "table_scene_mug_stereo_textured.pcd",
-        "terrain_CSite1_red2-utm.pcd", "tutorials_room_scan1.pcd"}) {
+  for (const SharedCloud& cloud : sharedClouds()) {
+    const std::string name = std::string(cloud.path).substr(7);  // after clouds/
     SCOPED_TRACE(name);
     pcl::PCLPointCloud2 expected;
     ASSERT_EQ(pcl::PCDReader().read(sharedData(std::string("clouds/") + name), expected), 0);

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "data_catalogue.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/mesh_io.h"
@@ -27,7 +28,6 @@ namespace {
 
 // The shared files that are whole. 1.2-with-color-clipped.las is not: its header claims 1,065
 // points, but 36,405 - 229 bytes hold 1,064 records of 34 (see TruncatedSharedFileIsRefused).
-const char* const kLasFiles[] = {"las/autzen_trim.las", "las/extrabytes.las", "las/test1_4.las"};
 
 std::string readBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -118,12 +118,14 @@ double fieldValue(const pcl::PCLPointCloud2& cloud, std::size_t i, const std::st
 
 // Every coordinate is X * scale + offset in double, and the fields are the records' fields.
 TEST(LasIO, CoordinatesAndFieldsMatchTheSpecificationsOffsets) {
-  for (const char* name : kLasFiles) {
+  for (const SharedCloud& entry : sharedLasFiles()) {
+    const char* name = entry.path;
     const std::string path = sharedData(name);
     const std::string bytes = readBytes(path);
     const SpecHeader h = specHeader(bytes);
     const MeshFile file = readMeshFile(path);
     ASSERT_EQ(static_cast<std::uint64_t>(file.positions.cols()), h.points) << name;
+    ASSERT_EQ(file.positions.cols(), entry.points) << name;
     ASSERT_TRUE(file.las) << name;
     EXPECT_EQ(file.coordinate_precision, FieldPrecision::Double);
     EXPECT_EQ(file.las->point_format, h.format);
@@ -220,7 +222,8 @@ std::string recordBytes(const std::string& b) {
 
 TEST(LasIO, ReadWriteReadIsBitIdenticalForRecordsAndVlrs) {
   const std::string folder = scratchFolder("las_round_trip");
-  for (const char* name : kLasFiles) {
+  for (const SharedCloud& entry : sharedLasFiles()) {
+    const char* name = entry.path;
     const std::string path = sharedData(name);
     const std::string original = readBytes(path);
     const MeshFile file = readMeshFile(path);
@@ -255,7 +258,8 @@ TEST(LasIO, ReadWriteReadIsBitIdenticalForRecordsAndVlrs) {
 // The by-return counts: what the specification's reader counts in the records.
 TEST(LasIO, WrittenCountsByReturnAreTheRecords) {
   const std::string folder = scratchFolder("las_counts");
-  for (const char* name : kLasFiles) {
+  for (const SharedCloud& entry : sharedLasFiles()) {
+    const char* name = entry.path;
     const MeshFile file = readMeshFile(sharedData(name));
     const std::string written = saveLas(folder + "/c.las", asTheToolsSaveIt(file), file.las);
     const SpecHeader h = specHeader(written);

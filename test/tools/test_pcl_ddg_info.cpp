@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "data_catalogue.h"
 #include "test_data.h"
 #include "tool_runner.h"
 
@@ -27,41 +28,21 @@ boost::property_tree::ptree json(const std::string& file) {
   return tree;
 }
 
-struct CatalogRow {
-  const char* file;
-  int vertices, faces, boundary_edges, nonmanifold_edges, duplicate_faces, unused_vertices;
-};
-
-// ../shared/data/CATALOG.md, measured independently of this project.
-const CatalogRow kCatalog[] = {
-    {"bumpy.off", 1250, 2496, 0, 0, 0, 0},
-    {"bun045_rangegrid_tri.ply", 40097, 79057, 1137, 0, 0, 6},
-    {"bun_zipper.ply", 35947, 69451, 223, 0, 0, 1113},
-    {"bun_zipper_res3.ply", 1889, 3851, 60, 141, 83, 2},
-    {"bun_zipper_res4.ply", 453, 948, 26, 70, 40, 0},
-    {"bunny.off", 3485, 6966, 0, 0, 0, 0},
-    {"cow.off", 2762, 5520, 0, 0, 0, 0},
-    {"horse.ply", 48485, 96966, 0, 0, 0, 0},
-    {"igea.ply", 134345, 268686, 0, 0, 0, 0},
-    {"rocker-arm.off", 10044, 20088, 0, 0, 0, 0},
-    {"tum_rabbit.vtk", 10429, 20715, 141, 0, 0, 0},
-};
-
 TEST(PclDdgInfo, JsonMatchesTheCatalogOnEverySharedMesh) {
-  for (const CatalogRow& row : kCatalog) {
-    SCOPED_TRACE(row.file);
-    const auto j = json(sharedData(std::string("meshes/") + row.file));
+  for (const SharedMesh& row : sharedMeshes()) {
+    SCOPED_TRACE(row.path);
+    const auto j = json(sharedData(row.path));
     EXPECT_EQ(j.get<int>("vertices"), row.vertices);
     EXPECT_EQ(j.get<int>("faces"), row.faces);
     EXPECT_EQ(j.get<int>("boundary_edges"), row.boundary_edges);
     EXPECT_EQ(j.get<int>("nonmanifold_edges"), row.nonmanifold_edges);
     EXPECT_EQ(j.get<int>("duplicate_faces"), row.duplicate_faces);
-    EXPECT_EQ(j.get<int>("unreferenced_vertices"), row.unused_vertices);
+    EXPECT_EQ(j.get<int>("unreferenced_vertices"), row.unreferenced_vertices);
     EXPECT_EQ(j.get<int>("out_of_range_faces"), 0);
     EXPECT_GT(j.get<double>("mean_edge_length"), 0.0);
     if (row.boundary_edges == 0 && row.nonmanifold_edges == 0) {
       // Closed scans: chi = 2 - 2g, and the catalogue names rocker-arm as the genus-1 model.
-      const int genus = std::string(row.file) == "rocker-arm.off" ? 1 : 0;
+      const int genus = std::string(row.path) == "meshes/rocker-arm.off" ? 1 : 0;
       EXPECT_EQ(j.get<int>("genus"), genus);
       EXPECT_EQ(j.get<int>("euler_characteristic"), 2 - 2 * genus);
     }

@@ -50,7 +50,8 @@ TEST(RingSurfaceVariation, ShrinksWithTheSquareOfTheEdgeLengthOnASphere) {
 }
 
 TEST(RingSurfaceVariation, IsNaNWithoutAPlane) {
-  // A vertex whose ring is one line (a needle triangle's corners all collinear) and an isolated one.
+  // A vertex whose ring is one line (a needle triangle's corners all collinear) and an isolated
+  // one.
   Eigen::Matrix3Xd p(3, 4);
   p << 0, 1, 2, 5,  //
       0, 0, 0, 5,   //
