@@ -49,6 +49,9 @@ LasCloud parseLAS(std::string_view data);
  *  format has no place for become Extra Bytes dimensions; bounds and counts are recomputed. */
 std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions,
                       const LasLayout* source);
+/** encodeLAS's bytes into the file at path, the records encoded a block at a time
+ *  from the cloud's x, y, z fields: nothing the size of the file is held. */
+void writeLAS(const std::string& path, const pcl::PCLPointCloud2& cloud, const LasLayout* source);
 
 /** How the points of a binary cloud file lie on disk, for reading it a piece at a time. */
 struct BinaryCloudLayout {

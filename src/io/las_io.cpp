@@ -8,12 +8,19 @@
 // size, the format's fields then any extra bytes), and in 1.3/1.4 extended VLRs (60-byte header,
 // 64-bit length) after the points. Everything is little-endian. A coordinate is the record's
 // 32-bit integer X times the header's scale plus its offset, computed in double.
+#include <fcntl.h>
 #include <pcl/common/io.h>
+
+#include <unistd.h>
+#include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <functional>
+#include <future>
 #include <limits>
 #include <sstream>
 
@@ -229,6 +236,98 @@ ExtraType extraType(const char* descriptor, std::size_t index) {
 
 std::uint32_t byteSize(const ExtraType& t) {
   return pcl::getFieldSize(t.datatype) * t.count;
+}
+
+// A dimension whose descriptor sets a scale or an offset (options bits 3 and 4) holds raw values:
+// the value is raw * scale + offset (1 and 0 when unset), a double, per element. Applied to
+// integers of up to 32 bits where doubles resolve every step (as for the coordinates: so that
+// writing (value - offset) / scale gives the raw integer back); other such dimensions stay raw,
+// their descriptor kept.
+struct ExtraScaling {
+  bool scaled = false;
+  double scale[3] = {1.0, 1.0, 1.0}, offset[3] = {0.0, 0.0, 0.0};
+};
+
+ExtraScaling extraScaling(const std::string& descriptor) {
+  ExtraScaling s;
+  const int type = static_cast<std::uint8_t>(descriptor[2]);
+  const int options = static_cast<std::uint8_t>(descriptor[3]);
+  if (type == 0 || type > 30 || (options & 0x18) == 0) return s;
+  const int base = (type - 1) % 10 + 1;  // 1-6: 8 to 32-bit integers
+  if (base > 6) return s;
+  for (int j = 0; j < (type - 1) / 10 + 1; ++j) {  // the dimension's elements only
+    if (options & 0x08) s.scale[j] = get<double>(descriptor.data() + 112 + 8 * j);
+    if (options & 0x10) s.offset[j] = get<double>(descriptor.data() + 136 + 8 * j);
+    const double largest = std::abs(s.offset[j]) + std::abs(s.scale[j]) * 4294967296.0;
+    const double spacing =
+        std::nextafter(largest, std::numeric_limits<double>::infinity()) - largest;
+    if (!std::isfinite(s.scale[j]) || s.scale[j] == 0.0 || !std::isfinite(s.offset[j]) ||
+        !(spacing <= std::abs(s.scale[j]) / 8.0))
+      return ExtraScaling();
+  }
+  s.scaled = true;
+  return s;
+}
+
+double rawValue(const char* p, std::uint8_t datatype) {
+  switch (datatype) {
+    case F::UINT8:
+      return get<std::uint8_t>(p);
+    case F::INT8:
+      return get<std::int8_t>(p);
+    case F::UINT16:
+      return get<std::uint16_t>(p);
+    case F::INT16:
+      return get<std::int16_t>(p);
+    case F::UINT32:
+      return get<std::uint32_t>(p);
+    case F::INT32:
+      return get<std::int32_t>(p);
+    case F::UINT64:
+      return static_cast<double>(get<std::uint64_t>(p));
+    case F::INT64:
+      return static_cast<double>(get<std::int64_t>(p));
+    case F::FLOAT32:
+      return get<float>(p);
+    default:
+      return get<double>(p);
+  }
+}
+
+/** Stores value (already unscaled) in the raw type: integers rounded, within their range. */
+bool putRawValue(char* p, std::uint8_t datatype, double value) {
+  const auto integer = [&](auto type_tag, double lo, double hi) {
+    using T = decltype(type_tag);
+    const double r = std::round(value);
+    if (!(r >= lo && r <= hi)) return false;
+    put(p, static_cast<T>(r));
+    return true;
+  };
+  switch (datatype) {
+    case F::UINT8:
+      return integer(std::uint8_t{}, 0, 255);
+    case F::INT8:
+      return integer(std::int8_t{}, -128, 127);
+    case F::UINT16:
+      return integer(std::uint16_t{}, 0, 65535);
+    case F::INT16:
+      return integer(std::int16_t{}, -32768, 32767);
+    case F::UINT32:
+      return integer(std::uint32_t{}, 0, 4294967295.0);
+    case F::INT32:
+      return integer(std::int32_t{}, -2147483648.0, 2147483647.0);
+    case F::UINT64:  // the doubles that convert exactly
+      return integer(std::uint64_t{}, 0, 18446744073709549568.0);
+    case F::INT64:
+      return integer(std::int64_t{}, -9223372036854775808.0, 9223372036854774784.0);
+    case F::FLOAT32:
+      if (std::isfinite(value) && std::abs(value) > std::numeric_limits<float>::max()) return false;
+      put(p, static_cast<float>(value));
+      return true;
+    default:
+      put(p, value);
+      return true;
+  }
 }
 
 // PDAL's names for normals and curvature in LAS (extra bytes) and ours in clouds (PCD naming).
@@ -475,6 +574,12 @@ LasLayout parseLayout(std::string_view data, HeaderFacts& facts) {
 struct Copy {
   std::uint32_t from, to, size;
 };
+struct Scaled {  // an Extra Bytes dimension with a scale or offset: raw -> double
+  std::uint32_t from, to;
+  std::uint8_t raw_type;
+  std::uint32_t count;
+  ExtraScaling scaling;
+};
 struct Bits {
   std::uint32_t from, to;
   std::uint8_t shift, mask;
@@ -507,6 +612,7 @@ LasCloud parseLAS(std::string_view data) {
   }
   std::vector<Copy> copies;
   std::vector<Bits> bits;
+  std::vector<Scaled> scaled;
   for (const CoreField& core : coreFields(layout.point_format)) {
     cloud.fields.push_back(makeField(core.name, core.datatype, step));
     const std::uint32_t size = pcl::getFieldSize(core.datatype);
@@ -531,10 +637,17 @@ LasCloud parseLAS(std::string_view data) {
     for (int n = 2; taken(name) || name == kLasUndocumentedBytesField; ++n)
       name = base + "_" + std::to_string(n);
     dim.field = name;
-    cloud.fields.push_back(makeField(name, type.datatype, step, type.count));
-    copies.push_back({at, step, byteSize(type)});
+    const ExtraScaling scaling = extraScaling(dim.descriptor);
+    if (scaling.scaled) {
+      cloud.fields.push_back(makeField(name, F::FLOAT64, step, type.count));
+      scaled.push_back({at, step, type.datatype, type.count, scaling});
+      step += 8 * type.count;
+    } else {
+      cloud.fields.push_back(makeField(name, type.datatype, step, type.count));
+      copies.push_back({at, step, byteSize(type)});
+      step += byteSize(type);
+    }
     at += byteSize(type);
-    step += byteSize(type);
   }
   if (layout.undocumented_bytes > 0) {
     cloud.fields.push_back(
@@ -585,6 +698,14 @@ LasCloud parseLAS(std::string_view data) {
     for (const Bits& b : bits)
       point[b.to] = static_cast<std::uint8_t>(
           (static_cast<std::uint8_t>(record[b.from]) >> b.shift) & b.mask);
+    for (const Scaled& e : scaled) {
+      const std::uint32_t size = pcl::getFieldSize(e.raw_type);
+      for (std::uint32_t j = 0; j < e.count; ++j) {
+        const double raw = rawValue(record + e.from + j * size, e.raw_type);
+        put(reinterpret_cast<char*>(point) + e.to + 8 * j,
+            raw * e.scaling.scale[j] + e.scaling.offset[j]);
+      }
+    }
   }
   // A coordinate beyond float's range cannot be held by PCL's point types.
   for (std::int64_t i = 0; i < count; ++i) {
@@ -664,7 +785,8 @@ bool descriptorFits(const std::string& descriptor, const pcl::PCLPointField& fie
   const int type = static_cast<std::uint8_t>(descriptor[2]);
   if (type > 30 || (type == 0 && descriptor[3] == 0)) return false;
   const ExtraType t = extraType(descriptor.data(), 0);
-  return t.datatype == field.datatype && t.count == std::max<std::uint32_t>(field.count, 1);
+  const std::uint8_t held = extraScaling(descriptor).scaled ? std::uint8_t{F::FLOAT64} : t.datatype;
+  return held == field.datatype && t.count == std::max<std::uint32_t>(field.count, 1);
 }
 
 // Where a value of the cloud goes in the record.
@@ -672,6 +794,16 @@ struct Slot {
   const pcl::PCLPointField* field;
   std::uint32_t to;
   std::uint32_t size;
+};
+struct ByteCopy {
+  std::uint32_t from, to, size;
+};
+struct ScaledSlot {  // doubles of the cloud stored as (value - offset) / scale in raw_type
+  const pcl::PCLPointField* field;
+  std::uint32_t to;
+  std::uint8_t raw_type;
+  std::uint32_t count;
+  ExtraScaling scaling;
 };
 struct BitSlot {
   const pcl::PCLPointField* field;  ///< null: the default value
@@ -684,14 +816,36 @@ std::uint8_t byteValue(const std::uint8_t* point, const pcl::PCLPointField& f) {
   return point[f.offset];
 }
 
-}  // namespace
-
-std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions,
-                      const LasLayout* source) {
-  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
-  if (static_cast<std::size_t>(positions.cols()) != n)
-    fail("positions do not match the point count");
+// How a cloud's points become records: the layout to write and where each field goes.
+struct LasPlan {
   LasLayout layout;
+  int format = 0;
+  bool extended = false;
+  std::vector<ByteCopy> copies;              // bytes of the cloud's rows copied as they are
+  std::vector<BitSlot> bit_slots;            // the format's bit fields
+  const pcl::PCLPointField* rank = nullptr;  // scan angle of the other kind (degrees <-> steps)
+  std::uint32_t angle_to = 0;
+  bool convert_colors = false;  // colours of another layout into 16-bit RGB at rgb_to
+  std::uint32_t rgb_to = 0;
+  std::vector<ScaledSlot> scaled;  // Extra Bytes with a scale or offset
+  std::uint64_t record_length = 0;
+  std::size_t standard = 0;  // the public header block's size for the version
+  std::uint64_t header_size = 0, point_offset = 0;
+};
+
+// What the header says of the records: integer bounds and counts by return.
+struct RecordStats {
+  std::array<std::int64_t, 3> lo{}, hi{};
+  bool any = false;
+  std::array<std::uint64_t, 15> by_return{};
+};
+
+/** The plan for writing cloud: source's layout, or LAS 1.4 format 6/7 whose scale and offset are
+ *  chosen from finite_bounds() (called only then). */
+LasPlan planLAS(const pcl::PCLPointCloud2& cloud, const LasLayout* source,
+                const std::function<Eigen::AlignedBox3d()>& finite_bounds) {
+  LasPlan plan;
+  LasLayout& layout = plan.layout;
   if (source != nullptr) {
     layout = *source;
   } else {
@@ -706,13 +860,10 @@ std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& 
          std::to_string(layout.point_format));
   layout.generating_software = padded("pcl_ddg", 32);
   if (source == nullptr) {
+    const Eigen::AlignedBox3d box = finite_bounds();
     for (int d = 0; d < 3; ++d) {
-      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (std::size_t i = 0; i < n; ++i) {
-        const double v = positions(d, static_cast<Eigen::Index>(i));
-        if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
-      }
-      chooseScaleAndOffset(lo, hi, layout.scale[d], layout.offset[d]);
+      chooseScaleAndOffset(box.isEmpty() ? 1.0 : box.min()[d], box.isEmpty() ? 0.0 : box.max()[d],
+                           layout.scale[d], layout.offset[d]);
     }
   }
   requireScale(layout.scale, layout.offset);
@@ -755,10 +906,10 @@ std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& 
   const bool rgb16 = has_rgb && std::count(consumed.begin(), consumed.end(), "red") > 0 &&
                      std::count(consumed.begin(), consumed.end(), "green") > 0 &&
                      std::count(consumed.begin(), consumed.end(), "blue") > 0;
-  VertexColors colors;
+  bool convert_colors = false;
   std::uint32_t rgb_to = 0;
   if (has_rgb && !rgb16 && vertexColorLayout(cloud)) {
-    colors = vertexColors(cloud);
+    convert_colors = true;
     for (const CoreField& core : coreFields(format)) {
       if (std::string(core.name) == "red") rgb_to = core.offset;
     }
@@ -791,8 +942,15 @@ std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& 
         fail("field name '" + f.name + "' is longer than the 32 bytes of an Extra Bytes name");
       dim.descriptor = newDescriptor(las_name, f);
     }
-    const std::uint32_t size = pcl::getFieldSize(f.datatype) * std::max<std::uint32_t>(f.count, 1);
-    extra_slots.push_back({&f, format_size + extra_size, size});
+    std::uint32_t size = pcl::getFieldSize(f.datatype) * std::max<std::uint32_t>(f.count, 1);
+    const ExtraScaling scaling = extraScaling(dim.descriptor);
+    if (scaling.scaled) {  // doubles back into the raw type (a kept descriptor's)
+      const ExtraType raw = extraType(dim.descriptor.data(), 0);
+      size = byteSize(raw);
+      plan.scaled.push_back({&f, format_size + extra_size, raw.datatype, raw.count, scaling});
+    } else {
+      extra_slots.push_back({&f, format_size + extra_size, size});
+    }
     extra_size += size;
     dims.push_back(std::move(dim));
   }
@@ -846,74 +1004,160 @@ std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& 
   if (header_size > std::numeric_limits<std::uint16_t>::max() ||
       point_offset > std::numeric_limits<std::uint32_t>::max())
     fail("the header and VLRs are too large");
-  const std::uint64_t points_end = point_offset + record_length * n;
-  std::uint64_t evlr_bytes = 0;
-  for (const auto& r : layout.evlrs) evlr_bytes += kEvlrHeader + r.data.size();
+  plan.format = format;
+  plan.extended = extended;
+  // Every byte copied as it is (the format's fields, Extra Bytes, undocumented bytes), in runs:
+  // a cloud read from LAS holds them in the record's order, so a record takes a few copies.
+  for (const auto* list : {&slots, &extra_slots}) {
+    for (const Slot& slot : *list) plan.copies.push_back({slot.field->offset, slot.to, slot.size});
+  }
+  if (undocumented != nullptr) {
+    plan.copies.push_back({undocumented->offset,
+                           static_cast<std::uint32_t>(format_size + extra_size),
+                           undocumented_size});
+  }
+  std::sort(plan.copies.begin(), plan.copies.end(),
+            [](const ByteCopy& a, const ByteCopy& b) { return a.to < b.to; });
+  std::vector<ByteCopy> runs;
+  for (const ByteCopy& c : plan.copies) {
+    if (!runs.empty() && runs.back().from + runs.back().size == c.from &&
+        runs.back().to + runs.back().size == c.to) {
+      runs.back().size += c.size;
+    } else {
+      runs.push_back(c);
+    }
+  }
+  plan.copies = std::move(runs);
+  plan.bit_slots = std::move(bit_slots);
+  plan.rank = rank;
+  plan.angle_to = angle_to;
+  plan.convert_colors = convert_colors;
+  plan.rgb_to = rgb_to;
+  plan.record_length = record_length;
+  plan.standard = standard;
+  plan.header_size = header_size;
+  plan.point_offset = point_offset;
+  return plan;
+}
 
-  std::string file(static_cast<std::size_t>(points_end + evlr_bytes), '\0');
-  char* records = file.data() + point_offset;
-
-  // Records, bounds and counts by return.
-  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
-  std::array<std::uint64_t, 15> by_return{};
-  for (std::size_t i = 0; i < n; ++i) {
-    char* record = records + i * record_length;
-    const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
-    for (int d = 0; d < 3; ++d) {
-      const double v = positions(d, static_cast<Eigen::Index>(i));
-      const double q = std::round((v - layout.offset[d]) / layout.scale[d]);
-      if (!std::isfinite(v) || !(q >= -2147483648.0 && q <= 2147483647.0)) {
+/** Encodes point i (record at `record`, zeroed) from the cloud's row and its exact position;
+ *  returns the error for a point LAS cannot hold, empty if none. */
+std::string encodeRecord(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, std::size_t i,
+                         const Eigen::Vector3d& position, const std::uint8_t* color, char* record,
+                         RecordStats& stats) {
+  const LasLayout& layout = plan.layout;
+  const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
+  for (int d = 0; d < 3; ++d) {
+    const double v = position[d];
+    const double x = (v - layout.offset[d]) / layout.scale[d];
+    // std::round inline where |x| fits 32 bits (x - trunc(x) is exact), std::round elsewhere.
+    double q;
+    if (std::abs(x) < 2147483648.0) {
+      const double t = static_cast<double>(static_cast<std::int64_t>(x));
+      q = x - t >= 0.5 ? t + 1.0 : x - t <= -0.5 ? t - 1.0 : t;
+    } else {
+      q = std::round(x);
+    }
+    if (!std::isfinite(v) || !(q >= -2147483648.0 && q <= 2147483647.0)) {
+      std::ostringstream text;
+      text.precision(17);
+      text << "point " << i << ": " << static_cast<char>('x' + d) << " = " << v
+           << (std::isfinite(v) ? " does not fit a 32-bit integer with scale " +
+                                      std::to_string(layout.scale[d]) + " and offset " +
+                                      std::to_string(layout.offset[d])
+                                : " is not finite (LAS stores integers)");
+      return text.str();
+    }
+    const auto X = static_cast<std::int32_t>(q);
+    put(record + 4 * d, X);
+    stats.lo[d] = stats.any ? std::min<std::int64_t>(stats.lo[d], X) : X;
+    stats.hi[d] = stats.any ? std::max<std::int64_t>(stats.hi[d], X) : X;
+  }
+  stats.any = true;
+  for (const ByteCopy& c : plan.copies) std::memcpy(record + c.to, point + c.from, c.size);
+  int return_number = 0;
+  for (const BitSlot& b : plan.bit_slots) {
+    const std::uint8_t v = b.field ? byteValue(point, *b.field) : b.fallback;
+    if ((v >> b.bits) != 0 && b.field != nullptr) {
+      return "point " + std::to_string(i) + ": " + b.field->name + " " + std::to_string(v) +
+             " does not fit point format " + std::to_string(plan.format) + "'s " +
+             std::to_string(b.bits) + " bits" +
+             (b.field->name == "classification" ? " (classes above 31 need formats 6-10)" : "");
+    }
+    record[b.to] = static_cast<char>(static_cast<std::uint8_t>(record[b.to]) | (v << b.shift));
+    if (b.is_return_number) return_number = v;
+  }
+  if (return_number >= 1 && return_number <= 15) ++stats.by_return[return_number - 1];
+  if (plan.rank != nullptr) {
+    const char* from = reinterpret_cast<const char*>(point) + plan.rank->offset;
+    if (plan.extended) {  // degrees -> 0.006 degree steps
+      put(record + plan.angle_to,
+          static_cast<std::int16_t>(std::lround(get<std::int8_t>(from) / 0.006)));
+    } else {
+      put(record + plan.angle_to,
+          static_cast<std::int8_t>(std::lround(get<std::int16_t>(from) * 0.006)));
+    }
+  }
+  for (const ScaledSlot& e : plan.scaled) {
+    const std::uint32_t size = pcl::getFieldSize(e.raw_type);
+    for (std::uint32_t j = 0; j < e.count; ++j) {
+      const double v = get<double>(reinterpret_cast<const char*>(point) + e.field->offset + 8 * j);
+      if (!putRawValue(record + e.to + j * size, e.raw_type,
+                       (v - e.scaling.offset[j]) / e.scaling.scale[j])) {
         std::ostringstream text;
         text.precision(17);
-        text << "point " << i << ": " << static_cast<char>('x' + d) << " = " << v
-             << (std::isfinite(v) ? " does not fit a 32-bit integer with scale " +
-                                        std::to_string(layout.scale[d]) + " and offset " +
-                                        std::to_string(layout.offset[d])
-                                  : " is not finite (LAS stores integers)");
-        fail(text.str());
-      }
-      const auto X = static_cast<std::int32_t>(q);
-      put(record + 4 * d, X);
-      const double stored = X * layout.scale[d] + layout.offset[d];
-      if (i == 0 || stored < lo[d]) lo[d] = stored;
-      if (i == 0 || stored > hi[d]) hi[d] = stored;
-    }
-    for (const Slot& s : slots) std::memcpy(record + s.to, point + s.field->offset, s.size);
-    int return_number = 0;
-    for (const BitSlot& b : bit_slots) {
-      const std::uint8_t v = b.field ? byteValue(point, *b.field) : b.fallback;
-      if ((v >> b.bits) != 0 && b.field != nullptr) {
-        fail("point " + std::to_string(i) + ": " + b.field->name + " " + std::to_string(v) +
-             " does not fit point format " + std::to_string(format) + "'s " +
-             std::to_string(b.bits) + " bits" +
-             (b.field->name == "classification" ? " (classes above 31 need formats 6-10)" : ""));
-      }
-      record[b.to] = static_cast<char>(static_cast<std::uint8_t>(record[b.to]) | (v << b.shift));
-      if (b.is_return_number) return_number = v;
-    }
-    if (return_number >= 1 && return_number <= 15) ++by_return[return_number - 1];
-    if (rank != nullptr) {
-      if (extended) {  // degrees -> 0.006 degree steps
-        const auto r = get<std::int8_t>(reinterpret_cast<const char*>(point) + rank->offset);
-        put(record + angle_to, static_cast<std::int16_t>(std::lround(r / 0.006)));
-      } else {
-        const auto a = get<std::int16_t>(reinterpret_cast<const char*>(point) + rank->offset);
-        put(record + angle_to, static_cast<std::int8_t>(std::lround(a * 0.006)));
+        text << "point " << i << ": " << e.field->name << " = " << v
+             << " does not fit its Extra Bytes type with scale " << e.scaling.scale[j]
+             << " and offset " << e.scaling.offset[j];
+        return text.str();
       }
     }
-    if (colors.cols() > 0) {
-      for (int c = 0; c < 3; ++c)
-        put(record + rgb_to + 2 * c,
-            static_cast<std::uint16_t>(colors(c, static_cast<Eigen::Index>(i)) * 257));
-    }
-    for (const Slot& s : extra_slots) std::memcpy(record + s.to, point + s.field->offset, s.size);
-    if (undocumented)
-      std::memcpy(record + format_size + extra_size, point + undocumented->offset,
-                  undocumented_size);
   }
+  if (color != nullptr) {
+    for (int c = 0; c < 3; ++c)
+      put(record + plan.rgb_to + 2 * c, static_cast<std::uint16_t>(color[c] * 257));
+  }
+  return {};
+}
 
-  // The header.
-  char* h = file.data();
+/** Records [first, first + positions.cols()) into `records` (zeroed); throws for the first point
+ *  LAS cannot hold. One thread: the work is a copy bound by memory, and a second thread made it
+ *  slower on two cores (measured in bench_mesh_io). */
+void encodeRecords(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, std::size_t first,
+                   const Eigen::Matrix3Xd& positions, const VertexColors& colors, char* records,
+                   RecordStats& stats) {
+  for (Eigen::Index j = 0; j < positions.cols(); ++j) {
+    const std::string error =
+        encodeRecord(plan, cloud, first + static_cast<std::size_t>(j), positions.col(j),
+                     colors.cols() > 0 ? colors.data() + 3 * j : nullptr,
+                     records + j * plan.record_length, stats);
+    if (!error.empty()) fail(error);
+  }
+}
+
+/** Where the file's parts go: bytes at an offset. */
+using ByteSink = std::function<void(std::uint64_t at, const char* bytes, std::size_t size)>;
+
+/** Writes the header, VLRs and EVLRs of a file of n records with these stats (the records
+ *  themselves are written by the caller). */
+void writeHeaderAndRecords(const LasPlan& plan, std::size_t n, const RecordStats& stats,
+                           const ByteSink& sink) {
+  const LasLayout& layout = plan.layout;
+  const int format = plan.format;
+  const std::uint64_t points_end = plan.point_offset + plan.record_length * n;
+  // Bounds from the integers (x = X * scale + offset is monotonic in X).
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
+  for (int d = 0; d < 3 && stats.any; ++d) {
+    const double a = static_cast<double>(static_cast<std::int32_t>(stats.lo[d])) * layout.scale[d] +
+                     layout.offset[d],
+                 b = static_cast<double>(static_cast<std::int32_t>(stats.hi[d])) * layout.scale[d] +
+                     layout.offset[d];
+    lo[d] = std::min(a, b);
+    hi[d] = std::max(a, b);
+  }
+  const auto& by_return = stats.by_return;
+  std::string header(static_cast<std::size_t>(plan.point_offset), '\0');
+  char* h = header.data();
   std::memcpy(h, "LASF", 4);
   put(h + 4, layout.file_source_id);
   put(h + 6, layout.global_encoding);
@@ -924,15 +1168,15 @@ std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& 
   std::memcpy(h + 58, padded(layout.generating_software, 32).data(), 32);
   put(h + 90, layout.creation_day);
   put(h + 92, layout.creation_year);
-  put(h + 94, static_cast<std::uint16_t>(header_size));
-  put(h + 96, static_cast<std::uint32_t>(point_offset));
+  put(h + 94, static_cast<std::uint16_t>(plan.header_size));
+  put(h + 96, static_cast<std::uint32_t>(plan.point_offset));
   put(h + 100, static_cast<std::uint32_t>(layout.vlrs.size()));
   h[104] = static_cast<char>(format);
-  put(h + 105, static_cast<std::uint16_t>(record_length));
+  put(h + 105, static_cast<std::uint16_t>(plan.record_length));
   // Legacy counts: always below 1.4; in 1.4 for formats 0-5 when they fit, zero for 6-10.
   if (layout.version_minor < 4 && n > 0xffffffffu)
     fail(std::to_string(n) + " points need LAS 1.4 (64-bit counts)");
-  if (layout.version_minor < 4 || (!extended && n <= 0xffffffffu)) {
+  if (layout.version_minor < 4 || (!plan.extended && n <= 0xffffffffu)) {
     put(h + 107, static_cast<std::uint32_t>(n));
     for (int r = 0; r < 5; ++r) put(h + 111 + 4 * r, static_cast<std::uint32_t>(by_return[r]));
   }
@@ -947,14 +1191,16 @@ std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& 
   for (std::size_t k = 0; k < layout.evlrs.size(); ++k) {
     const auto& r = layout.evlrs[k];
     if (static_cast<int>(k) == layout.waveform_evlr) waveform_start = at;
-    char* p = file.data() + at;
+    std::string e(kEvlrHeader + r.data.size(), '\0');
+    char* p = e.data();
     put(p, r.reserved);
     std::memcpy(p + 2, padded(r.user_id, 16).data(), 16);
     put(p + 18, r.record_id);
     put(p + 20, static_cast<std::uint64_t>(r.data.size()));
     std::memcpy(p + 28, padded(r.description, 32).data(), 32);
     std::memcpy(p + kEvlrHeader, r.data.data(), r.data.size());
-    at += kEvlrHeader + r.data.size();
+    sink(at, e.data(), e.size());
+    at += e.size();
   }
   if (layout.version_minor >= 3) put(h + 227, waveform_start);
   if (layout.version_minor >= 4) {
@@ -963,10 +1209,10 @@ std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& 
     put(h + 247, static_cast<std::uint64_t>(n));
     for (int r = 0; r < 15; ++r) put(h + 255 + 8 * r, by_return[r]);
   }
-  std::memcpy(h + standard, layout.header_extra.data(), layout.header_extra.size());
-  std::uint64_t p = header_size;
+  std::memcpy(h + plan.standard, layout.header_extra.data(), layout.header_extra.size());
+  std::uint64_t p = plan.header_size;
   for (const auto& r : layout.vlrs) {
-    char* v = file.data() + p;
+    char* v = header.data() + p;
     put(v, r.reserved);
     std::memcpy(v + 2, padded(r.user_id, 16).data(), 16);
     put(v + 18, r.record_id);
@@ -975,8 +1221,130 @@ std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& 
     std::memcpy(v + kVlrHeader, r.data.data(), r.data.size());
     p += kVlrHeader + r.data.size();
   }
-  std::memcpy(file.data() + p, layout.after_vlrs.data(), layout.after_vlrs.size());
+  std::memcpy(header.data() + p, layout.after_vlrs.data(), layout.after_vlrs.size());
+  sink(0, header.data(), header.size());
+}
+
+// Points encoded at once by writeLAS: a few MB of records, reused.
+constexpr std::size_t kBlockPoints = 1 << 18;
+
+Eigen::AlignedBox3d finiteBounds(const Eigen::Matrix3Xd& positions) {
+  Eigen::AlignedBox3d box;
+  for (Eigen::Index i = 0; i < positions.cols(); ++i)
+    if (positions.col(i).allFinite()) box.extend(Eigen::Vector3d(positions.col(i)));
+  return box;
+}
+
+/** The rows [first, first + count) of cloud as a cloud of their own. */
+pcl::PCLPointCloud2 rowsOf(const pcl::PCLPointCloud2& cloud, std::size_t first, std::size_t count) {
+  pcl::PCLPointCloud2 block;
+  block.fields = cloud.fields;
+  block.point_step = cloud.point_step;
+  block.is_bigendian = cloud.is_bigendian;
+  block.width = static_cast<std::uint32_t>(count);
+  block.height = 1;
+  block.row_step = block.point_step * block.width;
+  const auto* from = cloud.data.data() + first * cloud.point_step;
+  block.data.assign(from, from + count * cloud.point_step);
+  return block;
+}
+
+/** The exact coordinates of rows [first, first + count): read in place from float or double
+ *  fields, through a copy of the rows for any other type. */
+Eigen::Matrix3Xd blockPositions(const pcl::PCLPointCloud2& cloud, std::size_t first,
+                                std::size_t count) {
+  const pcl::PCLPointField* xyz[3] = {findField(cloud, "x"), findField(cloud, "y"),
+                                      findField(cloud, "z")};
+  const auto same = [&](std::uint8_t type) {
+    return std::all_of(xyz, xyz + 3,
+                       [&](const pcl::PCLPointField* f) { return f && f->datatype == type; });
+  };
+  if (!same(F::FLOAT64) && !same(F::FLOAT32))
+    return vertexPositions(rowsOf(cloud, first, count), NonFinitePolicy::Keep);
+  Eigen::Matrix3Xd positions(3, static_cast<Eigen::Index>(count));
+  const bool doubles = same(F::FLOAT64);
+  for (std::size_t i = 0; i < count; ++i) {
+    const char* row =
+        reinterpret_cast<const char*>(cloud.data.data()) + (first + i) * cloud.point_step;
+    for (int d = 0; d < 3; ++d) {
+      positions(d, static_cast<Eigen::Index>(i)) =
+          doubles ? get<double>(row + xyz[d]->offset) : get<float>(row + xyz[d]->offset);
+    }
+  }
+  return positions;
+}
+
+}  // namespace
+
+std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions,
+                      const LasLayout* source) {
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  if (static_cast<std::size_t>(positions.cols()) != n)
+    fail("positions do not match the point count");
+  const LasPlan plan = planLAS(cloud, source, [&] { return finiteBounds(positions); });
+  std::uint64_t evlr_bytes = 0;
+  for (const auto& r : plan.layout.evlrs) evlr_bytes += kEvlrHeader + r.data.size();
+  std::string file(
+      static_cast<std::size_t>(plan.point_offset + plan.record_length * n + evlr_bytes), '\0');
+  const VertexColors colors = plan.convert_colors ? vertexColors(cloud) : VertexColors();
+  RecordStats stats;
+  encodeRecords(plan, cloud, 0, positions, colors, file.data() + plan.point_offset, stats);
+  writeHeaderAndRecords(plan, n, stats, [&](std::uint64_t at, const char* bytes, std::size_t size) {
+    std::memcpy(file.data() + at, bytes, size);
+  });
   return file;
+}
+
+void writeLAS(const std::string& path, const pcl::PCLPointCloud2& cloud, const LasLayout* source) {
+  const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+  const LasPlan plan = planLAS(cloud, source, [&] {
+    Eigen::AlignedBox3d box;
+    for (std::size_t first = 0; first < n; first += kBlockPoints)
+      box.extend(finiteBounds(blockPositions(cloud, first, std::min(kBlockPoints, n - first))));
+    return box;
+  });
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw FileFormatException("cannot write '" + path + "': " + std::strerror(errno));
+  struct Closer {
+    int fd;
+    ~Closer() {
+      if (fd >= 0) ::close(fd);
+    }
+  } closer{fd};
+  const ByteSink sink = [&](std::uint64_t at, const char* bytes, std::size_t size) {
+    for (std::size_t done = 0; done < size;) {
+      const ssize_t w = ::pwrite(fd, bytes + done, size - done, static_cast<off_t>(at + done));
+      if (w < 0 && errno == EINTR) continue;
+      if (w <= 0) {
+        throw FileFormatException("cannot write '" + path +
+                                  "': " + std::strerror(w < 0 ? errno : ENOSPC));
+      }
+      done += static_cast<std::size_t>(w);
+    }
+  };
+  // The records a block at a time after the header's place, then the header with their stats.
+  // Each block is written by another thread while the next is encoded (two buffers in turn): the
+  // kernel's copy into the page cache costs about as much as the encoding.
+  RecordStats stats;
+  std::vector<char> buffers[2];
+  std::future<void> writing;
+  for (std::size_t first = 0, block = 0; first < n; first += kBlockPoints, ++block) {
+    const std::size_t count = std::min(kBlockPoints, n - first);
+    const Eigen::Matrix3Xd positions = blockPositions(cloud, first, count);
+    const VertexColors colors =
+        plan.convert_colors ? vertexColors(rowsOf(cloud, first, count)) : VertexColors();
+    std::vector<char>& records = buffers[block % 2];  // its last write was waited for below
+    records.assign(count * plan.record_length, '\0');
+    encodeRecords(plan, cloud, first, positions, colors, records.data(), stats);
+    if (writing.valid()) writing.get();
+    writing = std::async(std::launch::async, sink, plan.point_offset + first * plan.record_length,
+                         records.data(), records.size());
+  }
+  if (writing.valid()) writing.get();
+  writeHeaderAndRecords(plan, n, stats, sink);
+  closer.fd = -1;
+  if (::close(fd) != 0)
+    throw FileFormatException("cannot write '" + path + "': " + std::strerror(errno));
 }
 
 }  // namespace detail

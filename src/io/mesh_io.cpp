@@ -141,9 +141,7 @@ void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh,
     }
     AtomicFile file(path);
     if (ext == "las") {
-      writeBytes(file.temporaryPath(),
-                 detail::encodeLAS(mesh.cloud, vertexPositions(mesh.cloud, NonFinitePolicy::Keep),
-                                   options.las.get()));
+      detail::writeLAS(file.temporaryPath(), mesh.cloud, options.las.get());
     } else if (ext == "ply") {
       savePLY(file.temporaryPath(), mesh, options.ply_encoding);
     } else {

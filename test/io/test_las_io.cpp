@@ -220,6 +220,54 @@ std::string recordBytes(const std::string& b) {
   return b.substr(h.point_offset, h.points * h.record_length);
 }
 
+// LAS 1.4 R15 (Extra Bytes descriptor, options bits 3 and 4): value = raw * scale + offset. The
+// shared file's Intensity dimension (uint32 at record byte 49) given a scale and an offset, and its
+// Time dimension (uint64) one too, which doubles cannot invert exactly: it stays raw.
+TEST(LasIO, ScaledExtraBytesAreRawTimesScalePlusOffset) {
+  const std::string folder = scratchFolder("las_scaled_extra_bytes");
+  std::string bytes = readBytes(sharedData("las/extrabytes.las"));
+  for (const std::size_t d : {375 + 54 + 3 * 192, 375 + 54 + 4 * 192}) {
+    bytes[d + 3] = static_cast<char>(bytes[d + 3] | 0x18);
+    setAt<double>(bytes, d + 112, 0.01);
+    setAt<double>(bytes, d + 136, -5.0);
+  }
+  std::ofstream(folder + "/a.las", std::ios::binary) << bytes;
+  const MeshFile a = readMeshFile(folder + "/a.las");
+  const pcl::PCLPointCloud2& cloud = a.mesh.cloud;
+  const auto field = [&](const std::string& name) {
+    return *std::find_if(cloud.fields.begin(), cloud.fields.end(),
+                         [&](const pcl::PCLPointField& f) { return f.name == name; });
+  };
+  ASSERT_EQ(field("Intensity").datatype, pcl::PCLPointField::FLOAT64);
+  EXPECT_EQ(field("Time").datatype, pcl::PCLPointField::UINT64);
+  const SpecHeader h = specHeader(bytes);
+  for (std::uint64_t i = 0; i < h.points; ++i) {
+    const std::uint32_t raw = at<std::uint32_t>(bytes, h.point_offset + i * h.record_length + 49);
+    ASSERT_EQ(fieldValue(cloud, i, "Intensity"), raw * 0.01 + -5.0) << "point " << i;
+  }
+  // Written back: the same records and VLRs, bit for bit.
+  pcl::PolygonMesh mesh = asTheToolsSaveIt(a);
+  std::string written = saveLas(folder + "/a2.las", mesh, a.las);
+  EXPECT_EQ(vlrBytes(written), vlrBytes(bytes));
+  EXPECT_EQ(recordBytes(written), recordBytes(bytes));
+  // A new value is stored as round((value - offset) / scale); one beyond uint32 is refused.
+  const auto setIntensity = [&](double value) {  // point 0's, in the cloud with double x y z
+    for (const auto& f : mesh.cloud.fields)
+      if (f.name == "Intensity") std::memcpy(mesh.cloud.data.data() + f.offset, &value, 8);
+  };
+  setIntensity(123 * 0.01 - 5.0);
+  written = saveLas(folder + "/a3.las", mesh, a.las);
+  EXPECT_EQ(at<std::uint32_t>(written, specHeader(written).point_offset + 49), 123u);
+  setIntensity(-6.0);
+  EXPECT_THROW(saveMesh(folder + "/a4.las", mesh,
+                        [&] {
+                          MeshWriteOptions o;
+                          o.las = a.las;
+                          return o;
+                        }()),
+               FileFormatException);
+}
+
 TEST(LasIO, ReadWriteReadIsBitIdenticalForRecordsAndVlrs) {
   const std::string folder = scratchFolder("las_round_trip");
   for (const SharedCloud& entry : sharedLasFiles()) {
