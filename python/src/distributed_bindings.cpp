@@ -490,7 +490,7 @@ std::int64_t writeOutput(const std::vector<std::string>& inputs, const std::stri
   if (!whole) {
     file = std::make_unique<AtomicFile>(output);
     out = std::make_unique<CloudPieceWriter>(
-        file->temporaryPath(), ext == "ply", total, static_cast<std::uint32_t>(width),
+        file->temporaryPath(), ext, total, static_cast<std::uint32_t>(width),
         static_cast<std::uint32_t>(height), layouts[0].sensor_pose);
   }
   std::int64_t at = first_result;

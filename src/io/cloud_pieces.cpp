@@ -111,6 +111,11 @@ CloudPieceReader::CloudPieceReader(const std::string& path)
       throw FileFormatException(path + ": cannot read its header");
     layout_.width = static_cast<std::uint32_t>(layout_.points);
     layout_.height = 1;
+    try {  // the layout, from the header and VLRs as a file of no points
+      las_ = std::make_shared<const LasLayout>(detail::parseLAS(f.headerFor(0)).layout);
+    } catch (const pcl::PCLException& e) {
+      throw FileFormatException(path + ": " + errorDescription(e));
+    }
     return;
   }
   // A header is read from the file's first 64 KiB, or 4 MiB when it is longer (many comments).
@@ -148,6 +153,10 @@ const CloudFileLayout& CloudPieceReader::layout() const {
   return layout_;
 }
 
+const std::shared_ptr<const LasLayout>& CloudPieceReader::lasLayout() const {
+  return las_;
+}
+
 CloudPiece CloudPieceReader::read(std::int64_t first, std::int64_t count) {
   if (first < 0 || count < 0 || first > layout_.points || count > layout_.points - first) {
     throw pcl::BadArgumentException(path_ + ": points " + std::to_string(first) + ".." +
@@ -179,19 +188,41 @@ CloudPiece CloudPieceReader::read(std::int64_t first, std::int64_t count) {
   return piece;
 }
 
-CloudPieceWriter::CloudPieceWriter(const std::string& path, bool ply, std::int64_t points,
-                                   std::uint32_t width, std::uint32_t height,
-                                   const SensorPose& sensor_pose)
-    : ply_(ply),
+struct CloudPieceWriter::Las {
+  Las(const std::string& path, const LasLayout& layout) : writer(path, layout) {}
+  detail::LasPieceWriter writer;
+};
+
+CloudPieceWriter::CloudPieceWriter(const std::string& path, const std::string& format,
+                                   std::int64_t points, std::uint32_t width, std::uint32_t height,
+                                   const SensorPose& sensor_pose,
+                                   const std::shared_ptr<const LasLayout>& las)
+    : ply_(format == "ply"),
       points_(points),
       width_(width),
       height_(height),
-      sensor_pose_(sensor_pose),
-      out_(path, std::ios::binary) {
+      sensor_pose_(sensor_pose) {
+  if (format != "ply" && format != "pcd" && format != "las")
+    throw FileFormatException(path + ": pieces are written as .ply, .pcd or .las");
+  if (format == "las") {
+    if (!las) {
+      throw FileFormatException(
+          "a .las output written in pieces keeps a LAS input's layout: the input is not LAS");
+    }
+    las_ = std::make_unique<Las>(path, *las);
+    return;
+  }
+  out_.open(path, std::ios::binary);
   if (!out_) failSystem("cannot write " + path);
 }
 
+CloudPieceWriter::~CloudPieceWriter() = default;
+
 void CloudPieceWriter::write(pcl::PCLPointCloud2& piece) {
+  if (las_) {
+    las_->writer.write(piece);
+    return;
+  }
   // Colours in the format's layout and no padding in a PCD, as saveMesh writes them.
   const ColorLayout colors = ply_ ? ColorLayout::Channels : ColorLayout::PackedRGB;
   const auto current = vertexColorLayout(piece);
@@ -231,6 +262,10 @@ void CloudPieceWriter::write(pcl::PCLPointCloud2& piece) {
 }
 
 void CloudPieceWriter::close() {
+  if (las_) {
+    las_->writer.close();
+    return;
+  }
   out_.close();
   if (!out_) failSystem("cannot write the output");
 }

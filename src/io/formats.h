@@ -5,6 +5,7 @@
 #include <pcl/PolygonMesh.h>
 
 #include <limits>
+#include <memory>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -52,6 +53,25 @@ std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& 
 /** encodeLAS's bytes into the file at path, the records encoded a block at a time
  *  from the cloud's x, y, z fields: nothing the size of the file is held. */
 void writeLAS(const std::string& path, const pcl::PCLPointCloud2& cloud, const LasLayout* source);
+
+/** A LAS file written a piece of points at a time (the out-of-core path): source's layout (version,
+ *  point format, scale, offset, VLRs and EVLRs; the Extra Bytes planned from the first piece's
+ *  fields, which every piece must have), the header's counts and bounds written at close(). The
+ *  bytes are writeLAS's for the same points at once. */
+class LasPieceWriter {
+ public:
+  LasPieceWriter(const std::string& path, const LasLayout& source);
+  ~LasPieceWriter();
+  LasPieceWriter(const LasPieceWriter&) = delete;
+  LasPieceWriter& operator=(const LasPieceWriter&) = delete;
+  void write(const pcl::PCLPointCloud2& piece);
+  void close();
+
+ private:
+  struct State;
+  LasLayout source_;
+  std::unique_ptr<State> state_;
+};
 
 /** How the points of a binary cloud file lie on disk, for reading it a piece at a time. */
 struct BinaryCloudLayout {

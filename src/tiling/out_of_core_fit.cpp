@@ -194,9 +194,13 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
                                       const ResultFields& add_fields) {
   if (options.neighbourhood != NeighbourhoodKind::KdTree)
     throw pcl::BadArgumentException("a cloud out of core is fitted with kd-tree neighbourhoods");
-  if (fileExtension(output) != "ply" && fileExtension(output) != "pcd")
-    throw FileFormatException(output + ": the output must be .ply or .pcd");
+  const std::string output_format = fileExtension(output);
+  if (output_format != "ply" && output_format != "pcd" && output_format != "las")
+    throw FileFormatException(output + ": the output must be .ply, .pcd or .las");
   CloudPieceReader pieces(input);
+  if (output_format == "las" && !pieces.lasLayout())
+    throw FileFormatException(output +
+                              ": a .las output out of core needs a .las input (its layout)");
   const CloudFileLayout& layout = pieces.layout();
   OutOfCoreReport report;
   report.points = layout.points;
@@ -308,8 +312,8 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
 
   // 5. The input's pieces with the results beside them.
   AtomicFile file(output);
-  CloudPieceWriter out(file.temporaryPath(), fileExtension(output) == "ply", layout.points,
-                       layout.width, layout.height, layout.sensor_pose);
+  CloudPieceWriter out(file.temporaryPath(), output_format, layout.points, layout.width,
+                       layout.height, layout.sensor_pose, pieces.lasLayout());
   forEachPiece([&](std::int64_t first, CloudPiece& piece) {
     add_fields(piece, results.get(first, piece.positions.cols()));
     out.write(piece.cloud);

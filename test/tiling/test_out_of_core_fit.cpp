@@ -31,17 +31,18 @@ class OutOfCore : public ::testing::Test {
   std::string path(const std::string& name) const { return dir_ + "/" + name; }
   // The tool in memory and out of core on the same input: the outputs must be the same bytes.
   void expectSameOutput(const std::string& input, const std::string& options,
-                        const std::string& memory, const char* tool = PCL_DDG_NORMALS_TOOL) {
-    SCOPED_TRACE(input + options);
+                        const std::string& memory, const char* tool = PCL_DDG_NORMALS_TOOL,
+                        const std::string& ext = "ply") {
+    SCOPED_TRACE(input + options + " -> ." + ext);
     // Out of core is the kd-tree's path; in memory an organized cloud would take the grid.
     const ToolRun whole =
-        runTool(tool, input + " " + path("whole.ply") + " " + options + " -neighbours kdtree");
+        runTool(tool, input + " " + path("whole." + ext) + " " + options + " -neighbours kdtree");
     ASSERT_EQ(whole.exit_code, 0) << whole.err;
     const ToolRun tiled =
-        runTool(tool, input + " " + path("tiled.ply") + " " + options + " -memory " + memory);
+        runTool(tool, input + " " + path("tiled." + ext) + " " + options + " -memory " + memory);
     ASSERT_EQ(tiled.exit_code, 0) << tiled.err;
     EXPECT_NE(tiled.err.find("out of core"), std::string::npos) << tiled.err;
-    EXPECT_TRUE(fileBytes(path("whole.ply")) == fileBytes(path("tiled.ply")))
+    EXPECT_TRUE(fileBytes(path("whole." + ext)) == fileBytes(path("tiled." + ext)))
         << "out of core differs from in memory\n"
         << tiled.err;
   }
@@ -73,6 +74,10 @@ TEST_F(OutOfCore, EverySharedCloudGivesTheInMemoryOutputByteForByte) {
   expectSameOutput(sharedData("las/autzen_trim.las"), "-k 16", "4M");
   expectSameOutput(sharedData("las/test1_4.las"), "-method quadric -k 12", "2M",
                    PCL_DDG_CURVATURE_TOOL);
+  // ... and written as LAS in the input's layout (normals as Extra Bytes), from pieces.
+  expectSameOutput(sharedData("las/autzen_trim.las"), "-k 16", "4M", PCL_DDG_NORMALS_TOOL, "las");
+  expectSameOutput(sharedData("las/extrabytes.las"), "-method quadric -k 12", "2M",
+                   PCL_DDG_CURVATURE_TOOL, "las");
   expectNoScratchLeft();
 }
 
@@ -111,6 +116,12 @@ TEST_F(OutOfCore, InputsThatCannotBeReadInPiecesAndBadOptionsAreRefused) {
     EXPECT_NE(run.err.find(message), std::string::npos) << run.err;
     EXPECT_FALSE(std::filesystem::exists(path("out.ply")));
   }
+  // A .las output in pieces keeps a LAS input's layout (scale and offset): none from a PLY.
+  saveMesh(path("in.ply"), loadMesh(sharedData("clouds/bun0.pcd")));
+  const ToolRun to_las = runTool(normals, path("in.ply") + " " + path("out.las") + " -memory 64M");
+  EXPECT_EQ(to_las.exit_code, 1);
+  EXPECT_NE(to_las.err.find("needs a .las input"), std::string::npos) << to_las.err;
+  EXPECT_FALSE(std::filesystem::exists(path("out.las")));
   for (const char* options : {"-memory lots", "-memory 0", "-memory 1k", "-memory 64M -radius 2h",
                               "-memory 64M -method area", "-memory 64M -neighbours rings"}) {
     EXPECT_EQ(

@@ -366,7 +366,7 @@ int fitEachInputOutOfCore(const char* tool_name, const ToolArguments& args,
                           const LocalFitOptions& options, FieldPrecision precision,
                           const PieceFields& add) {
   memoryArgument(args);  // checked before any file is read
-  return forEachInput(args, tool_name, {"ply", "pcd"},
+  return forEachInput(args, tool_name, {"ply", "pcd", "las"},
                       [&](const std::string& input, const std::string& output) {
                         fitOutOfCore(tool_name, args, input, output, options,
                                      outOfCoreFields(output, precision, add));

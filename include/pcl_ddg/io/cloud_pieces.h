@@ -6,7 +6,8 @@
  * be, so every value converts exactly as it does when the file is read at once.
  *
  * Read: binary PCD (uncompressed), binary PLY clouds (one vertex element, no faces) and LAS 1.0-1.4
- * without EVLRs. Written: binary PCD or binary PLY, by extension, with the header of the whole.
+ * without EVLRs. Written: binary PCD, binary PLY, or LAS in the layout of a LAS input, with the
+ * header of the whole.
  */
 #include <pcl/PCLPointCloud2.h>
 
@@ -17,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 
@@ -48,6 +50,8 @@ class CloudPieceReader {
   CloudPieceReader& operator=(const CloudPieceReader&) = delete;
 
   const CloudFileLayout& layout() const;
+  /** A LAS file's layout (version, point format, scale, offset, VLRs); null for other formats. */
+  const std::shared_ptr<const LasLayout>& lasLayout() const;
   /** pcl::BadArgumentException when the range is not in the file. */
   CloudPiece read(std::int64_t first, std::int64_t count);
 
@@ -57,22 +61,30 @@ class CloudPieceReader {
   std::ifstream in_;
   CloudFileLayout layout_;
   std::unique_ptr<Format> format_;
+  std::shared_ptr<const LasLayout> las_;
 };
 
 /** Writes a cloud of `points` points a piece at a time into `path` (the caller's temporary file:
- *  see atomic_file.h): binary PLY when `ply`, else binary PCD, as saveMesh writes them (colours
- *  in the format's layout, no padding fields in a PCD). The first piece's fields make the header;
- *  every piece must have them. */
+ *  see atomic_file.h) in `format` ("ply", "pcd" or "las"), as saveMesh writes it: binary PLY,
+ *  binary PCD (colours in the format's layout, no padding fields), or LAS in the layout `las`
+ *  (required for "las": a LAS input's, whose scale and offset hold the points). The first piece's
+ *  fields make the header; every piece must have them. */
 class CloudPieceWriter {
  public:
-  CloudPieceWriter(const std::string& path, bool ply, std::int64_t points, std::uint32_t width,
-                   std::uint32_t height, const SensorPose& sensor_pose);
+  CloudPieceWriter(const std::string& path, const std::string& format, std::int64_t points,
+                   std::uint32_t width, std::uint32_t height, const SensorPose& sensor_pose,
+                   const std::shared_ptr<const LasLayout>& las = nullptr);
+  ~CloudPieceWriter();
+  CloudPieceWriter(const CloudPieceWriter&) = delete;
+  CloudPieceWriter& operator=(const CloudPieceWriter&) = delete;
   void write(pcl::PCLPointCloud2& piece);
   /** Flushes and closes; FileFormatException when the output could not be written. */
   void close();
 
  private:
+  struct Las;
   bool ply_;
+  std::unique_ptr<Las> las_;  ///< set for a LAS output
   std::int64_t points_;
   std::uint32_t width_, height_;
   SensorPose sensor_pose_;
