@@ -642,16 +642,17 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
         options["viewpoint"] = list(clouds[0].viewpoint)
     if merge is None:
         names = [os.path.basename(c.path) for c in clouds]
-        if not output_format and any(n.lower().endswith(".las") for n in names):
-            output_format = "ply"  # LAS output (the input's VLRs, scale, offset) is the tool's
         if output_format:
             names = [os.path.splitext(n)[0] + "." + output_format.lstrip(".") for n in names]
         if len(set(names)) != len(names):
             raise ValueError("two inputs have the same file name: give --merge FILE")
         outputs = [os.path.join(output_dir, n) for n in names]
     else:
-        if os.path.splitext(merge)[1].lower() not in (".ply", ".pcd"):
-            raise ValueError(f"--merge {merge}: the output must be .ply or .pcd")
+        if os.path.splitext(merge)[1].lower() not in (".ply", ".pcd", ".las"):
+            raise ValueError(f"--merge {merge}: the output must be .ply, .pcd or .las")
+        if merge.lower().endswith(".las") and not clouds[0].path.lower().endswith(".las"):
+            raise ValueError(f"--merge {merge}: a .las output keeps a LAS input's layout "
+                             "(scale, offset, VLRs): the inputs are not LAS")
         outputs = [merge]
     os.makedirs(output_dir, exist_ok=True)
     state = os.path.join(output_dir, STATE_FOLDER, tool)
@@ -788,7 +789,7 @@ def estimate_normals(inputs, output_dir, client=None, **options) -> Dict[str, An
 
     options: method ("pca"|"quadric"), k, radius, max_nn, viewpoint, orient ("viewpoint"|"up"),
     up, precision ("float"|"double"), merge (one output file) or one file per input in
-    output_dir (``output_format`` "ply"|"pcd" to change it), memory_per_worker ("2G"), retries
+    output_dir (``output_format`` "ply"|"pcd"|"las" to change it), memory_per_worker ("2G"), retries
     (3), resume (True: tiles whose results and checksum are complete are skipped),
     threads_per_worker (1), progress (False: a progress line on stderr).
 
@@ -949,7 +950,7 @@ def _parser(tool: str) -> argparse.ArgumentParser:
     p.add_argument("--memory-per-worker", default="2G")
     p.add_argument("--retries", type=int, default=3)
     p.add_argument("--merge", metavar="FILE", help="one output file in the inputs' order")
-    p.add_argument("--format", choices=["ply", "pcd"], help="per-input outputs' format")
+    p.add_argument("--format", choices=["ply", "pcd", "las"], help="per-input outputs' format")
     p.add_argument("--resume", action=argparse.BooleanOptionalAction, default=True)
     p.add_argument("--allow-mixed-crs", action="store_true")
     p.add_argument("--connect-timeout", type=float, default=5.0)

@@ -448,17 +448,18 @@ void addFields(CloudPiece& input, const std::string& output, const std::string& 
 }
 
 /**
- * Writes `output` (binary PLY or PCD): the points of `inputs`, in their order, each with its
- * fields and the fit's (the results file holds `floats` float32 per point of the concatenated
- * inputs, from point `first_result` on), as the tool writes the merged cloud. Atomic.
+ * Writes `output` (binary PLY or PCD, or LAS in the first input's layout): the points of `inputs`,
+ * in their order, each with its fields and the fit's (the results file holds `floats` float32 per
+ * point of the concatenated inputs, from point `first_result` on), as the tool writes the merged
+ * cloud. Atomic.
  */
 std::int64_t writeOutput(const std::vector<std::string>& inputs, const std::string& output,
                          const std::string& results_path, std::int64_t first_result, int floats,
                          const std::string& tool, const std::string& precision_name,
                          std::int64_t piece_points, bool stream_pcd) {
   const std::string ext = fileExtension(output);
-  if (ext != "ply" && ext != "pcd")
-    throw FileFormatException(output + ": the output must be .ply or .pcd");
+  if (ext != "ply" && ext != "pcd" && ext != "las")
+    throw FileFormatException(output + ": the output must be .ply, .pcd or .las");
   choice("tool", tool, {"normals", "curvature"});
   const FieldPrecision precision =
       choice("precision", precision_name, {"float", "double"}) == "double" ? FieldPrecision::Double
@@ -466,8 +467,11 @@ std::int64_t writeOutput(const std::vector<std::string>& inputs, const std::stri
   py::gil_scoped_release release;
   std::int64_t total = 0;
   std::vector<CloudFileLayout> layouts;
+  std::shared_ptr<const LasLayout> las;  // a LAS output keeps the first input's layout
   for (const std::string& input : inputs) {
-    layouts.push_back(CloudPieceReader(input).layout());
+    const CloudPieceReader reader(input);
+    if (layouts.empty()) las = reader.lasLayout();
+    layouts.push_back(reader.layout());
     total += layouts.back().points;
   }
   if (inputs.empty()) throw pcl::BadArgumentException("no input");
@@ -491,7 +495,7 @@ std::int64_t writeOutput(const std::vector<std::string>& inputs, const std::stri
     file = std::make_unique<AtomicFile>(output);
     out = std::make_unique<CloudPieceWriter>(
         file->temporaryPath(), ext, total, static_cast<std::uint32_t>(width),
-        static_cast<std::uint32_t>(height), layouts[0].sensor_pose);
+        static_cast<std::uint32_t>(height), layouts[0].sensor_pose, las);
   }
   std::int64_t at = first_result;
   std::vector<float> records;
