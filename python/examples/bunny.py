@@ -57,15 +57,27 @@ def main(out_folder):
         print("matplotlib not installed: no picture")
         return 0
     os.makedirs(out_folder, exist_ok=True)
-    figure = plt.figure(figsize=(10, 5))
-    ax = figure.add_subplot(1, 2, 1, projection="3d")
-    ax.scatter(V[:, 0], V[:, 2], V[:, 1], c=np.clip(smooth_mean, lo, hi), cmap="coolwarm", s=1)
-    ax.set_title("mean curvature (heat-smoothed)")
-    ax = figure.add_subplot(1, 2, 2, projection="3d")
-    step = max(1, V.shape[0] // 2000)
-    P, N = V[::step], faces.normals[::step]
-    ax.quiver(P[:, 0], P[:, 2], P[:, 1], N[:, 0], N[:, 2], N[:, 1], length=0.005)
-    ax.set_title("area-weighted vertex normals")
+    # Plotted with y up (the scan's up axis), the same view and equal axes in both panels.
+    X, Y, Z = V[:, 0], V[:, 2], V[:, 1]
+    figure = plt.figure(figsize=(11, 5.5))
+    for panel in (1, 2):
+        ax = figure.add_subplot(1, 2, panel, projection="3d")
+        ax.set_box_aspect((np.ptp(X), np.ptp(Y), np.ptp(Z)))
+        ax.view_init(elev=15, azim=-70)
+        ax.set_axis_off()
+        if panel == 1:
+            points = ax.scatter(X, Y, Z, c=np.clip(smooth_mean, lo, hi), cmap="coolwarm", s=4)
+            figure.colorbar(points, ax=ax, shrink=0.6, label="mean curvature H (1 / length)")
+            ax.set_title("mean curvature (cotan, heat-smoothed)")
+        else:
+            # Every few vertices' normal, 1.2 mean edge lengths long.
+            step = max(1, V.shape[0] // 350)
+            P, N = V[::step], faces.normals[::step]
+            ax.scatter(X, Y, Z, c="lightgray", s=2)
+            ax.quiver(P[:, 0], P[:, 2], P[:, 1], N[:, 0], N[:, 2], N[:, 1],
+                      length=1.2 * report["mean_edge_length"], color="tab:blue", linewidth=0.6)
+            ax.set_title("area-weighted vertex normals")
+    figure.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.92, wspace=0.05)
     path = os.path.join(out_folder, "bunny_curvature.png")
     figure.savefig(path, dpi=100)
     print(f"wrote {path}")

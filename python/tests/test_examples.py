@@ -1,5 +1,6 @@
 """The examples in python/examples run (each in a subprocess, writing into a temporary folder)."""
 
+import importlib.util
 import subprocess
 import sys
 from pathlib import Path
@@ -15,6 +16,14 @@ def test_example_runs(example, tmp_path):
                             text=True, timeout=600)
     assert result.returncode == 0, result.stdout + result.stderr
     assert result.stdout.strip()
+    # Every picture an example says it wrote is there; with matplotlib (Debian's, installed by the
+    # README's test command) the bunny example draws one.
+    written = [line.split(" ", 1)[1] for line in result.stdout.splitlines()
+               if line.startswith("wrote ")]
+    for path in written:
+        assert Path(path).stat().st_size > 10000, path
+    if example.name == "bunny.py" and importlib.util.find_spec("matplotlib"):
+        assert any(path.endswith(".png") for path in written), result.stdout
 
 
 def test_there_are_examples():
