@@ -80,7 +80,7 @@ TEST(TiledLocalFit, PCAOnEverySharedCloudEqualsTheWholeCloudBitForBit) {
     std::printf(
         "%s: %zu points, %zu tiles, %lld halo growths, %lld far points, at most %lld "
         "gathered\n",
-        file, cloud->size(), report.tiles, static_cast<long long>(report.halo_growths),
+        file.c_str(), cloud->size(), report.tiles, static_cast<long long>(report.halo_growths),
         static_cast<long long>(report.far_points), static_cast<long long>(report.largest_gather));
   }
 }
