@@ -326,28 +326,26 @@ def _intersects(lo: np.ndarray, hi: np.ndarray, box: Sequence[float]) -> bool:
 # A tile, on a worker
 
 
-def _peak_bytes() -> int:
-    """This process's peak resident memory (VmHWM)."""
+def _status_bytes(key: str, default: int) -> int:
+    """A memory line of /proc/self/status (in kB there) in bytes; default where it cannot be read."""
     try:
         with open("/proc/self/status") as f:
             for line in f:
-                if line.startswith("VmHWM:"):
+                if line.startswith(key + ":"):
                     return int(line.split()[1]) * 1024
     except OSError:
         pass
-    return 0
+    return default
+
+
+def _peak_bytes() -> int:
+    """This process's peak resident memory (VmHWM)."""
+    return _status_bytes("VmHWM", 0)
 
 
 def _resident_bytes() -> int:
     """This process's resident memory now (VmRSS)."""
-    try:
-        with open("/proc/self/status") as f:
-            for line in f:
-                if line.startswith("VmRSS:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return WORKER_BASELINE_BYTES
+    return _status_bytes("VmRSS", WORKER_BASELINE_BYTES)
 
 
 def _gather(plan: Plan, paths: List[str], firsts: List[int], lo: np.ndarray, hi: np.ndarray,

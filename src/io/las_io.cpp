@@ -1295,6 +1295,23 @@ std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& 
   return file;
 }
 
+namespace {
+
+void pwriteAll(int fd, const std::string& path, std::uint64_t at, const char* bytes,
+               std::size_t size) {
+  for (std::size_t done = 0; done < size;) {
+    const ssize_t w = ::pwrite(fd, bytes + done, size - done, static_cast<off_t>(at + done));
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) {
+      throw FileFormatException("cannot write '" + path +
+                                "': " + std::strerror(w < 0 ? errno : ENOSPC));
+    }
+    done += static_cast<std::size_t>(w);
+  }
+}
+
+}  // namespace
+
 void writeLAS(const std::string& path, const pcl::PCLPointCloud2& cloud, const LasLayout* source) {
   const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
   const LasPlan plan = planLAS(cloud, source, [&] {
@@ -1312,15 +1329,7 @@ void writeLAS(const std::string& path, const pcl::PCLPointCloud2& cloud, const L
     }
   } closer{fd};
   const ByteSink sink = [&](std::uint64_t at, const char* bytes, std::size_t size) {
-    for (std::size_t done = 0; done < size;) {
-      const ssize_t w = ::pwrite(fd, bytes + done, size - done, static_cast<off_t>(at + done));
-      if (w < 0 && errno == EINTR) continue;
-      if (w <= 0) {
-        throw FileFormatException("cannot write '" + path +
-                                  "': " + std::strerror(w < 0 ? errno : ENOSPC));
-      }
-      done += static_cast<std::size_t>(w);
-    }
+    pwriteAll(fd, path, at, bytes, size);
   };
   // The records a block at a time after the header's place, then the header with their stats.
   // Each block is written by another thread while the next is encoded (two buffers in turn): the
@@ -1367,23 +1376,6 @@ LasPieceWriter::LasPieceWriter(const std::string& path, const LasLayout& source)
 LasPieceWriter::~LasPieceWriter() {
   if (state_->fd >= 0) ::close(state_->fd);
 }
-
-namespace {
-
-void pwriteAll(int fd, const std::string& path, std::uint64_t at, const char* bytes,
-               std::size_t size) {
-  for (std::size_t done = 0; done < size;) {
-    const ssize_t w = ::pwrite(fd, bytes + done, size - done, static_cast<off_t>(at + done));
-    if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) {
-      throw FileFormatException("cannot write '" + path +
-                                "': " + std::strerror(w < 0 ? errno : ENOSPC));
-    }
-    done += static_cast<std::size_t>(w);
-  }
-}
-
-}  // namespace
 
 void LasPieceWriter::write(const pcl::PCLPointCloud2& piece) {
   State& s = *state_;

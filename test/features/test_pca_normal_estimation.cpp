@@ -80,34 +80,7 @@ TEST(PCANormals, ConvergeAtFirstOrderOnAJitteredTorusCloud) {
 }
 
 TEST(PCANormals, FirstOrderOnEveryAnalyticSurfaceAndExactOnThePlane) {
-  struct Case {
-    const char* name;
-    SurfaceSample (*make)(int);
-  };
-  const Case cases[] = {
-      {"plane",
-       [](int r) {
-         return makePlane({r, 0.25, 3});
-       }},
-      {"sphere", [](int r) { return makeIcosphere(r == 32 ? 4 : 5, 1.0, 0.25, 3); }},
-      {"cylinder",
-       [](int r) {
-         return makeCylinder({2 * r, 0.25, 3});
-       }},
-      {"torus",
-       [](int r) {
-         return makeTorus({2 * r, 0.25, 3});
-       }},
-      {"saddle",
-       [](int r) {
-         return makeSaddle({r, 0.25, 3});
-       }},
-      {"paraboloid",
-       [](int r) {
-         return makeParaboloid({r, 0.25, 3});
-       }},
-  };
-  for (const Case& c : cases) {
+  for (const SurfaceFamily& c : analyticSurfaceFamilies(0.25, 3)) {
     double error[2];
     for (int i = 0; i < 2; ++i) {
       // Scaled by 100 about the origin before the shift, so float coordinates resolve the sampling.

@@ -128,35 +128,8 @@ TEST(QuadricNormals, ConvergeAtSecondOrderOnAJitteredTorusCloud) {
 }
 
 TEST(QuadricNormals, SecondOrderOnEveryAnalyticSurfaceAndAsAccurateFarFromTheOrigin) {
-  struct Case {
-    const char* name;
-    SurfaceSample (*make)(int);
-  };
-  const Case cases[] = {
-      {"plane",
-       [](int r) {
-         return makePlane({r, 0.1, 3});
-       }},
-      {"sphere", [](int r) { return makeIcosphere(r == 32 ? 4 : 5, 1.0, 0.1, 3); }},
-      {"cylinder",
-       [](int r) {
-         return makeCylinder({2 * r, 0.1, 3});
-       }},
-      {"torus",
-       [](int r) {
-         return makeTorus({2 * r, 0.1, 3});
-       }},
-      {"saddle",
-       [](int r) {
-         return makeSaddle({r, 0.1, 3});
-       }},
-      {"paraboloid",
-       [](int r) {
-         return makeParaboloid({r, 0.1, 3});
-       }},
-  };
   const Eigen::Isometry3d rotation(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
-  for (const Case& c : cases) {
+  for (const SurfaceFamily& c : analyticSurfaceFamilies(0.1, 3)) {
     // Orders near the origin, where float coordinates resolve a unit surface to 1e-7.
     double error[2];
     for (int i = 0; i < 2; ++i) {

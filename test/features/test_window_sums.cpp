@@ -18,23 +18,40 @@ namespace {
 
 using detail::WindowSums;
 
-/** The covariance (divided by the count) of the finite points of the window, in two passes. */
+/** The covariance (divided by the count) of the finite points of the window, in two passes over
+ *  the window. Plain arithmetic, no copy: the brute force runs for every pixel, under the
+ *  sanitizers too, where Eigen's small expressions are not inlined. */
 Eigen::Matrix3d twoPassCovariance(const pcl::PointCloud<pcl::PointXYZ>& cloud, int x, int y,
                                   int radius, int& count) {
-  std::vector<Eigen::Vector3d> points;
-  for (int v = std::max(0, y - radius); v <= std::min<int>(cloud.height - 1, y + radius); ++v) {
-    for (int u = std::max(0, x - radius); u <= std::min<int>(cloud.width - 1, x + radius); ++u) {
-      const pcl::PointXYZ& p = cloud.at(u, v);
-      if (pcl::isXYZFinite(p)) points.push_back(p.getVector3fMap().cast<double>());
+  const int u0 = std::max(0, x - radius), u1 = std::min<int>(cloud.width - 1, x + radius);
+  const int v0 = std::max(0, y - radius), v1 = std::min<int>(cloud.height - 1, y + radius);
+  const auto forEachPoint = [&](const auto& visit) {
+    for (int v = v0; v <= v1; ++v) {
+      for (int u = u0; u <= u1; ++u) {
+        const pcl::PointXYZ& p = cloud.at(u, v);
+        if (pcl::isXYZFinite(p)) visit(double{p.x}, double{p.y}, double{p.z});
+      }
     }
-  }
-  count = static_cast<int>(points.size());
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (const auto& p : points) mean += p;
-  mean /= std::max(count, 1);
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const auto& p : points) covariance += (p - mean) * (p - mean).transpose();
-  return covariance / std::max(count, 1);
+  };
+  count = 0;
+  double mean[3] = {0.0, 0.0, 0.0};
+  forEachPoint([&](double px, double py, double pz) {
+    mean[0] += px;
+    mean[1] += py;
+    mean[2] += pz;
+    ++count;
+  });
+  for (double& m : mean) m /= std::max(count, 1);
+  double c[3][3] = {};
+  forEachPoint([&](double px, double py, double pz) {
+    const double d[3] = {px - mean[0], py - mean[1], pz - mean[2]};
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) c[r][k] += d[r] * d[k];
+  });
+  Eigen::Matrix3d covariance;
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) covariance(r, k) = c[r][k] / std::max(count, 1);
+  return covariance;
 }
 
 void expectSumsEqualTwoPass(const pcl::PointCloud<pcl::PointXYZ>& cloud, int radius) {

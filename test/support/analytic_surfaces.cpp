@@ -233,6 +233,32 @@ SurfaceSample makeParaboloid(const Sampling& sampling, double a) {
   return graphSurface(sampling, a, 1);
 }
 
+std::vector<SurfaceFamily> analyticSurfaceFamilies(double jitter, std::uint32_t seed) {
+  return {
+      {"plane",
+       [=](int r) {
+         return makePlane({r, jitter, seed});
+       }},
+      {"sphere", [=](int r) { return makeIcosphere(r == 32 ? 4 : 5, 1.0, jitter, seed); }},
+      {"cylinder",
+       [=](int r) {
+         return makeCylinder({2 * r, jitter, seed});
+       }},
+      {"torus",
+       [=](int r) {
+         return makeTorus({2 * r, jitter, seed});
+       }},
+      {"saddle",
+       [=](int r) {
+         return makeSaddle({r, jitter, seed});
+       }},
+      {"paraboloid",
+       [=](int r) {
+         return makeParaboloid({r, jitter, seed});
+       }},
+  };
+}
+
 SurfaceSample makeIcosphere(int level, double radius, double jitter, std::uint32_t seed) {
   const double g = (1.0 + std::sqrt(5.0)) / 2.0;
   std::vector<Eigen::Vector3d> v = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0},

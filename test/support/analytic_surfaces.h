@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <functional>
+#include <vector>
 
 namespace pcl_ddg {
 namespace test {
@@ -55,6 +57,16 @@ SurfaceSample makeTorus(const Sampling& sampling, double major = 1.0, double min
 SurfaceSample makeSaddle(const Sampling& sampling, double a = 0.5);
 /** Paraboloid z = a (x^2 + y^2) over [-1,1]^2. */
 SurfaceSample makeParaboloid(const Sampling& sampling, double a = 0.5);
+
+/** One surface of the convergence tests, made at a resolution of 32 or 64. */
+struct SurfaceFamily {
+  const char* name;
+  std::function<SurfaceSample(int resolution)> make;
+};
+/** Plane, sphere, cylinder, torus, saddle and paraboloid with the same jitter and seed, sampled so
+ *  that resolutions 32 and 64 give about 1k and 4k points (the sphere: icosphere levels 4 and 5;
+ *  the closed cylinder and torus twice as many columns). */
+std::vector<SurfaceFamily> analyticSurfaceFamilies(double jitter, std::uint32_t seed);
 
 }  // namespace test
 }  // namespace pcl_ddg
