@@ -80,31 +80,6 @@ void checkSignals(int, int) {
   if (PyErr_CheckSignals() != 0) throw py::error_already_set();
 }
 
-// The values of a column-major matrix whose pattern is symmetric (every Laplacian of the library)
-// in row order: row v of L has the pattern of column v, so the CSR arrays are the matrix's own
-// indices and offsets, and only the values move, each found by a binary search in its column.
-// The values are L's, bit for bit.
-std::vector<double> rowOrderValues(const Eigen::SparseMatrix<double>& columns) {
-  const auto n = static_cast<int>(columns.outerSize());
-  const int* outer = columns.outerIndexPtr();
-  const int* inner = columns.innerIndexPtr();
-  const double* values = columns.valuePtr();
-  std::vector<double> row_values(static_cast<std::size_t>(columns.nonZeros()));
-  // Columns in ascending order meet the rows of every column in ascending order too: a cursor per
-  // column finds where entry (row, column) goes in row `row` without a search.
-  std::vector<int> cursor(outer, outer + n);
-  for (int column = 0; column < n; ++column) {
-    for (int k = outer[column]; k < outer[column + 1]; ++k) {
-      const int row = inner[k];
-      const int at = cursor[row]++;
-      if (at >= outer[row + 1] || inner[at] != column)
-        throw std::logic_error("the Laplacian's pattern is not symmetric");
-      row_values[static_cast<std::size_t>(at)] = values[k];
-    }
-  }
-  return row_values;
-}
-
 }  // namespace
 
 void bindMeshes(py::module_& m) {
@@ -150,20 +125,16 @@ void bindMeshes(py::module_& m) {
                                     : LaplacianForm::Summed;
         const MassType type = massOf(mass);
         Mesh mesh = meshOf(V, F);
-        // The library's time alone; the CSR conversion is the binding's overhead.
-        Eigen::SparseMatrix<double> l =
-            compute([&] { return laplacian(mesh.topology, mesh.positions, w, f, type); });
-        std::vector<double> values = [&] {
-          py::gil_scoped_release release;
-          return rowOrderValues(l);
-        }();
-        // indices and indptr are the matrix's own arrays, kept alive by one capsule.
-        auto* matrix = new Eigen::SparseMatrix<double>(std::move(l));
-        py::capsule owner(matrix,
-                          [](void* p) { delete static_cast<Eigen::SparseMatrix<double>*>(p); });
+        // Compressed rows straight from the library: the arrays are scipy's CSR as they are,
+        // kept alive by one capsule.
+        auto* matrix = new Eigen::SparseMatrix<double, Eigen::RowMajor>(compute(
+            [&] { return laplacian<Eigen::RowMajor>(mesh.topology, mesh.positions, w, f, type); }));
+        py::capsule owner(matrix, [](void* p) {
+          delete static_cast<Eigen::SparseMatrix<double, Eigen::RowMajor>*>(p);
+        });
         const auto nnz = static_cast<py::ssize_t>(matrix->nonZeros());
         const auto rows = static_cast<py::ssize_t>(matrix->outerSize());
-        return py::make_tuple(vectorArray(std::move(values)),
+        return py::make_tuple(py::array_t<double>({nnz}, matrix->valuePtr(), owner),
                               py::array_t<int>({nnz}, matrix->innerIndexPtr(), owner),
                               py::array_t<int>({rows + 1}, matrix->outerIndexPtr(), owner));
       },

@@ -835,10 +835,30 @@ struct LasPlan {
 
 // What the header says of the records: integer bounds and counts by return.
 struct RecordStats {
-  std::array<std::int64_t, 3> lo{}, hi{};
+  static constexpr std::int64_t kMax = std::numeric_limits<std::int64_t>::max();
+  std::array<std::int64_t, 3> lo{kMax, kMax, kMax}, hi{-kMax, -kMax, -kMax};
   bool any = false;
   std::array<std::uint64_t, 15> by_return{};
 };
+
+/** size bytes in fixed-size moves: a memcpy of a size unknown at compile time is a call, and a
+ *  record takes several such copies. */
+inline void copyBytes(char* to, const std::uint8_t* from, std::uint32_t size) {
+  for (; size >= 8; size -= 8, to += 8, from += 8) std::memcpy(to, from, 8);
+  if (size >= 4) {
+    std::memcpy(to, from, 4);
+    to += 4;
+    from += 4;
+    size -= 4;
+  }
+  if (size >= 2) {
+    std::memcpy(to, from, 2);
+    to += 2;
+    from += 2;
+    size -= 2;
+  }
+  if (size != 0) *to = static_cast<char>(*from);
+}
 
 /** The plan for writing cloud: source's layout, or LAS 1.4 format 6/7 whose scale and offset are
  *  chosen from finite_bounds() (called only then). */
@@ -1041,10 +1061,10 @@ LasPlan planLAS(const pcl::PCLPointCloud2& cloud, const LasLayout* source,
 }
 
 /** Encodes point i (record at `record`, zeroed) from the cloud's row and its exact position;
- *  returns the error for a point LAS cannot hold, empty if none. */
-std::string encodeRecord(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, std::size_t i,
-                         const Eigen::Vector3d& position, const std::uint8_t* color, char* record,
-                         RecordStats& stats) {
+ *  false, and why in `error`, for a point LAS cannot hold. */
+bool encodeRecord(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, std::size_t i,
+                  const double* position, const std::uint8_t* color, char* record,
+                  RecordStats& stats, std::string& error) {
   const LasLayout& layout = plan.layout;
   const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
   for (int d = 0; d < 3; ++d) {
@@ -1066,23 +1086,25 @@ std::string encodeRecord(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, 
                                       std::to_string(layout.scale[d]) + " and offset " +
                                       std::to_string(layout.offset[d])
                                 : " is not finite (LAS stores integers)");
-      return text.str();
+      error = text.str();
+      return false;
     }
     const auto X = static_cast<std::int32_t>(q);
     put(record + 4 * d, X);
-    stats.lo[d] = stats.any ? std::min<std::int64_t>(stats.lo[d], X) : X;
-    stats.hi[d] = stats.any ? std::max<std::int64_t>(stats.hi[d], X) : X;
+    stats.lo[d] = std::min<std::int64_t>(stats.lo[d], X);
+    stats.hi[d] = std::max<std::int64_t>(stats.hi[d], X);
   }
   stats.any = true;
-  for (const ByteCopy& c : plan.copies) std::memcpy(record + c.to, point + c.from, c.size);
+  for (const ByteCopy& c : plan.copies) copyBytes(record + c.to, point + c.from, c.size);
   int return_number = 0;
   for (const BitSlot& b : plan.bit_slots) {
     const std::uint8_t v = b.field ? byteValue(point, *b.field) : b.fallback;
     if ((v >> b.bits) != 0 && b.field != nullptr) {
-      return "point " + std::to_string(i) + ": " + b.field->name + " " + std::to_string(v) +
-             " does not fit point format " + std::to_string(plan.format) + "'s " +
-             std::to_string(b.bits) + " bits" +
-             (b.field->name == "classification" ? " (classes above 31 need formats 6-10)" : "");
+      error = "point " + std::to_string(i) + ": " + b.field->name + " " + std::to_string(v) +
+              " does not fit point format " + std::to_string(plan.format) + "'s " +
+              std::to_string(b.bits) + " bits" +
+              (b.field->name == "classification" ? " (classes above 31 need formats 6-10)" : "");
+      return false;
     }
     record[b.to] = static_cast<char>(static_cast<std::uint8_t>(record[b.to]) | (v << b.shift));
     if (b.is_return_number) return_number = v;
@@ -1109,7 +1131,8 @@ std::string encodeRecord(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, 
         text << "point " << i << ": " << e.field->name << " = " << v
              << " does not fit its Extra Bytes type with scale " << e.scaling.scale[j]
              << " and offset " << e.scaling.offset[j];
-        return text.str();
+        error = text.str();
+        return false;
       }
     }
   }
@@ -1117,7 +1140,7 @@ std::string encodeRecord(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, 
     for (int c = 0; c < 3; ++c)
       put(record + plan.rgb_to + 2 * c, static_cast<std::uint16_t>(color[c] * 257));
   }
-  return {};
+  return true;
 }
 
 /** Records [first, first + positions.cols()) into `records` (zeroed); throws for the first point
@@ -1126,12 +1149,12 @@ std::string encodeRecord(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, 
 void encodeRecords(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, std::size_t first,
                    const Eigen::Matrix3Xd& positions, const VertexColors& colors, char* records,
                    RecordStats& stats) {
+  std::string error;
   for (Eigen::Index j = 0; j < positions.cols(); ++j) {
-    const std::string error =
-        encodeRecord(plan, cloud, first + static_cast<std::size_t>(j), positions.col(j),
-                     colors.cols() > 0 ? colors.data() + 3 * j : nullptr,
-                     records + j * plan.record_length, stats);
-    if (!error.empty()) fail(error);
+    if (!encodeRecord(plan, cloud, first + static_cast<std::size_t>(j), positions.col(j).data(),
+                      colors.cols() > 0 ? colors.data() + 3 * j : nullptr,
+                      records + j * plan.record_length, stats, error))
+      fail(error);
   }
 }
 

@@ -5,11 +5,13 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
 
 #include "analytic_surfaces.h"
+#include "data_catalogue.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -149,6 +151,42 @@ TEST(Laplacian, RowsSumToZeroAndSummedFormIsSymmetric) {
                 1e-9 * averaged.cwiseAbs().sum() / l.cols());
     }
   }
+}
+
+// Both ends of an edge add the same cotangents in the same order, so the summed L is its own
+// transpose bit for bit, and its compressed rows (what the Python module hands scipy as CSR) are
+// the same matrix as its compressed columns, for both weights and forms: on every shared mesh,
+// with its boundaries, non-manifold edges and duplicate faces.
+TEST(Laplacian, SummedIsItsOwnTransposeBitForBitAndRowStorageIsTheSameMatrix) {
+  const auto same = [](const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix<double>& b) {
+    return a.nonZeros() == b.nonZeros() &&
+           std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1,
+                      b.outerIndexPtr()) &&
+           std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr()) &&
+           std::equal(a.valuePtr(), a.valuePtr() + a.nonZeros(), b.valuePtr());
+  };
+  int meshes = 0;
+  for (const SharedMesh& row : sharedMeshes()) {
+    SCOPED_TRACE(row.path);
+    const MeshFile file = readMeshFile(sharedData(row.path));
+    ASSERT_TRUE(file.positions.allFinite());
+    const MeshTopology topology(file.mesh, OutOfRangeFacePolicy::Drop);
+    for (auto w : {LaplacianWeights::Uniform, LaplacianWeights::Cotangent}) {
+      for (auto form : {LaplacianForm::Summed, LaplacianForm::Averaged}) {
+        const Eigen::SparseMatrix<double> columns = laplacian(topology, file.positions, w, form);
+        // Eigen's conversion between storage orders is a transposition by counting.
+        const Eigen::SparseMatrix<double> rows =
+            laplacian<Eigen::RowMajor>(topology, file.positions, w, form);
+        EXPECT_TRUE(same(rows, columns)) << static_cast<int>(w) << " " << static_cast<int>(form);
+        if (form == LaplacianForm::Summed) {
+          const Eigen::SparseMatrix<double> transpose = columns.transpose();
+          EXPECT_TRUE(same(transpose, columns)) << static_cast<int>(w);
+        }
+      }
+    }
+    ++meshes;
+  }
+  EXPECT_EQ(meshes, static_cast<int>(sharedMeshes().size()));
 }
 
 TEST(Laplacian, UniformWeightsAreTheGraph) {

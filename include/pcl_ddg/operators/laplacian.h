@@ -28,13 +28,22 @@ enum class LaplacianForm { Summed, Averaged };
 
 /**
  * Assembles L (pattern: the mesh graph plus the diagonal, built straight into compressed storage;
- * OpenMP over rows). Throws InvalidMeshException on non-finite or mismatched positions.
+ * OpenMP over vertices). Throws InvalidMeshException on non-finite or mismatched positions.
+ *
+ * The summed L equals its transpose bit for bit (both ends of an edge add the same cotangents in
+ * the same order), so its compressed columns are its compressed rows.
+ * \tparam Storage Eigen::ColMajor (compressed columns, Eigen's default) or Eigen::RowMajor
+ *         (compressed rows, scipy's CSR): the same matrix, bit for bit, without a transposition.
  */
-Eigen::SparseMatrix<double> laplacian(const MeshTopology& topology,
-                                      const Eigen::Matrix3Xd& positions,
-                                      LaplacianWeights weights = LaplacianWeights::Cotangent,
-                                      LaplacianForm form = LaplacianForm::Summed,
-                                      MassType mass = MassType::MixedVoronoi);
+template <int Storage = Eigen::ColMajor>
+Eigen::SparseMatrix<double, Storage> laplacian(
+    const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+    LaplacianWeights weights = LaplacianWeights::Cotangent,
+    LaplacianForm form = LaplacianForm::Summed, MassType mass = MassType::MixedVoronoi);
+extern template Eigen::SparseMatrix<double, Eigen::ColMajor> laplacian<Eigen::ColMajor>(
+    const MeshTopology&, const Eigen::Matrix3Xd&, LaplacianWeights, LaplacianForm, MassType);
+extern template Eigen::SparseMatrix<double, Eigen::RowMajor> laplacian<Eigen::RowMajor>(
+    const MeshTopology&, const Eigen::Matrix3Xd&, LaplacianWeights, LaplacianForm, MassType);
 
 /** The summed cotangent Laplacian. */
 Eigen::SparseMatrix<double> cotangentLaplacian(const MeshTopology& topology,
