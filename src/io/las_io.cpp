@@ -10,6 +10,7 @@
 // 32-bit integer X times the header's scale plus its offset, computed in double.
 #include <fcntl.h>
 #include <pcl/common/io.h>
+#include <sys/mman.h>
 
 #include <unistd.h>
 #include <Eigen/Geometry>
@@ -19,8 +20,8 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <functional>
-#include <future>
 #include <limits>
 #include <sstream>
 
@@ -839,6 +840,15 @@ struct RecordStats {
   std::array<std::int64_t, 3> lo{kMax, kMax, kMax}, hi{-kMax, -kMax, -kMax};
   bool any = false;
   std::array<std::uint64_t, 15> by_return{};
+
+  void add(const RecordStats& other) {
+    for (int d = 0; d < 3; ++d) {
+      lo[d] = std::min(lo[d], other.lo[d]);
+      hi[d] = std::max(hi[d], other.hi[d]);
+    }
+    any = any || other.any;
+    for (std::size_t r = 0; r < by_return.size(); ++r) by_return[r] += other.by_return[r];
+  }
 };
 
 /** size bytes in fixed-size moves: a memcpy of a size unknown at compile time is a call, and a
@@ -1144,8 +1154,7 @@ bool encodeRecord(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, std::si
 }
 
 /** Records [first, first + positions.cols()) into `records` (zeroed); throws for the first point
- *  LAS cannot hold. One thread: the work is a copy bound by memory, and a second thread made it
- *  slower on two cores (measured in bench_mesh_io). */
+ *  LAS cannot hold. */
 void encodeRecords(const LasPlan& plan, const pcl::PCLPointCloud2& cloud, std::size_t first,
                    const Eigen::Matrix3Xd& positions, const VertexColors& colors, char* records,
                    RecordStats& stats) {
@@ -1343,40 +1352,72 @@ void writeLAS(const std::string& path, const pcl::PCLPointCloud2& cloud, const L
       box.extend(finiteBounds(blockPositions(cloud, first, std::min(kBlockPoints, n - first))));
     return box;
   });
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd < 0) throw FileFormatException("cannot write '" + path + "': " + std::strerror(errno));
+  std::uint64_t evlr_bytes = 0;
+  for (const auto& r : plan.layout.evlrs) evlr_bytes += kEvlrHeader + r.data.size();
+  const std::uint64_t size = plan.point_offset + plan.record_length * n + evlr_bytes;
+  const auto failed = [&](int error) {
+    return FileFormatException("cannot write '" + path + "': " + std::strerror(error));
+  };
+  // O_RDWR: a shared mapping needs a descriptor open for reading too.
+  const int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw failed(errno);
   struct Closer {
     int fd;
     ~Closer() {
       if (fd >= 0) ::close(fd);
     }
   } closer{fd};
-  const ByteSink sink = [&](std::uint64_t at, const char* bytes, std::size_t size) {
-    pwriteAll(fd, path, at, bytes, size);
-  };
-  // The records a block at a time after the header's place, then the header with their stats.
-  // Each block is written by another thread while the next is encoded (two buffers in turn): the
-  // kernel's copy into the page cache costs about as much as the encoding.
-  RecordStats stats;
-  std::vector<char> buffers[2];
-  std::future<void> writing;
-  for (std::size_t first = 0, block = 0; first < n; first += kBlockPoints, ++block) {
-    const std::size_t count = std::min(kBlockPoints, n - first);
-    const Eigen::Matrix3Xd positions = blockPositions(cloud, first, count);
-    const VertexColors colors =
-        plan.convert_colors ? vertexColors(rowsOf(cloud, first, count)) : VertexColors();
-    std::vector<char>& records = buffers[block % 2];  // its last write was waited for below
-    records.assign(count * plan.record_length, '\0');
-    encodeRecords(plan, cloud, first, positions, colors, records.data(), stats);
-    if (writing.valid()) writing.get();
-    writing = std::async(std::launch::async, sink, plan.point_offset + first * plan.record_length,
-                         records.data(), records.size());
+  // The file at its full size with its blocks reserved (a full disk is this error, not a SIGBUS
+  // while writing into the mapping), then mapped: the records are encoded straight into the page
+  // cache, which the kernel hands out zeroed, with no buffer to clear and no copy to make.
+  if (const int error = ::posix_fallocate(fd, 0, static_cast<off_t>(size))) throw failed(error);
+  void* const mapping =
+      ::mmap(nullptr, static_cast<std::size_t>(size), PROT_READ | PROT_WRITE, MAP_SHARED, fd, 0);
+  if (mapping == MAP_FAILED) {
+    // A file system without shared writable mappings (some FUSE mounts): encoded in memory, then
+    // written.
+    const std::string bytes = encodeLAS(cloud, blockPositions(cloud, 0, n), source);
+    pwriteAll(fd, path, 0, bytes.data(), bytes.size());
+    closer.fd = -1;
+    if (::close(fd) != 0) throw failed(errno);
+    return;
   }
-  if (writing.valid()) writing.get();
-  writeHeaderAndRecords(plan, n, stats, sink);
+  struct Unmapper {
+    void* at;
+    std::size_t size;
+    ~Unmapper() { ::munmap(at, size); }
+  } unmapper{mapping, static_cast<std::size_t>(size)};
+  char* const file = static_cast<char*>(mapping);
+  // Blocks on every core: each encodes its records and faults its pages in on its own. The stats
+  // are merged in block order, and the first block that fails names the first point that does.
+  const auto blocks = static_cast<std::ptrdiff_t>((n + kBlockPoints - 1) / kBlockPoints);
+  std::vector<RecordStats> block_stats(static_cast<std::size_t>(blocks));
+  std::vector<std::exception_ptr> errors(static_cast<std::size_t>(blocks));
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::ptrdiff_t block = 0; block < blocks; ++block) {
+    const auto b = static_cast<std::size_t>(block);
+    const std::size_t first = b * kBlockPoints;
+    const std::size_t count = std::min(kBlockPoints, n - first);
+    try {
+      const VertexColors colors =
+          plan.convert_colors ? vertexColors(rowsOf(cloud, first, count)) : VertexColors();
+      encodeRecords(plan, cloud, first, blockPositions(cloud, first, count), colors,
+                    file + plan.point_offset + first * plan.record_length, block_stats[b]);
+    } catch (...) {
+      errors[b] = std::current_exception();
+    }
+  }
+  RecordStats stats;
+  for (std::size_t b = 0; b < block_stats.size(); ++b) {
+    if (errors[b]) std::rethrow_exception(errors[b]);
+    stats.add(block_stats[b]);
+  }
+  writeHeaderAndRecords(plan, n, stats,
+                        [&](std::uint64_t at, const char* bytes, std::size_t length) {
+                          std::memcpy(file + at, bytes, length);
+                        });
   closer.fd = -1;
-  if (::close(fd) != 0)
-    throw FileFormatException("cannot write '" + path + "': " + std::strerror(errno));
+  if (::close(fd) != 0) throw failed(errno);
 }
 
 struct LasPieceWriter::State {

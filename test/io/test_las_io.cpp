@@ -4,18 +4,24 @@
 #include <gtest/gtest.h>
 
 #include <pcl/common/io.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "data_catalogue.h"
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/cloud_pieces.h"
 #include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
@@ -454,6 +460,65 @@ TEST(LasIO, ANewFileIsLas14Format6Or7) {
   back = readMeshFile(folder + "/b.las");
   EXPECT_EQ(fieldValue(back.mesh.cloud, 1, "red"), 65535);
   EXPECT_EQ(vertexColors(back.mesh.cloud), colors);
+}
+
+// A file is encoded in blocks of 2^18 points on every core, straight into a mapping of the file: a
+// cloud of three blocks (the last one partial) gives the same bytes with one thread and with
+// several, and the same records as the piece writer of the -memory path, which encodes a piece
+// at a time and writes each after the other.
+TEST(LasIO, AFileOfSeveralBlocksIsTheSameFromOneThreadOrManyOrInPieces) {
+  const std::string folder = scratchFolder("las_blocks");
+  const int n = 700000;
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> ground(0.0, 1000.0);
+  Eigen::Matrix3Xd p(3, n);
+  VertexColors colors(3, n);
+  for (int i = 0; i < n; ++i) {
+    p.col(i) << 500000.0 + ground(random), 4000000.0 + ground(random), 0.05 * ground(random);
+    colors.col(i) << i % 256, (i / 256) % 256, (i * 7) % 256;
+  }
+  pcl::PolygonMesh mesh = makeMesh(p, {});
+  setVertexCoordinates(mesh.cloud, p, FieldPrecision::Double);
+  setVertexColors(mesh.cloud, colors);
+#ifdef _OPENMP
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+#endif
+  const std::string one = saveLas(folder + "/one.las", mesh, nullptr);
+#ifdef _OPENMP
+  omp_set_num_threads(std::max(2, threads));
+#endif
+  const std::string many = saveLas(folder + "/many.las", mesh, nullptr);
+#ifdef _OPENMP
+  omp_set_num_threads(threads);
+#endif
+  EXPECT_EQ(specHeader(one).points, static_cast<std::uint64_t>(n));
+  EXPECT_TRUE(one == many);
+
+  // In pieces of 100,000 points that do not align with the blocks, in the layout read back, with
+  // the exact coordinates (as the -memory path reads them).
+  const MeshFile back = readMeshFile(folder + "/one.las");
+  pcl::PCLPointCloud2 cloud = back.mesh.cloud;
+  setVertexCoordinates(cloud, back.positions, FieldPrecision::Double);
+  CloudPieceWriter pieces(folder + "/pieces.las", "las", n, n, 1, SensorPose{}, back.las);
+  for (int first = 0; first < n; first += 100000) {
+    pcl::PCLPointCloud2 piece;
+    piece.fields = cloud.fields;
+    piece.point_step = cloud.point_step;
+    piece.width = static_cast<std::uint32_t>(std::min(100000, n - first));
+    piece.height = 1;
+    piece.row_step = piece.point_step * piece.width;
+    const auto* from = cloud.data.data() + static_cast<std::size_t>(first) * cloud.point_step;
+    piece.data.assign(from, from + piece.row_step);
+    pieces.write(piece);
+  }
+  pieces.close();
+  const std::string in_pieces = readBytes(folder + "/pieces.las");
+  EXPECT_TRUE(recordBytes(in_pieces) == recordBytes(one));
+  // The header's stats, merged over the blocks here and over the pieces there: bounds (179-226),
+  // the point count and the counts by return (247-374).
+  EXPECT_EQ(in_pieces.substr(179, 48), one.substr(179, 48));
+  EXPECT_EQ(in_pieces.substr(247, 128), one.substr(247, 128));
 }
 
 TEST(LasIO, LazIsRefusedWithHowToDecompress) {
