@@ -18,28 +18,42 @@ for candidate in "$here/../../shared/data" /work/shared/data; do
   [ -z "$shared" ] && [ -f "$candidate/CATALOG.md" ] && shared=$candidate
 done
 
-status=0
-for target in "${targets[@]}"; do
-  corpus=$build/fuzz/corpus/$target
-  seeds=$build/fuzz/seeds/$target
-  findings=$build/fuzz/findings/$target
+# One target's run; its summary goes to BUILD_DIR/fuzz/<target>.summary, printed when it ends.
+fuzz_target() {
+  local target=$1 corpus=$build/fuzz/corpus/$1 seeds=$build/fuzz/seeds/$1
+  local findings=$build/fuzz/findings/$1 summary=$build/fuzz/$1.summary dict=()
   mkdir -p "$corpus" "$seeds" "$findings"
   rm -f "$seeds"/*
   if [ -d "$here/seeds/$target" ]; then cp "$here/seeds/$target"/* "$seeds"/; fi
   if [ -n "$shared" ]; then
     find "$shared" -type f -name "*.$target" -exec ln -sf {} "$seeds"/ \;
   fi
-  dict=()
   [ -f "$here/$target.dict" ] && dict=(-dict="$here/$target.dict")
-  echo "== fuzz_$target for ${seconds}s"
+  echo "== fuzz_$target for ${seconds}s" > "$summary"
   if ! "$build/fuzz/fuzz_$target" "$corpus" "$seeds" "${dict[@]}" -max_total_time="$seconds" \
       -max_len=16384 -timeout=20 -rss_limit_mb=2048 -malloc_limit_mb=256 -print_final_stats=1 \
       -artifact_prefix="$findings/" 2>"$build/fuzz/$target.log"; then
-    echo "fuzz_$target: FINDING (see $findings and $build/fuzz/$target.log)"
-    grep -E "ERROR|SUMMARY|runtime error" "$build/fuzz/$target.log" | head -5 || true
-    status=1
-  else
-    grep -E "stat::number_of_executed_units|cov:" "$build/fuzz/$target.log" | tail -2 || true
+    echo "fuzz_$target: FINDING (see $findings and $build/fuzz/$target.log)" >> "$summary"
+    grep -E "ERROR|SUMMARY|runtime error" "$build/fuzz/$target.log" | head -5 >> "$summary" || true
+    return 1
   fi
+  grep -E "stat::number_of_executed_units|cov:" "$build/fuzz/$target.log" | tail -2 >> "$summary" || true
+}
+
+# The targets run side by side, one per core: each is single-threaded.
+status=0
+running=0
+for target in "${targets[@]}"; do
+  if ((running >= ${PCL_DDG_FUZZ_JOBS:-$(nproc)})); then
+    wait -n || status=1
+    running=$((running - 1))
+  fi
+  fuzz_target "$target" &
+  running=$((running + 1))
 done
+while ((running > 0)); do
+  wait -n || status=1
+  running=$((running - 1))
+done
+for target in "${targets[@]}"; do cat "$build/fuzz/$target.summary"; done
 exit $status

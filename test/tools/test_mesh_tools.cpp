@@ -207,7 +207,7 @@ TEST_F(MeshTools, OrganizedFramesUseTheGridAndStayOrganized) {
 
 TEST_F(MeshTools, CompareNeighbourhoodsOnAnOrganizedFrame) {
   // Pixel grid against kd-tree; the output stays organized and carries both fields.
-  const ToolRun run = runTool(PCL_DDG_COMPARE_TOOL,
+  const ToolRun run = runTool(PCL_DDG_COMPARE_NEIGHBOURHOODS_TOOL,
                               sharedData("clouds/office1.pcd") + " " + path("out.pcd") + " -k 49");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.err.find("pixel grid"), std::string::npos) << run.err;
@@ -218,7 +218,8 @@ TEST_F(MeshTools, CompareNeighbourhoodsOnAnOrganizedFrame) {
   EXPECT_TRUE(vertexScalarField(out, "angle_difference").size() == 307200);
   EXPECT_TRUE(vertexScalarField(out, "overlap").size() == 307200);
   // An unorganized cloud has no topology to compare.
-  EXPECT_EQ(runTool(PCL_DDG_COMPARE_TOOL, sharedData("clouds/bun0.pcd") + " " + path("bun.pcd"))
+  EXPECT_EQ(runTool(PCL_DDG_COMPARE_NEIGHBOURHOODS_TOOL,
+                    sharedData("clouds/bun0.pcd") + " " + path("bun.pcd"))
                 .exit_code,
             1);
 }
@@ -364,8 +365,8 @@ TEST_F(MeshTools, CompareNeighbourhoodsShowsAThinTwoSheetSurface) {
   const SurfaceSample sheets = makeTwoSheets(1.5 / 12);
   const pcl::PolygonMesh mesh = polygonMeshOf(sheets);
   saveMesh(path("sheets.ply"), mesh);
-  const ToolRun run =
-      runTool(PCL_DDG_COMPARE_TOOL, path("sheets.ply") + " " + path("cmp.ply") + " -k 16");
+  const ToolRun run = runTool(PCL_DDG_COMPARE_NEIGHBOURHOODS_TOOL,
+                              path("sheets.ply") + " " + path("cmp.ply") + " -k 16");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   double over5 = -1, over30 = -1;
   const auto at = run.out.find("over 5 degrees: ");
@@ -379,12 +380,13 @@ TEST_F(MeshTools, CompareNeighbourhoodsShowsAThinTwoSheetSurface) {
     EXPECT_TRUE(hasVertexField(out.cloud, field));
   EXPECT_LT(vertexScalarField(out.cloud, "overlap").mean(), 0.6);
 
-  const ToolRun scan = runTool(PCL_DDG_COMPARE_TOOL, sharedData("meshes/bun_zipper.ply") + " " +
-                                                         path("bz.ply") + " -method quadric -k 20");
+  const ToolRun scan =
+      runTool(PCL_DDG_COMPARE_NEIGHBOURHOODS_TOOL, sharedData("meshes/bun_zipper.ply") + " " +
+                                                       path("bz.ply") + " -method quadric -k 20");
   ASSERT_EQ(scan.exit_code, 0) << scan.err;
   EXPECT_NE(scan.out.find("mean Jaccard"), std::string::npos);
-  const ToolRun cloud =
-      runTool(PCL_DDG_COMPARE_TOOL, sharedData("clouds/bun0.pcd") + " " + path("c.ply"));
+  const ToolRun cloud = runTool(PCL_DDG_COMPARE_NEIGHBOURHOODS_TOOL,
+                                sharedData("clouds/bun0.pcd") + " " + path("c.ply"));
   EXPECT_EQ(cloud.exit_code, 1);
   EXPECT_FALSE(std::filesystem::exists(path("c.ply")));
 }

@@ -105,12 +105,13 @@ TEST_F(PCLInterop, ComparisonColoursOnlyWhatHasNoColoursUnlessAsked) {
   green.colwise() = (Eigen::Matrix<std::uint8_t, 3, 1>() << 0, 200, 0).finished();
   setVertexColors(bunny.cloud, green);
   saveMesh(path("green.ply"), bunny);
-  run(PCL_DDG_COMPARE_TOOL, path("green.ply") + " " + path("kept.ply"));
+  run(PCL_DDG_COMPARE_NEIGHBOURHOODS_TOOL, path("green.ply") + " " + path("kept.ply"));
   const pcl::PolygonMesh kept = loadMesh(path("kept.ply"));
   EXPECT_EQ(vertexColors(kept.cloud), green);
   EXPECT_FALSE(hasVertexField(kept.cloud, "quality"));
   std::string err;
-  run(PCL_DDG_COMPARE_TOOL, path("green.ply") + " " + path("map.ply") + " -color overlap", &err);
+  run(PCL_DDG_COMPARE_NEIGHBOURHOODS_TOOL,
+      path("green.ply") + " " + path("map.ply") + " -color overlap", &err);
   const pcl::PolygonMesh map = loadMesh(path("map.ply"));
   EXPECT_NE(vertexColors(map.cloud), green);
   EXPECT_EQ(vertexScalarField(map.cloud, "quality"), vertexScalarField(map.cloud, "overlap"));

@@ -608,11 +608,13 @@ TEST_F(ToolOptions, CompareNeighbourhoodsEqualsTheLibraryForEveryOption) {
       {"", frame16, {}, path("frame.pcd")},
       {"-max_depth_jump 0.5", on(frame, jump), frame16, path("frame.pcd")},
   };
-  checkOptionTable(PCL_DDG_COMPARE_TOOL, file, path("c.ply"), "-precision double", Match::Exact,
-                   table);
+  checkOptionTable(PCL_DDG_COMPARE_NEIGHBOURHOODS_TOOL, file, path("c.ply"), "-precision double",
+                   Match::Exact, table);
   // -color none: the two fields and no colours.
-  ASSERT_EQ(runTool(PCL_DDG_COMPARE_TOOL, file + " " + path("none.ply") + " -color none").exit_code,
-            0);
+  ASSERT_EQ(
+      runTool(PCL_DDG_COMPARE_NEIGHBOURHOODS_TOOL, file + " " + path("none.ply") + " -color none")
+          .exit_code,
+      0);
   const pcl::PolygonMesh none = loadMesh(path("none.ply"));
   EXPECT_TRUE(hasVertexField(none.cloud, "angle_difference"));
   EXPECT_FALSE(hasVertexField(none.cloud, "red"));
