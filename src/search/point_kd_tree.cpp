@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <numeric>
 
@@ -14,10 +16,22 @@ namespace {
 
 constexpr int kLeafSize = 10;  // FLANN's default; measured faster than PCL's 15 for k = 16
 
+// The smallest float above d >= 0: its bits plus one (infinity stays), without a libm call in the
+// search's innermost loop.
+float nextFloatUp(float d) {
+  if (!(d > 0.0f)) return std::numeric_limits<float>::denorm_min();
+  if (d == std::numeric_limits<float>::infinity()) return d;
+  std::uint32_t bits;
+  std::memcpy(&bits, &d, sizeof bits);
+  ++bits;
+  std::memcpy(&d, &bits, sizeof d);
+  return d;
+}
+
 // Keeps the k nearest in the caller's vectors, ordered by (distance, index): ties are broken by
 // the point's index, so the answer is one set in one order whatever the tree's shape or the order
 // the points were visited in (a tile of a cloud, indexed in the cloud's order, gets the same
-// neighbours as the whole cloud; see pcl_ddg/tiling).
+// neighbours as the whole cloud; see pcl_ddg/tiling). Indices are the caller's from the start.
 class NearestK : public flann::ResultSet<float> {
  public:
   NearestK(std::size_t k, const std::vector<pcl::index_t>& ids, pcl::Indices& indices,
@@ -31,7 +45,7 @@ class NearestK : public flann::ResultSet<float> {
   // the ties through, to be decided by index.
   float worstDist() const override { return worst_; }
   void addPoint(float distance, std::size_t index) override {
-    const auto id = static_cast<pcl::index_t>(index);
+    const pcl::index_t id = ids_[index];
     if (count_ == k_ && !precedes(distance, id, k_ - 1)) return;
     std::size_t i = count_ < k_ ? count_++ : k_ - 1;
     for (; i > 0 && precedes(distance, id, i - 1); --i) {
@@ -40,15 +54,13 @@ class NearestK : public flann::ResultSet<float> {
     }
     distances_[i] = distance;
     indices_[i] = id;
-    if (count_ == k_)
-      worst_ = std::nextafter(distances_[k_ - 1], std::numeric_limits<float>::infinity());
+    if (count_ == k_) worst_ = nextFloatUp(distances_[k_ - 1]);
   }
   std::size_t count() const { return count_; }
 
  private:
-  bool precedes(float distance, pcl::index_t index, std::size_t slot) const {
-    return distance < distances_[slot] ||
-           (distance == distances_[slot] && ids_[index] < ids_[indices_[slot]]);
+  bool precedes(float distance, pcl::index_t id, std::size_t slot) const {
+    return distance < distances_[slot] || (distance == distances_[slot] && id < indices_[slot]);
   }
 
   std::size_t k_, count_ = 0;
@@ -108,7 +120,6 @@ int PointKdTree::nearestK(const float* query, int k, pcl::Indices& indices,
   index_->tree.findNeighbors(result, query, flann::SearchParams(-1, 0.0f));
   indices.resize(result.count());
   squared_distances.resize(result.count());
-  for (pcl::index_t& i : indices) i = ids_[i];
   return static_cast<int>(indices.size());
 }
 
