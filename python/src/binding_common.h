@@ -28,9 +28,24 @@ namespace py = pybind11;
  *  dtype. */
 Eigen::Matrix3Xd positionsOf(const py::array& array, const char* name);
 
-/** The address the binding reads an (n, 3) array from, without converting it (0 when it would
- *  have to convert): the tests' evidence that float64 C-contiguous input is read in place. */
-std::uintptr_t inPlaceAddress(const py::array& array);
+/** An (n, 3) array's rows as the library's 3 x n positions: float64 C-contiguous arrays in place
+ *  (their rows are the library's columns, the same bytes), any other array converted once. The
+ *  array must outlive the view (a function argument does). */
+class PositionsView {
+ public:
+  PositionsView(const py::array& array, const char* name);
+  Eigen::Map<const Eigen::Matrix3Xd> map() const { return {data_, 3, cols_}; }
+  Eigen::Index cols() const { return cols_; }
+
+ private:
+  Eigen::Matrix3Xd converted_;
+  const double* data_ = nullptr;
+  Eigen::Index cols_ = 0;
+};
+
+/** The address the last PositionsView of this thread read positions from: the array's own buffer
+ *  when it was read in place, the converted copy's otherwise (the tests' evidence of zero copy). */
+std::uintptr_t& lastPositionsAddress();
 
 /** A mesh's topology from F: an (m, 3) integer array or a sequence of polygons. Indices are
  *  checked against num_vertices (ValueError naming the face). */

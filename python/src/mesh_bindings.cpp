@@ -23,19 +23,20 @@ namespace python {
 
 namespace {
 
-// V and F as the library takes them; V must be finite (InvalidMeshError naming the vertex).
+// V (read in place where it can be) and F as the library takes them; V must be finite
+// (InvalidMeshError naming the vertex).
 struct Mesh {
-  Eigen::Matrix3Xd positions;
+  PositionsView positions;
   MeshTopology topology;
 };
 
 Mesh meshOf(const py::array& vertices, const py::object& faces,
             NonFinitePolicy finite = NonFinitePolicy::Throw,
             OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw) {
-  Eigen::Matrix3Xd positions = positionsOf(vertices, "V");
+  PositionsView positions(vertices, "V");
   if (finite == NonFinitePolicy::Throw) {
     py::gil_scoped_release release;
-    requireFinite(positions);
+    requireFinite(positions.map());
   }
   MeshTopology topology = topologyOf(static_cast<int>(positions.cols()), faces, policy);
   return {std::move(positions), std::move(topology)};
@@ -103,8 +104,8 @@ void bindMeshes(py::module_& m) {
         }
         options.mass = massOf(mass);
         Mesh mesh = meshOf(V, F);
-        MeshNormals normals =
-            compute([&] { return computeMeshNormals(mesh.topology, mesh.positions, options); });
+        MeshNormals normals = compute(
+            [&] { return computeMeshNormals(mesh.topology, mesh.positions.map(), options); });
         py::dict counts;
         counts["invalid_vertices"] = normals.invalid_vertices;
         counts["cancelled_vertices"] = normals.cancelled_vertices;
@@ -127,8 +128,9 @@ void bindMeshes(py::module_& m) {
         Mesh mesh = meshOf(V, F);
         // Compressed rows straight from the library: the arrays are scipy's CSR as they are,
         // kept alive by one capsule.
-        auto* matrix = new Eigen::SparseMatrix<double, Eigen::RowMajor>(compute(
-            [&] { return laplacian<Eigen::RowMajor>(mesh.topology, mesh.positions, w, f, type); }));
+        auto* matrix = new Eigen::SparseMatrix<double, Eigen::RowMajor>(compute([&] {
+          return laplacian<Eigen::RowMajor>(mesh.topology, mesh.positions.map(), w, f, type);
+        }));
         py::capsule owner(matrix, [](void* p) {
           delete static_cast<Eigen::SparseMatrix<double, Eigen::RowMajor>*>(p);
         });
@@ -148,7 +150,7 @@ void bindMeshes(py::module_& m) {
         const MassType type = massOf(k);
         Mesh mesh = meshOf(V, F);
         return vectorArray(
-            compute([&] { return lumpedMass(mesh.topology, mesh.positions, type); }));
+            compute([&] { return lumpedMass(mesh.topology, mesh.positions.map(), type); }));
       },
       py::arg("V"), py::arg("F"), py::arg("kind") = "mixed", "The diagonal of M (vertex areas).");
 
@@ -158,7 +160,7 @@ void bindMeshes(py::module_& m) {
         const MassType type = massOf(mass);
         Mesh mesh = meshOf(V, F);
         VertexCurvatures c =
-            compute([&] { return computeCurvatures(mesh.topology, mesh.positions, type); });
+            compute([&] { return computeCurvatures(mesh.topology, mesh.positions.map(), type); });
         py::dict counts;
         counts["clamped_vertices"] = c.clamped_vertices;
         counts["invalid_vertices"] = c.invalid_vertices;
@@ -176,7 +178,8 @@ void bindMeshes(py::module_& m) {
       [](const py::array& V, const py::object& F) {
         // As pcl_ddg_info: defects are counted, not refused.
         Mesh mesh = meshOf(V, F, NonFinitePolicy::Keep, OutOfRangeFacePolicy::Drop);
-        return compute([&] { return makeMeshReport(mesh.topology, mesh.positions).toJson(); });
+        return compute(
+            [&] { return makeMeshReport(mesh.topology, mesh.positions.map()).toJson(); });
       },
       py::arg("V"), py::arg("F"), "makeMeshReport as JSON (pcl_ddg_info -json).");
 
@@ -212,13 +215,13 @@ void bindMeshes(py::module_& m) {
         Eigen::Matrix3Xd smoothed = compute([&] {
           // As pcl_ddg_smooth: the step in units of h^2 unless absolute_time; the explicit
           // default is half the stability bound, and a step above it is refused.
-          const double h = meanEdgeLength(mesh.topology, mesh.positions);
+          const double h = meanEdgeLength(mesh.topology, mesh.positions.map());
           if (!(h > 0.0))
             throw pcl::BadArgumentException("the mesh has no edge of positive length");
           const double step = lambda_dt.value_or(1.0);
           if (p.scheme == SmoothingScheme::Explicit) {
             const double bound =
-                explicitStabilityLimit(mesh.topology, mesh.positions, p.weights, p.mass);
+                explicitStabilityLimit(mesh.topology, mesh.positions.map(), p.weights, p.mass);
             p.time_step = lambda_dt ? (absolute_time ? step : step * h * h) : 0.5 * bound;
             if (p.time_step > bound && !allow_unstable) {
               throw pcl::BadArgumentException(
@@ -230,7 +233,8 @@ void bindMeshes(py::module_& m) {
           } else {
             p.time_step = absolute_time ? step : step * h * h;
           }
-          return smoothMeshPositions(mesh.topology, mesh.positions, p, nullptr, checkSignals);
+          return smoothMeshPositions(mesh.topology, Eigen::Matrix3Xd(mesh.positions.map()), p,
+                                     nullptr, checkSignals);
         });
         return rowsArray(std::move(smoothed));
       },
@@ -276,11 +280,11 @@ void bindMeshes(py::module_& m) {
         auto* result = new Eigen::MatrixXd();
         py::capsule owner(result, [](void* p) { delete static_cast<Eigen::MatrixXd*>(p); });
         *result = compute([&] {
-          const double h = meanEdgeLength(mesh.topology, mesh.positions);
+          const double h = meanEdgeLength(mesh.topology, mesh.positions.map());
           if (!(h > 0.0))
             throw pcl::BadArgumentException("the mesh has no edge of positive length");
           p.diffusion_time = absolute_time ? time : time * h * h;
-          return smoothScalarFields(mesh.topology, mesh.positions, fields, p);
+          return smoothScalarFields(mesh.topology, mesh.positions.map(), fields, p);
         });
         const auto rows = static_cast<py::ssize_t>(result->rows());
         if (values.ndim() == 1) return py::array_t<double>({rows}, result->data(), owner);

@@ -93,8 +93,21 @@ Eigen::Matrix3Xd positionsOf(const py::array& array, const char* name) {
   return positionsOf(py::array_t<double, py::array::c_style | py::array::forcecast>(array), name);
 }
 
-std::uintptr_t inPlaceAddress(const py::array& array) {
-  return isFloat64CContiguous(array) ? reinterpret_cast<std::uintptr_t>(array.data()) : 0;
+PositionsView::PositionsView(const py::array& array, const char* name) {
+  if (isFloat64CContiguous(array)) {
+    cols_ = rowCount(array, name);
+    data_ = static_cast<const double*>(array.data());
+  } else {
+    converted_ = positionsOf(array, name);
+    cols_ = converted_.cols();
+    data_ = converted_.data();
+  }
+  lastPositionsAddress() = reinterpret_cast<std::uintptr_t>(data_);
+}
+
+std::uintptr_t& lastPositionsAddress() {
+  thread_local std::uintptr_t address = 0;
+  return address;
 }
 
 namespace {
@@ -147,13 +160,14 @@ MeshTopology topologyOf(int num_vertices, const py::object& faces, OutOfRangeFac
     const auto corners = static_cast<std::size_t>(f.ndim() == 2 ? f.shape(1) : 0);
     if (corners == 3 && f.dtype().kind() == 'i' && f.dtype().itemsize() == 4 &&
         (f.flags() & py::array::c_style) != 0) {
-      // int32 (m, 3) C-contiguous: the triangles' own layout; copied and checked without the GIL.
-      Eigen::Matrix3Xi triangles(3, static_cast<Eigen::Index>(rows));
+      // int32 (m, 3) C-contiguous: the triangles' own layout, read in place and checked without
+      // the GIL; copied only to drop out-of-range corners.
+      const Eigen::Map<const Eigen::Matrix3Xi> in_place(static_cast<const int*>(f.data()), 3,
+                                                        static_cast<Eigen::Index>(rows));
       std::int64_t bad = -1;
       {
         py::gil_scoped_release release;
-        if (rows > 0) std::memcpy(triangles.data(), f.data(), sizeof(int) * 3 * rows);
-        const int* data = triangles.data();
+        const int* data = in_place.data();
         for (std::size_t i = 0; i < 3 * rows && bad < 0; i += 3 * 4096) {
           // Blocks: a vectorisable range check, the offender searched only in a failing block.
           const std::size_t end = std::min(3 * rows, i + 3 * 4096);
@@ -165,12 +179,12 @@ MeshTopology topologyOf(int num_vertices, const py::object& faces, OutOfRangeFac
           }
         }
       }
-      if (bad >= 0 && check)
-        checkedIndex(triangles.data()[bad], num_vertices, static_cast<std::size_t>(bad / 3));
-      if (bad >= 0) {
-        for (Eigen::Index j = 0; j < triangles.size(); ++j)
-          triangles.data()[j] = droppableIndex(triangles.data()[j], num_vertices);
-      }
+      if (bad < 0) return buildTopology(num_vertices, in_place, policy);
+      if (check)
+        checkedIndex(in_place.data()[bad], num_vertices, static_cast<std::size_t>(bad / 3));
+      Eigen::Matrix3Xi triangles = in_place;
+      for (Eigen::Index j = 0; j < triangles.size(); ++j)
+        triangles.data()[j] = droppableIndex(triangles.data()[j], num_vertices);
       return buildTopology(num_vertices, triangles, policy);
     }
     const auto indices = py::array_t<long long, py::array::c_style | py::array::forcecast>(f);
@@ -294,8 +308,9 @@ PYBIND11_MODULE(_pcl_ddg, m) {
   m.def(
       "_last_compute_seconds", [] { return lastComputeSeconds(); },
       "Seconds the last call of this thread spent in the library (GIL released).");
-  m.def("_in_place_address", &inPlaceAddress, py::arg("array"),
-        "The address the binding reads an array from without converting it; 0 if it converts.");
+  m.def(
+      "_last_positions_address", [] { return lastPositionsAddress(); },
+      "The address this thread's last mesh call read V from (V's own buffer when read in place).");
   bindMeshes(m);
   bindClouds(m);
   bindIO(m);

@@ -11,14 +11,20 @@ from conftest import icosphere
 def test_float64_c_contiguous_is_read_in_place():
     V, F = icosphere(2)
     assert V.dtype == np.float64 and V.flags.c_contiguous
-    # The address the binding reads from is the array's own buffer.
-    assert _pcl_ddg._in_place_address(V) == V.__array_interface__["data"][0]
-    # The Python layer passes the same object on (no np.asarray copy).
+    # The Python layer passes the same object on (no np.asarray copy) ...
     assert pcl_ddg._array(V, "V") is V
-    # float32, Fortran order and strided views would be converted (once, in C++).
-    assert _pcl_ddg._in_place_address(V.astype(np.float32)) == 0
-    assert _pcl_ddg._in_place_address(np.asfortranarray(V)) == 0
-    assert _pcl_ddg._in_place_address(np.hstack([V, V])[:, ::2]) == 0
+    # ... and every mesh function reads the library's positions from the array's own buffer.
+    address = V.__array_interface__["data"][0]
+    for call in (lambda v: pcl_ddg.vertex_normals(v, F), lambda v: pcl_ddg.laplacian(v, F),
+                 lambda v: pcl_ddg.mass_matrix(v, F), lambda v: pcl_ddg.curvatures(v, F),
+                 lambda v: pcl_ddg.mesh_report(v, F)):
+        call(V)
+        assert _pcl_ddg._last_positions_address() == address
+        # float32, Fortran order and strided views are converted (once, in C++).
+        for other in (V.astype(np.float32), np.asfortranarray(V), np.hstack([V, V])[:, ::2]):
+            call(other)
+            assert _pcl_ddg._last_positions_address() not in (0, address,
+                                                              other.__array_interface__["data"][0])
 
 
 def test_float32_non_contiguous_and_integer_input_give_the_same_results():

@@ -9,7 +9,7 @@
 
 namespace pcl_ddg {
 
-double meanEdgeLength(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+double meanEdgeLength(const MeshTopology& topology, const PositionsRef& positions) {
   // Each edge once, from its smaller end, in the order of edge ids (smaller, then larger vertex),
   // read from the neighbour rows: the edge map is not needed. Summed in fixed blocks of that order,
   // then the block sums in order: parallel, and the same last bit whatever the thread count.
@@ -52,7 +52,7 @@ double meanEdgeLength(const MeshTopology& topology, const Eigen::Matrix3Xd& posi
   return count > 0 ? sum / static_cast<double>(count) : 0.0;
 }
 
-TriangleQuality triangleQuality(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+TriangleQuality triangleQuality(const MeshTopology& topology, const PositionsRef& positions) {
   constexpr double kDegreesPerRadian = 57.295779513082320876798;
   const Eigen::Matrix3Xi& t = topology.triangles();
   const std::int64_t triangles = t.cols();
@@ -78,7 +78,7 @@ TriangleQuality triangleQuality(const MeshTopology& topology, const Eigen::Matri
   return quality;
 }
 
-BoundingBox boundingBox(const Eigen::Matrix3Xd& positions) {
+BoundingBox boundingBox(const PositionsRef& positions) {
   BoundingBox box;
   bool any = false;
   for (Eigen::Index i = 0; i < positions.cols(); ++i) {

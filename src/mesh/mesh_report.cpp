@@ -10,7 +10,7 @@
 
 namespace pcl_ddg {
 
-std::int64_t countZeroAreaFaces(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+std::int64_t countZeroAreaFaces(const MeshTopology& topology, const PositionsRef& positions) {
   // A face counts when all its triangles are degenerate; its triangles are consecutive, and it is
   // counted from its first one.
   const Eigen::Matrix3Xi& tris = topology.triangles();
@@ -30,7 +30,7 @@ std::int64_t countZeroAreaFaces(const MeshTopology& topology, const Eigen::Matri
   return count;
 }
 
-MeshReport makeMeshReport(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+MeshReport makeMeshReport(const MeshTopology& topology, const PositionsRef& positions) {
   const TopologyCounts& c = topology.counts();
   MeshReport r;
   r.vertices = topology.numVertices();

@@ -11,7 +11,8 @@
 namespace pcl_ddg {
 namespace {
 
-std::vector<pcl::Vertices> trianglesAsPolygons(const Eigen::Matrix3Xi& triangles) {
+std::vector<pcl::Vertices> trianglesAsPolygons(
+    const Eigen::Ref<const Eigen::Matrix3Xi>& triangles) {
   std::vector<pcl::Vertices> polygons(triangles.cols());
   for (Eigen::Index t = 0; t < triangles.cols(); ++t) {
     for (int k = 0; k < 3; ++k) {
@@ -43,7 +44,7 @@ MeshTopology::MeshTopology(int num_vertices, const std::vector<pcl::Vertices>& p
   build(polygons, policy);
 }
 
-MeshTopology::MeshTopology(int num_vertices, const Eigen::Matrix3Xi& triangles,
+MeshTopology::MeshTopology(int num_vertices, const Eigen::Ref<const Eigen::Matrix3Xi>& triangles,
                            OutOfRangeFacePolicy policy)
     : num_vertices_(num_vertices) {
   build(trianglesAsPolygons(triangles), policy);

@@ -71,7 +71,7 @@ float floatFieldValue(double value, const std::string& field, std::size_t vertex
   return static_cast<float>(value);
 }
 
-NonFiniteVertices findNonFiniteVertices(const Eigen::Matrix3Xd& positions) {
+NonFiniteVertices findNonFiniteVertices(const PositionsRef& positions) {
   NonFiniteVertices result;
   Eigen::Index first = positions.cols();
   std::int64_t count = 0;
@@ -86,7 +86,7 @@ NonFiniteVertices findNonFiniteVertices(const Eigen::Matrix3Xd& positions) {
   return result;
 }
 
-void requireFinite(const Eigen::Matrix3Xd& positions) {
+void requireFinite(const PositionsRef& positions) {
   const NonFiniteVertices bad = findNonFiniteVertices(positions);
   if (bad.count == 0) return;
   std::ostringstream msg;

@@ -19,7 +19,7 @@ struct VertexSums {
   double area = 0.0;                                      ///< sum of |area vectors|
 };
 
-VertexSums gather(const MeshTopology& topology, const Eigen::Matrix3Xd& positions, int v,
+VertexSums gather(const MeshTopology& topology, const PositionsRef& positions, int v,
                   MassType mass) {
   VertexSums s;
   detail::forEachCornerOf(topology, positions, v, [&](const detail::CornerView& c, int) {
@@ -34,7 +34,7 @@ VertexSums gather(const MeshTopology& topology, const Eigen::Matrix3Xd& position
 
 }  // namespace
 
-Eigen::VectorXd angleDefect(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+Eigen::VectorXd angleDefect(const MeshTopology& topology, const PositionsRef& positions) {
   detail::requireMatchingPositions(topology, positions);
   Eigen::VectorXd defect(topology.numVertices());
 #pragma omp parallel for schedule(static)
@@ -51,8 +51,8 @@ Eigen::VectorXd angleDefect(const MeshTopology& topology, const Eigen::Matrix3Xd
   return defect;
 }
 
-Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology,
-                                     const Eigen::Matrix3Xd& positions, MassType mass) {
+Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology, const PositionsRef& positions,
+                                     MassType mass) {
   detail::requireMatchingPositions(topology, positions);
   Eigen::Matrix3Xd hn(3, topology.numVertices());
 #pragma omp parallel for schedule(static)
@@ -68,7 +68,7 @@ Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology,
   return hn;
 }
 
-VertexCurvatures computeCurvatures(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+VertexCurvatures computeCurvatures(const MeshTopology& topology, const PositionsRef& positions,
                                    MassType mass) {
   detail::requireMatchingPositions(topology, positions);
   const int n = topology.numVertices();

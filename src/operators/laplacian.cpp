@@ -71,7 +71,7 @@ Sparse<Storage> uniform(const MeshTopology& topology) {
 }
 
 template <int Storage>
-Sparse<Storage> cotangent(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+Sparse<Storage> cotangent(const MeshTopology& topology, const PositionsRef& positions) {
   detail::requireMatchingPositions(topology, positions);
   Sparse<Storage> l = graphPattern<Storage>(topology);
   const Eigen::Matrix3Xi& tris = topology.triangles();
@@ -117,7 +117,7 @@ Eigen::SparseMatrix<double> uniformLaplacian(const MeshTopology& topology) {
 }
 
 Eigen::SparseMatrix<double> cotangentLaplacian(const MeshTopology& topology,
-                                               const Eigen::Matrix3Xd& positions) {
+                                               const PositionsRef& positions) {
   return cotangent<Eigen::ColMajor>(topology, positions);
 }
 
@@ -127,7 +127,7 @@ void divideRowsByMass(Eigen::SparseMatrix<double>& matrix, const Eigen::VectorXd
 
 template <int Storage>
 Eigen::SparseMatrix<double, Storage> laplacian(const MeshTopology& topology,
-                                               const Eigen::Matrix3Xd& positions,
+                                               const PositionsRef& positions,
                                                LaplacianWeights weights, LaplacianForm form,
                                                MassType mass) {
   detail::requireMatchingPositions(topology, positions);
@@ -139,8 +139,8 @@ Eigen::SparseMatrix<double, Storage> laplacian(const MeshTopology& topology,
 }
 
 template Eigen::SparseMatrix<double, Eigen::ColMajor> laplacian<Eigen::ColMajor>(
-    const MeshTopology&, const Eigen::Matrix3Xd&, LaplacianWeights, LaplacianForm, MassType);
+    const MeshTopology&, const PositionsRef&, LaplacianWeights, LaplacianForm, MassType);
 template Eigen::SparseMatrix<double, Eigen::RowMajor> laplacian<Eigen::RowMajor>(
-    const MeshTopology&, const Eigen::Matrix3Xd&, LaplacianWeights, LaplacianForm, MassType);
+    const MeshTopology&, const PositionsRef&, LaplacianWeights, LaplacianForm, MassType);
 
 }  // namespace pcl_ddg

@@ -4,7 +4,7 @@
 
 namespace pcl_ddg {
 
-Eigen::VectorXd lumpedMass(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+Eigen::VectorXd lumpedMass(const MeshTopology& topology, const PositionsRef& positions,
                            MassType type) {
   detail::requireMatchingPositions(topology, positions);
   const Eigen::Matrix3Xi& triangles = topology.triangles();
@@ -22,8 +22,8 @@ Eigen::VectorXd lumpedMass(const MeshTopology& topology, const Eigen::Matrix3Xd&
   return mass;
 }
 
-Eigen::SparseMatrix<double> massMatrix(const MeshTopology& topology,
-                                       const Eigen::Matrix3Xd& positions, MassType type) {
+Eigen::SparseMatrix<double> massMatrix(const MeshTopology& topology, const PositionsRef& positions,
+                                       MassType type) {
   const Eigen::VectorXd mass = lumpedMass(topology, positions, type);
   Eigen::SparseMatrix<double> m(mass.size(), mass.size());
   m.reserve(Eigen::VectorXi::Ones(mass.size()));

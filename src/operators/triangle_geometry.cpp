@@ -8,7 +8,7 @@
 namespace pcl_ddg {
 namespace detail {
 
-void requireMatchingPositions(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+void requireMatchingPositions(const MeshTopology& topology, const PositionsRef& positions) {
   if (positions.cols() != topology.numVertices()) {
     throw InvalidMeshException("positions have " + std::to_string(positions.cols()) +
                                " columns for a mesh of " + std::to_string(topology.numVertices()) +

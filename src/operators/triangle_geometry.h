@@ -16,7 +16,7 @@ namespace pcl_ddg {
 namespace detail {
 
 /** Throws InvalidMeshException unless positions has one finite column per topology vertex. */
-void requireMatchingPositions(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+void requireMatchingPositions(const MeshTopology& topology, const PositionsRef& positions);
 
 /** Triangle t seen from its corner k: p0 is that corner, p1 and p2 follow in winding order. */
 struct CornerView {
@@ -55,8 +55,8 @@ inline int cornerOf(const Eigen::Matrix3Xi& triangles, int t, int v) {
   return triangles(0, t) == v ? 0 : (triangles(1, t) == v ? 1 : 2);
 }
 
-inline CornerView viewFromCorner(const Eigen::Matrix3Xd& positions,
-                                 const Eigen::Matrix3Xi& triangles, int t, int k) {
+inline CornerView viewFromCorner(const PositionsRef& positions, const Eigen::Matrix3Xi& triangles,
+                                 int t, int k) {
   CornerView c;
   c.p0 = positions.col(triangles(k, t));
   c.p1 = positions.col(triangles((k + 1) % 3, t));
@@ -76,8 +76,7 @@ inline CornerView viewFromCorner(const Eigen::Matrix3Xd& positions,
 
 /** Calls f(view, t) for every non-degenerate triangle t of v, viewed from v's corner. */
 template <typename F>
-void forEachCornerOf(const MeshTopology& topology, const Eigen::Matrix3Xd& positions, int v,
-                     F&& f) {
+void forEachCornerOf(const MeshTopology& topology, const PositionsRef& positions, int v, F&& f) {
   const Eigen::Matrix3Xi& triangles = topology.triangles();
   for (const int t : topology.incidentTriangles(v)) {
     const CornerView c = viewFromCorner(positions, triangles, t, cornerOf(triangles, t, v));

@@ -24,7 +24,7 @@ struct NormalSums {
 // vertex sums its triangles in ascending order whatever the number of threads, and no per-triangle
 // array is needed: it was 48 B a vertex at the peak of a tool's run, and with its pages fresh, as
 // in a tool's run, the normals took twice as long.
-NormalSums faceNormalSums(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+NormalSums faceNormalSums(const MeshTopology& topology, const PositionsRef& positions,
                           NormalWeighting weighting) {
   const Eigen::Matrix3Xi& triangles = topology.triangles();
   const int n = topology.numVertices();
@@ -62,7 +62,7 @@ NormalSums faceNormalSums(const MeshTopology& topology, const Eigen::Matrix3Xd& 
 
 // Angle weighting: every corner has its own weight, so each vertex gathers its triangles whole
 // (a per-triangle array of angles measured slower: its fresh pages cost more than the flops).
-NormalSums angleWeightedSums(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+NormalSums angleWeightedSums(const MeshTopology& topology, const PositionsRef& positions) {
   NormalSums result{Eigen::Matrix3Xd(3, topology.numVertices()),
                     Eigen::VectorXd(topology.numVertices())};
 #pragma omp parallel for schedule(static)
@@ -83,7 +83,7 @@ NormalSums angleWeightedSums(const MeshTopology& topology, const Eigen::Matrix3X
 // -M^-1 L x turned towards the area normal, or the area normal where it is shorter than epsilon
 // or on the boundary (counted in fallback). Where the area normal has cancelled, the turn is
 // undecided: that vertex gets the (cancelled) area sum, which becomes NaN.
-NormalSums meanCurvatureDirections(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+NormalSums meanCurvatureDirections(const MeshTopology& topology, const PositionsRef& positions,
                                    MassType mass_type, double epsilon, std::int64_t& fallback) {
   NormalSums result{Eigen::Matrix3Xd(3, topology.numVertices()),
                     Eigen::VectorXd(topology.numVertices())};
@@ -119,7 +119,7 @@ NormalSums meanCurvatureDirections(const MeshTopology& topology, const Eigen::Ma
 
 }  // namespace
 
-MeshNormals computeMeshNormals(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+MeshNormals computeMeshNormals(const MeshTopology& topology, const PositionsRef& positions,
                                const MeshNormalOptions& options) {
   detail::requireMatchingPositions(topology, positions);
   const NormalWeighting weighting = options.weighting;

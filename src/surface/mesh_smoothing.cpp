@@ -76,7 +76,7 @@ void requireNotCollapsed(const MeshTopology& topology, const Eigen::Matrix3Xd& c
 
 }  // namespace
 
-double explicitStabilityLimit(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& positions,
                               LaplacianWeights weights, MassType mass) {
   const Eigen::SparseMatrix<double> l = laplacian(topology, positions, weights);
   const Eigen::VectorXd m = lumpedMass(topology, positions, mass);
@@ -90,7 +90,7 @@ double explicitStabilityLimit(const MeshTopology& topology, const Eigen::Matrix3
   return largest > 0.0 ? 2.0 / largest : std::numeric_limits<double>::infinity();
 }
 
-double enclosedVolume(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+double enclosedVolume(const MeshTopology& topology, const PositionsRef& positions) {
   // Tetrahedra to a point near the surface, so that scans far from the origin lose no digits.
   const Eigen::Vector3d origin = positions.rowwise().mean();
   const Eigen::Matrix3Xi& t = topology.triangles();
@@ -103,7 +103,7 @@ double enclosedVolume(const MeshTopology& topology, const Eigen::Matrix3Xd& posi
   return six_volume / 6.0;
 }
 
-double surfaceArea(const MeshTopology& topology, const Eigen::Matrix3Xd& positions) {
+double surfaceArea(const MeshTopology& topology, const PositionsRef& positions) {
   const Eigen::Matrix3Xi& t = topology.triangles();
   double area = 0.0;
   for (Eigen::Index f = 0; f < t.cols(); ++f) {

@@ -11,7 +11,7 @@
 
 namespace pcl_ddg {
 
-Eigen::MatrixXd smoothScalarFields(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+Eigen::MatrixXd smoothScalarFields(const MeshTopology& topology, const PositionsRef& positions,
                                    const Eigen::MatrixXd& fields, const HeatFlowParameters& p) {
   const int n = topology.numVertices();
   if (n == 0 || topology.numTriangles() == 0) throw InvalidMeshException("mesh has no triangles");
@@ -69,7 +69,7 @@ Eigen::MatrixXd smoothScalarFields(const MeshTopology& topology, const Eigen::Ma
   return values;
 }
 
-Eigen::VectorXd smoothScalarField(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+Eigen::VectorXd smoothScalarField(const MeshTopology& topology, const PositionsRef& positions,
                                   const Eigen::VectorXd& field, const HeatFlowParameters& p) {
   return smoothScalarFields(topology, positions, field, p);
 }

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/mesh/positions_ref.h"
 
 namespace pcl_ddg {
 
@@ -38,7 +39,7 @@ inline bool isDegenerateTriangle(const Eigen::Vector3d& a, const Eigen::Vector3d
 }
 
 /** Mean length of the unique edges whose end points are finite (0 if there are none). */
-double meanEdgeLength(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+double meanEdgeLength(const MeshTopology& topology, const PositionsRef& positions);
 
 /** Angle quality of the non-degenerate triangles (degenerate ones are counted by MeshReport). */
 struct TriangleQuality {
@@ -47,7 +48,7 @@ struct TriangleQuality {
 };
 constexpr double kSliverAngleDegrees = 1.0;
 
-TriangleQuality triangleQuality(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+TriangleQuality triangleQuality(const MeshTopology& topology, const PositionsRef& positions);
 
 struct BoundingBox {
   Eigen::Vector3d min = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
@@ -56,6 +57,6 @@ struct BoundingBox {
 };
 
 /** Box of the finite points (NaN corners if there are none). */
-BoundingBox boundingBox(const Eigen::Matrix3Xd& positions);
+BoundingBox boundingBox(const PositionsRef& positions);
 
 }  // namespace pcl_ddg

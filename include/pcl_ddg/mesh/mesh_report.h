@@ -9,6 +9,7 @@
 
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/mesh/positions_ref.h"
 
 namespace pcl_ddg {
 
@@ -44,9 +45,9 @@ struct MeshReport {
 };
 
 /** Faces all of whose triangles have zero area by the relative guard (mesh_geometry.h). */
-std::int64_t countZeroAreaFaces(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+std::int64_t countZeroAreaFaces(const MeshTopology& topology, const PositionsRef& positions);
 
 /** Counts every defect of the mesh; positions may hold non-finite vertices (they are counted). */
-MeshReport makeMeshReport(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+MeshReport makeMeshReport(const MeshTopology& topology, const PositionsRef& positions);
 
 }  // namespace pcl_ddg

@@ -79,8 +79,9 @@ class MeshTopology {
   MeshTopology(int num_vertices, const std::vector<pcl::Vertices>& polygons,
                OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw);
 
-  /** Builds from a vertex count and a 3 x T triangle index matrix. */
-  MeshTopology(int num_vertices, const Eigen::Matrix3Xi& triangles,
+  /** Builds from a vertex count and a 3 x T triangle index matrix (or a view of T x 3 C-order
+   *  ints, as NumPy holds them). */
+  MeshTopology(int num_vertices, const Eigen::Ref<const Eigen::Matrix3Xi>& triangles,
                OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw);
 
   int numVertices() const { return num_vertices_; }

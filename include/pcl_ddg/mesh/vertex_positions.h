@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <string>
 
+#include "pcl_ddg/mesh/positions_ref.h"
+
 namespace pcl_ddg {
 
 /** What to do with a vertex whose coordinates are NaN or infinite. */
@@ -19,7 +21,7 @@ struct NonFiniteVertices {
   std::int64_t count = 0;
 };
 
-NonFiniteVertices findNonFiniteVertices(const Eigen::Matrix3Xd& positions);
+NonFiniteVertices findNonFiniteVertices(const PositionsRef& positions);
 
 /**
  * Reads the x, y, z fields (any numeric type) of every point into a 3 x N matrix in double.
@@ -47,6 +49,6 @@ bool hasVertexField(const pcl::PCLPointCloud2& cloud, const std::string& name);
 float floatFieldValue(double value, const std::string& field, std::size_t vertex);
 
 /** Throws InvalidMeshException naming the first non-finite vertex and the count, if any. */
-void requireFinite(const Eigen::Matrix3Xd& positions);
+void requireFinite(const PositionsRef& positions);
 
 }  // namespace pcl_ddg

@@ -21,16 +21,16 @@
 #include <vector>
 
 #include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/mesh/positions_ref.h"
 #include "pcl_ddg/operators/mass_matrix.h"
 
 namespace pcl_ddg {
 
 /** Integrated Gaussian curvature (angle defect) per vertex; 0 for an isolated vertex. */
-Eigen::VectorXd angleDefect(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+Eigen::VectorXd angleDefect(const MeshTopology& topology, const PositionsRef& positions);
 
 /** The mean-curvature normal Hn = -1/2 M^-1 L x (zero at zero-mass vertices). */
-Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology,
-                                     const Eigen::Matrix3Xd& positions,
+Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology, const PositionsRef& positions,
                                      MassType mass = MassType::MixedVoronoi);
 
 struct VertexCurvatures {
@@ -47,7 +47,7 @@ struct VertexCurvatures {
 };
 
 /** All curvatures at once, sharing the triangle quantities (OpenMP over vertices). */
-VertexCurvatures computeCurvatures(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+VertexCurvatures computeCurvatures(const MeshTopology& topology, const PositionsRef& positions,
                                    MassType mass = MassType::MixedVoronoi);
 
 }  // namespace pcl_ddg

@@ -19,6 +19,7 @@
 #include <Eigen/SparseCore>
 
 #include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/mesh/positions_ref.h"
 #include "pcl_ddg/operators/mass_matrix.h"
 
 namespace pcl_ddg {
@@ -37,17 +38,17 @@ enum class LaplacianForm { Summed, Averaged };
  */
 template <int Storage = Eigen::ColMajor>
 Eigen::SparseMatrix<double, Storage> laplacian(
-    const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+    const MeshTopology& topology, const PositionsRef& positions,
     LaplacianWeights weights = LaplacianWeights::Cotangent,
     LaplacianForm form = LaplacianForm::Summed, MassType mass = MassType::MixedVoronoi);
 extern template Eigen::SparseMatrix<double, Eigen::ColMajor> laplacian<Eigen::ColMajor>(
-    const MeshTopology&, const Eigen::Matrix3Xd&, LaplacianWeights, LaplacianForm, MassType);
+    const MeshTopology&, const PositionsRef&, LaplacianWeights, LaplacianForm, MassType);
 extern template Eigen::SparseMatrix<double, Eigen::RowMajor> laplacian<Eigen::RowMajor>(
-    const MeshTopology&, const Eigen::Matrix3Xd&, LaplacianWeights, LaplacianForm, MassType);
+    const MeshTopology&, const PositionsRef&, LaplacianWeights, LaplacianForm, MassType);
 
 /** The summed cotangent Laplacian. */
 Eigen::SparseMatrix<double> cotangentLaplacian(const MeshTopology& topology,
-                                               const Eigen::Matrix3Xd& positions);
+                                               const PositionsRef& positions);
 
 /** The summed uniform Laplacian (positions are not needed). */
 Eigen::SparseMatrix<double> uniformLaplacian(const MeshTopology& topology);

@@ -16,6 +16,7 @@
 #include <Eigen/SparseCore>
 
 #include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/mesh/positions_ref.h"
 
 namespace pcl_ddg {
 
@@ -23,12 +24,11 @@ enum class MassType { Barycentric, Voronoi, MixedVoronoi };
 
 /** Vertex areas (the diagonal of M), gathered per vertex (OpenMP). Throws InvalidMeshException
  *  on non-finite or mismatched positions. */
-Eigen::VectorXd lumpedMass(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+Eigen::VectorXd lumpedMass(const MeshTopology& topology, const PositionsRef& positions,
                            MassType type = MassType::MixedVoronoi);
 
 /** The diagonal mass matrix as a sparse matrix. */
-Eigen::SparseMatrix<double> massMatrix(const MeshTopology& topology,
-                                       const Eigen::Matrix3Xd& positions,
+Eigen::SparseMatrix<double> massMatrix(const MeshTopology& topology, const PositionsRef& positions,
                                        MassType type = MassType::MixedVoronoi);
 
 }  // namespace pcl_ddg

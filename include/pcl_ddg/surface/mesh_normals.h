@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/mesh/positions_ref.h"
 #include "pcl_ddg/operators/mass_matrix.h"
 
 namespace pcl_ddg {
@@ -45,7 +46,7 @@ struct MeshNormals {
   std::int64_t fallback_vertices = 0;   ///< MeanCurvature: flat vertices given the area normal
 };
 
-MeshNormals computeMeshNormals(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+MeshNormals computeMeshNormals(const MeshTopology& topology, const PositionsRef& positions,
                                const MeshNormalOptions& options = {});
 
 }  // namespace pcl_ddg

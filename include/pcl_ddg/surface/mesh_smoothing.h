@@ -42,6 +42,7 @@
 
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/mesh/positions_ref.h"
 #include "pcl_ddg/operators/laplacian.h"
 #include "pcl_ddg/operators/mass_matrix.h"
 #include "pcl_ddg/operators/sparse_cholesky.h"
@@ -102,16 +103,16 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
  * the Gershgorin bound on the spectrum of M^-1 L (sufficient; the sharp limit is usually 1-3x
  * larger). In length^2; on scans often 1e-3 h^2 or less, because of tiny vertex areas.
  */
-double explicitStabilityLimit(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& positions,
                               LaplacianWeights weights = LaplacianWeights::Cotangent,
                               MassType mass = MassType::MixedVoronoi);
 
 /** Volume enclosed by a closed, consistently oriented mesh (divergence theorem; positive for
  *  outward faces). */
-double enclosedVolume(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+double enclosedVolume(const MeshTopology& topology, const PositionsRef& positions);
 
 /** Sum of the triangle areas. */
-double surfaceArea(const MeshTopology& topology, const Eigen::Matrix3Xd& positions);
+double surfaceArea(const MeshTopology& topology, const PositionsRef& positions);
 
 /**
  * The same as a mesh processor with pcl::MeshProcessing's shape (without its VTK dependency):

@@ -35,12 +35,12 @@ struct HeatFlowParameters {
 };
 
 /** Smooths every column of fields (N x c, one row per vertex). */
-Eigen::MatrixXd smoothScalarFields(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+Eigen::MatrixXd smoothScalarFields(const MeshTopology& topology, const PositionsRef& positions,
                                    const Eigen::MatrixXd& fields,
                                    const HeatFlowParameters& parameters);
 
 /** One field. */
-Eigen::VectorXd smoothScalarField(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+Eigen::VectorXd smoothScalarField(const MeshTopology& topology, const PositionsRef& positions,
                                   const Eigen::VectorXd& field,
                                   const HeatFlowParameters& parameters);
 
