@@ -2,7 +2,9 @@
 """pcl_ddg.distributed against the tool alone, on one synthetic survey (a height field of
 --points points in flight-line order, jittered, as binary PLY):
 
-1. pcl_ddg_normals -k 16 on the whole file (OMP_NUM_THREADS=1, and all cores);
+1. pcl_ddg_normals -k 16 on the whole file, pinned to one core (the library, like PCL's OMP
+   estimators, takes every core the process may run on: OMP_NUM_THREADS alone does not make it
+   serial), and on all cores;
 2. pcl_ddg.distributed normals -k 16 --merge on a LocalCluster of 1 and of 2 worker processes
    (one thread each), its output compared byte for byte with the tool's;
 3. the scheduler's own cost per task (no-op tasks), for docs/distributed.md's projection.
@@ -43,9 +45,11 @@ def survey(path, points, seed=1):
     pcl_ddg.write(path, np.concatenate(rows))
 
 
-def timed(command, env=None):
+def timed(command, cores=None):
+    """Wall seconds of command, run on the given cores only (None: every core)."""
+    pin = None if cores is None else (lambda: os.sched_setaffinity(0, cores))
     start = time.perf_counter()
-    subprocess.run(command, check=True, env=env, stdout=subprocess.DEVNULL,
+    subprocess.run(command, check=True, preexec_fn=pin, stdout=subprocess.DEVNULL,
                    stderr=subprocess.DEVNULL)
     return time.perf_counter() - start
 
@@ -69,8 +73,8 @@ def main():
         print(f"survey: {args.points} points, {os.path.getsize(cloud) >> 20} MiB, written in "
               f"{time.perf_counter() - start:.1f} s", flush=True)
         tool_out = os.path.join(scratch, "tool.ply")
-        env1 = dict(os.environ, OMP_NUM_THREADS="1")
-        tool1 = timed([args.tool, cloud, tool_out, "-k", "16"], env1)
+        one_core = {min(os.sched_getaffinity(0))}
+        tool1 = timed([args.tool, cloud, tool_out, "-k", "16"], one_core)
         print(f"| tool, 1 thread | {tool1:.1f} s | {args.points / tool1:,.0f} points/s |",
               flush=True)
         tool_all = timed([args.tool, cloud, tool_out, "-k", "16"])

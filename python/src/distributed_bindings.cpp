@@ -146,121 +146,37 @@ double reach(const Eigen::Vector3d& q, const Eigen::AlignedBox3d& halo_box,
   return r;
 }
 
-// Point counts on a grid of cubic cells over a gathered tile, with their 3-D prefix sums: the
-// count of any block of cells in O(1). A point's k-th neighbour (itself counted, as the kd-tree
-// counts it) lies within sqrt(3) (m + 1) c when the (2m + 1)^3 cells around its cell hold k points:
-// that block lies inside the cube of half-width (m + 1) c around the point.
-class CellCounts {
+// The kd-tree of a tile's fit, which also keeps how far each index query looked: the squared
+// distance of its k-th neighbour (infinity with fewer than k). The estimator queries in parallel,
+// each point its own slot.
+class LookingKdTree : public KdTreeSearch<pcl::PointXYZ> {
  public:
-  explicit CellCounts(const pcl::PointCloud<pcl::PointXYZ>& cloud) {
-    const std::size_t n = cloud.size();
-    if (n == 0) return;
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-    Eigen::Vector3d hi = -lo;
-    for (const auto& p : cloud) {
-      const Eigen::Vector3d v = p.getVector3fMap().cast<double>();
-      lo = lo.cwiseMin(v);
-      hi = hi.cwiseMax(v);
-    }
-    if (!lo.allFinite() || !hi.allFinite()) return;
-    origin_ = lo;
-    const Eigen::Vector3d extent = hi - lo;
-    // The cell size giving about two cells per point (bisection on a log scale).
-    double small = std::max(extent.maxCoeff(), 1e-300) * 1e-7, large = extent.maxCoeff() + 1e-300;
-    const auto cellsFor = [&](double c) {
-      double cells = 1.0;
-      for (int d = 0; d < 3; ++d) cells *= std::floor(extent[d] / c) + 2.0;
-      return cells;
-    };
-    for (int i = 0; i < 60; ++i) {
-      const double mid = std::sqrt(small * large);
-      (cellsFor(mid) > 2.0 * static_cast<double>(n) + 64.0 ? small : large) = mid;
-    }
-    cell_ = large;
-    for (int d = 0; d < 3; ++d) dims_[d] = static_cast<int>(std::floor(extent[d] / cell_)) + 1;
-    // Prefix sums over (dims + 1) per axis, index 0 being empty.
-    const std::size_t sx = static_cast<std::size_t>(dims_[0]) + 1;
-    const std::size_t sy = static_cast<std::size_t>(dims_[1]) + 1;
-    const std::size_t sz = static_cast<std::size_t>(dims_[2]) + 1;
-    stride_y_ = sz;
-    stride_x_ = sy * sz;
-    sums_.assign(sx * sy * sz, 0);
-    for (const auto& p : cloud) {
-      const Eigen::Vector3i c = cellOf(p);
-      ++sums_[at(c[0] + 1, c[1] + 1, c[2] + 1)];
-    }
-    for (std::size_t x = 1; x < sx; ++x)
-      for (std::size_t y = 0; y < sy; ++y)
-        for (std::size_t z = 0; z < sz; ++z)
-          sums_[x * stride_x_ + y * stride_y_ + z] +=
-              sums_[(x - 1) * stride_x_ + y * stride_y_ + z];
-    for (std::size_t x = 0; x < sx; ++x)
-      for (std::size_t y = 1; y < sy; ++y)
-        for (std::size_t z = 0; z < sz; ++z)
-          sums_[x * stride_x_ + y * stride_y_ + z] +=
-              sums_[x * stride_x_ + (y - 1) * stride_y_ + z];
-    for (std::size_t x = 0; x < sx; ++x)
-      for (std::size_t y = 0; y < sy; ++y)
-        for (std::size_t z = 1; z < sz; ++z)
-          sums_[x * stride_x_ + y * stride_y_ + z] += sums_[x * stride_x_ + y * stride_y_ + z - 1];
-    ready_ = true;
+  explicit LookingKdTree(std::size_t points)
+      : squared_kth_(points, std::numeric_limits<float>::infinity()) {}
+  using KdTreeSearch<pcl::PointXYZ>::nearestKSearch;
+  int nearestKSearch(const PointCloud& cloud, pcl::index_t index, int k, pcl::Indices& indices,
+                     std::vector<float>& squared) const override {
+    const int found =
+        KdTreeSearch<pcl::PointXYZ>::nearestKSearch(cloud, index, k, indices, squared);
+    if (found >= k) squared_kth_[static_cast<std::size_t>(index)] = squared[found - 1];
+    return found;
   }
-
-  /** An upper bound of the distance of q's k-th neighbour among the points (q one of them),
-   *  above the kd-tree's float rounding; infinity when no block of up to 7^3 cells holds k. */
-  double kthNeighbourBound(const pcl::PointXYZ& q, int k) const {
-    if (!ready_) return std::numeric_limits<double>::infinity();
-    const Eigen::Vector3i c = cellOf(q);
-    for (int m = 1; m <= 3; ++m) {
-      Eigen::Vector3i a, b;  // the block [a, b] of cells, clamped to the grid
-      for (int d = 0; d < 3; ++d) {
-        a[d] = std::max(c[d] - m, 0);
-        b[d] = std::min(c[d] + m, dims_[d] - 1);
-      }
-      if (blockCount(a, b) >= k) return std::sqrt(3.0) * (m + 1) * cell_ * (1.0 + 1e-4);
-    }
-    return std::numeric_limits<double>::infinity();
-  }
+  float squaredKth(std::size_t index) const { return squared_kth_[index]; }
 
  private:
-  Eigen::Vector3i cellOf(const pcl::PointXYZ& p) const {
-    Eigen::Vector3i c;
-    for (int d = 0; d < 3; ++d) {
-      const double v = std::floor((static_cast<double>(p.data[d]) - origin_[d]) / cell_);
-      c[d] = static_cast<int>(std::clamp(v, 0.0, static_cast<double>(dims_[d] - 1)));
-    }
-    return c;
-  }
-  std::size_t at(int x, int y, int z) const {
-    return static_cast<std::size_t>(x) * stride_x_ + static_cast<std::size_t>(y) * stride_y_ +
-           static_cast<std::size_t>(z);
-  }
-  // Points in cells a..b inclusive (inclusion-exclusion on the prefix sums).
-  std::int64_t blockCount(const Eigen::Vector3i& a, const Eigen::Vector3i& b) const {
-    const int x0 = a[0], y0 = a[1], z0 = a[2], x1 = b[0] + 1, y1 = b[1] + 1, z1 = b[2] + 1;
-    return static_cast<std::int64_t>(sums_[at(x1, y1, z1)]) - sums_[at(x0, y1, z1)] -
-           sums_[at(x1, y0, z1)] - sums_[at(x1, y1, z0)] + sums_[at(x0, y0, z1)] +
-           sums_[at(x0, y1, z0)] + sums_[at(x1, y0, z0)] - sums_[at(x0, y0, z0)];
-  }
-
-  bool ready_ = false;
-  Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
-  double cell_ = 1.0;
-  int dims_[3] = {1, 1, 1};
-  std::size_t stride_x_ = 0, stride_y_ = 0;
-  std::vector<std::int32_t> sums_;
+  mutable std::vector<float> squared_kth_;
 };
 
 /**
  * Fits the `own` points of a gathered tile (points in the merged cloud's order, so that the
- * kd-tree's ties break as on the whole cloud). mode "certified": a point is fitted only when its
- * k-th neighbour among the gathered points (widened by the rounding margin) is nearer than the halo
- * box's edge (`reach`); the others come back uncertified, with how far they look, for a wider
- * gather ("look": the same without fitting; "all": every own point is fitted). Radius searches
+ * kd-tree's ties break as on the whole cloud). mode "certified": a point's fit counts only when
+ * its k-th neighbour among the gathered points (widened by the rounding margin) is nearer than the
+ * halo box's edge (`reach`), as the fit's own search finds it; the others come back uncertified,
+ * with how far they looked, for a wider gather. "all": every own point is fitted. Radius searches
  * are certified by a halo of the radius, so the check applies to k only.
  * Returns (records (n_own, 4 or 9) float32: nx ny nz curvature [pc1 pc2 k1 direction],
- * certified, looking distance (an upper bound where certified without a search), reach (how far
- * each point may look inside the halo box; infinity unchecked), failed, fallback).
+ * certified, looking distance, reach (how far each point may look inside the halo box; infinity
+ * unchecked), failed, fallback).
  */
 py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::forcecast>& xyz,
                   const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& own,
@@ -270,9 +186,7 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
                   const std::optional<std::vector<double>>& halo_box,
                   const std::vector<double>& bounds, const std::string& mode,
                   unsigned int threads) {
-  choice("mode", mode, {"look", "certified", "all"});
-  const bool certify = mode != "all";
-  const bool fit_any = mode != "look";
+  const bool certify = choice("mode", mode, {"certified", "all"}) == "certified";
   if (xyz.ndim() != 2 || xyz.shape(1) != 3) throw py::value_error("points must be (m, 3)");
   const auto m = static_cast<std::size_t>(xyz.shape(0));
   const auto n_own = static_cast<std::size_t>(own.size());
@@ -309,6 +223,7 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
   const float* p = xyz.data();
   const std::int64_t* own_at = own.data();
   LocalFitResult fit;
+  std::int64_t failed = 0, fallback = 0;
   {
     py::gil_scoped_release release;
     auto cloud = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
@@ -321,74 +236,58 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
     for (std::size_t j = 0; j < n_own; ++j) {
       if (own_at[j] < 0 || static_cast<std::size_t>(own_at[j]) >= m)
         throw pcl::BadArgumentException("own position outside the gathered points");
+    }
+    std::shared_ptr<LookingKdTree> search;
+    if (check) {
+      search = std::make_shared<LookingKdTree>(m);
+      options.kd_tree_search = search;
+    }
+    auto indices = std::make_shared<pcl::Indices>(own_at, own_at + n_own);
+    if (n_own > 0) fit = fitLocalSurfaces(cloud, nullptr, options, indices);
+    // tiled_local_fit.cpp's rule: the k-th neighbour among the gathered points (never nearer than
+    // the true one), widened by the rounding margin, within the reach.
+    for (std::size_t j = 0; j < n_own; ++j) {
       ok[j] = true;
       look[j] = 0.0;
       reach_of[j] = std::numeric_limits<double>::infinity();
+      if (!check) continue;
+      const auto at = static_cast<std::size_t>(own_at[j]);
+      reach_of[j] = reach((*cloud)[at].getVector3fMap().cast<double>(), box, cloud_bounds);
+      const float squared = search->squaredKth(at);
+      look[j] = std::isfinite(squared)
+                    ? std::sqrt(static_cast<double>(squared)) * (1.0 + kRoundingMargin) + 1e-30
+                    : std::numeric_limits<double>::infinity();
+      ok[j] = look[j] <= reach_of[j];
     }
-    if (check && n_own > 0) {
-      // Most points are certified without a search: k gathered points in a block of cells around
-      // a point lie in a cube around it, which bounds its k-th neighbour's distance.
-      std::vector<std::uint8_t> searched(n_own, 1);
-      const CellCounts cells(*cloud);
-      for (std::size_t j = 0; j < n_own; ++j) {
-        const pcl::PointXYZ& q = (*cloud)[static_cast<std::size_t>(own_at[j])];
-        const double bound = cells.kthNeighbourBound(q, k);
-        reach_of[j] = reach(q.getVector3fMap().cast<double>(), box, cloud_bounds);
-        if (bound <= reach_of[j]) {
-          look[j] = bound;
-          searched[j] = 0;
-        }
-      }
-      // The others as tiled_local_fit.cpp's lookingDistances: the k-th neighbour among the
-      // gathered points (never nearer than the true one), widened by the rounding margin.
-      if (std::find(searched.begin(), searched.end(), 1) != searched.end()) {
-        KdTreeSearch<pcl::PointXYZ> search;
-        search.setInputCloud(cloud);
-        pcl::Indices neighbours;
-        std::vector<float> squared;
-        for (std::size_t j = 0; j < n_own; ++j) {
-          if (!searched[j]) continue;
-          const pcl::PointXYZ& q = (*cloud)[static_cast<std::size_t>(own_at[j])];
-          const int found = search.nearestKSearch(q, k, neighbours, squared);
-          look[j] = found < k
-                        ? std::numeric_limits<double>::infinity()
-                        : std::sqrt(static_cast<double>(squared.back())) * (1.0 + kRoundingMargin) +
-                              1e-30;
-          ok[j] = look[j] <= reach_of[j];
-        }
-      }
-    }
-    auto indices = std::make_shared<pcl::Indices>();
-    for (std::size_t j = 0; j < n_own; ++j)
-      if (ok[j]) indices->push_back(static_cast<pcl::index_t>(own_at[j]));
-    if (!fit_any) indices->clear();
-    if (!indices->empty()) fit = fitLocalSurfaces(cloud, nullptr, options, indices);
-    std::size_t at = 0;
+    // Counted over the certified points only (the others are fitted again after a wider gather):
+    // a failed point has no normal, a quadric that fell back no curvatures.
     const float nan = std::numeric_limits<float>::quiet_NaN();
     for (std::size_t j = 0; j < n_own; ++j) {
       float* r = rec + j * floats;
-      if (!ok[j] || !fit_any) {
+      if (!ok[j]) {
         std::fill(r, r + floats, nan);
         continue;
       }
-      const pcl::Normal& n = fit.normals[at];
+      const pcl::Normal& n = fit.normals[j];
+      if (!std::isfinite(n.normal_x))
+        ++failed;
+      else if (floats == 9 && !std::isfinite(fit.curvatures[j].pc1))
+        ++fallback;
       r[0] = n.normal_x;
       r[1] = n.normal_y;
       r[2] = n.normal_z;
       r[3] = n.curvature;
       if (floats == 9) {
-        const pcl::PrincipalCurvatures& c = fit.curvatures[at];
+        const pcl::PrincipalCurvatures& c = fit.curvatures[j];
         r[4] = c.pc1;
         r[5] = c.pc2;
         r[6] = c.principal_curvature_x;
         r[7] = c.principal_curvature_y;
         r[8] = c.principal_curvature_z;
       }
-      ++at;
     }
   }
-  return py::make_tuple(records, certified, looking, reaches, fit.failed_points,
-                        fit.fallback_points);
+  return py::make_tuple(records, certified, looking, reaches, failed, fallback);
 }
 
 // The tools' fields for a fit (pcl_ddg_normals: setNormalFields; pcl_ddg_curvature -method
@@ -566,8 +465,8 @@ void bindDistributed(py::module_& m) {
         py::arg("radius"), py::arg("max_nn"), py::arg("viewpoint"), py::arg("orient"),
         py::arg("up"), py::arg("halo_box"), py::arg("bounds"), py::arg("mode"), py::arg("threads"),
         "Fits a tile's own points among its gathered points (merged-cloud order); mode "
-        "'certified': only the points whose k-th neighbour is nearer than the halo's edge, "
-        "'all': every own point, 'look': no fit, the looking distances and the mask only.");
+        "'certified': the fits of the points whose k-th neighbour is nearer than the halo's edge "
+        "count, 'all': every own point's.");
   m.def("_write_output", &writeOutput, py::arg("inputs"), py::arg("output"), py::arg("results"),
         py::arg("first_result"), py::arg("floats"), py::arg("tool"), py::arg("precision"),
         py::arg("piece_points") = std::int64_t{1} << 18, py::arg("stream_pcd") = false,

@@ -25,6 +25,8 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
   } else if (options.neighbourhood == NeighbourhoodKind::Grid) {
     estimator.setSearchMethod(
         std::make_shared<OrganizedGridSearch<pcl::PointXYZ>>(options.max_depth_jump));
+  } else if (options.kd_tree_search) {
+    estimator.setSearchMethod(options.kd_tree_search);
   } else {
     estimator.setSearchMethod(std::make_shared<KdTreeSearch<pcl::PointXYZ>>());
   }

@@ -7,6 +7,7 @@
 #include <pcl/pcl_base.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
+#include <pcl/search/search.h>
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -50,6 +51,9 @@ struct LocalFitOptions {
   bool seed_facing_viewpoint = false;
   /** Up: n . up >= 0 (unset: +z); SpanningTree without seed_facing_viewpoint: the reference. */
   std::optional<Eigen::Vector3d> up;
+  /** KdTree: this search method instead of a new KdTreeSearch (one that also records what it
+   *  finds, say). */
+  std::shared_ptr<pcl::search::Search<pcl::PointXYZ>> kd_tree_search;
 };
 
 struct LocalFitResult {
