@@ -493,6 +493,13 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
             "seconds": time.perf_counter() - start}
 
 
+def write_output(inputs: List[str], output: str, results_path: str, first: int, floats: int,
+                 tool: str, precision: str) -> int:
+    """One output file on a worker: the inputs' points and fields, as the tool writes them, with
+    the results from row `first` of the results file (written atomically)."""
+    return _pcl_ddg._write_output(inputs, output, results_path, first, floats, tool, precision)
+
+
 # ---------------------------------------------------------------------------------------------
 # The client
 
@@ -730,38 +737,43 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
             report.update(result["points"])
         attempts = set(os.listdir(os.path.join(state, "attempts"))) - before
         seconds_tiles = time.perf_counter() - started
+        # The results at their points' places, then the output files, written as the tool writes
+        # them: one task per input file on the workers (one for a merged output).
+        started = time.perf_counter()
+        floats = 9 if method == "quadric" else 4
+        results_path = os.path.join(state, "results.bin")
+        mm = np.memmap(results_path, dtype="<f4", mode="w+", shape=(max(total, 1), floats))
+        mm[:] = np.nan
+        for t in plan.tiles:
+            data_path, _ = _tile_paths(state, t)
+            with open(data_path, "rb") as f:
+                n, fl = struct.unpack("<qq", f.read(16))
+                gi = np.frombuffer(f.read(8 * n), "<i8")
+                rr = np.frombuffer(f.read(4 * n * fl), "<f4").reshape(n, fl)
+            mm[gi] = rr
+        mm.flush()
+        del mm
+        tool_name = "normals" if tool == "normals" else "curvature"
+        writes = [([c.path for c in clouds], merge, 0)] if merge is not None else [
+            ([c.path], out, c.first) for c, out in zip(clouds, outputs)]
+        futures = [client.submit(write_output, paths_in, out, results_path, first, floats,
+                                 tool_name, precision, retries=retries, pure=False,
+                                 key=f"pcl_ddg-write-{i}-{uuid.uuid4().hex[:8]}")
+                   for i, (paths_in, out, first) in enumerate(writes)]
+        try:
+            client.gather(futures)
+        except Exception as error:  # noqa: BLE001
+            raise DistributedError(f"writing the outputs failed: {type(error).__name__}: "
+                                   f"{error}") from error
+        seconds_write = time.perf_counter() - started
     finally:
         if own_client:
             cluster = getattr(client, "cluster", None)
             client.close()
             if cluster is not None:
                 cluster.close()
-    # The results at their points' places, then the output files, written as the tool writes.
-    started = time.perf_counter()
-    floats = 9 if method == "quadric" else 4
-    results_path = os.path.join(state, "results.bin")
-    mm = np.memmap(results_path, dtype="<f4", mode="w+", shape=(max(total, 1), floats))
-    mm[:] = np.nan
-    for t in plan.tiles:
-        data_path, _ = _tile_paths(state, t)
-        with open(data_path, "rb") as f:
-            n, fl = struct.unpack("<qq", f.read(16))
-            gi = np.frombuffer(f.read(8 * n), "<i8")
-            rr = np.frombuffer(f.read(4 * n * fl), "<f4").reshape(n, fl)
-        mm[gi] = rr
-    mm.flush()
-    del mm
-    tool_name = "normals" if tool == "normals" else "curvature"
-    if merge is not None:
-        _pcl_ddg._write_output([c.path for c in clouds], merge, results_path, 0, floats,
-                               tool_name, precision)
-    else:
-        for c, out in zip(clouds, outputs):
-            _pcl_ddg._write_output([c.path], out, results_path, c.first, floats, tool_name,
-                                   precision)
     os.remove(results_path)
     seconds = time.perf_counter() - start
-    seconds_write = time.perf_counter() - started
     computed = sum(r["points"] for r in tiles)
     return {
         "points": total, "finite_points": plan.finite_points, "tiles": len(plan.tiles),
