@@ -41,10 +41,13 @@ fuzz_target() {
 }
 
 # The targets run side by side, one per core: each is single-threaded.
+jobs=${PCL_DDG_FUZZ_JOBS:-$(nproc)}
+[[ $jobs =~ ^[1-9][0-9]*$ ]] || { echo "PCL_DDG_FUZZ_JOBS must be a positive number" >&2; exit 2; }
+for target in "${targets[@]}"; do rm -f "$build/fuzz/$target.summary"; done
 status=0
 running=0
 for target in "${targets[@]}"; do
-  if ((running >= ${PCL_DDG_FUZZ_JOBS:-$(nproc)})); then
+  if ((running >= jobs)); then
     wait -n || status=1
     running=$((running - 1))
   fi
@@ -55,5 +58,7 @@ while ((running > 0)); do
   wait -n || status=1
   running=$((running - 1))
 done
-for target in "${targets[@]}"; do cat "$build/fuzz/$target.summary"; done
+for target in "${targets[@]}"; do
+  cat "$build/fuzz/$target.summary" 2>/dev/null || { echo "fuzz_$target: no summary"; status=1; }
+done
 exit $status

@@ -756,15 +756,23 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
         tool_name = "normals" if tool == "normals" else "curvature"
         writes = [([c.path for c in clouds], merge, 0)] if merge is not None else [
             ([c.path], out, c.first) for c, out in zip(clouds, outputs)]
-        futures = [client.submit(write_output, paths_in, out, results_path, first, floats,
-                                 tool_name, precision, retries=retries, pure=False,
-                                 key=f"pcl_ddg-write-{i}-{uuid.uuid4().hex[:8]}")
-                   for i, (paths_in, out, first) in enumerate(writes)]
         try:
+            # A .pcd is written from the whole cloud (binary_compressed, as the tool writes it):
+            # by the client, which no tile budget binds. The others piece by piece, by workers.
+            futures = [client.submit(write_output, paths_in, out, results_path, first, floats,
+                                     tool_name, precision, retries=retries, pure=False,
+                                     key=f"pcl_ddg-write-{i}-{uuid.uuid4().hex[:8]}")
+                       for i, (paths_in, out, first) in enumerate(writes)
+                       if not out.lower().endswith(".pcd")]
+            for paths_in, out, first in writes:
+                if out.lower().endswith(".pcd"):
+                    write_output(paths_in, out, results_path, first, floats, tool_name, precision)
             client.gather(futures)
         except Exception as error:  # noqa: BLE001
             raise DistributedError(f"writing the outputs failed: {type(error).__name__}: "
                                    f"{error}") from error
+        finally:
+            os.remove(results_path)
         seconds_write = time.perf_counter() - started
     finally:
         if own_client:
@@ -772,7 +780,6 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
             client.close()
             if cluster is not None:
                 cluster.close()
-    os.remove(results_path)
     seconds = time.perf_counter() - start
     computed = sum(r["points"] for r in tiles)
     return {

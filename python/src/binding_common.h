@@ -30,16 +30,20 @@ Eigen::Matrix3Xd positionsOf(const py::array& array, const char* name);
 
 /** An (n, 3) array's rows as the library's 3 x n positions: float64 C-contiguous arrays in place
  *  (their rows are the library's columns, the same bytes), any other array converted once. The
- *  array must outlive the view (a function argument does). */
+ *  array must outlive the view (a function argument does), and nothing may write to it while the
+ *  library reads it with the GIL released (as with any NumPy buffer shared between threads). */
 class PositionsView {
  public:
   PositionsView(const py::array& array, const char* name);
-  Eigen::Map<const Eigen::Matrix3Xd> map() const { return {data_, 3, cols_}; }
+  Eigen::Map<const Eigen::Matrix3Xd> map() const {
+    return in_place_ ? Eigen::Map<const Eigen::Matrix3Xd>(in_place_, 3, cols_)
+                     : Eigen::Map<const Eigen::Matrix3Xd>(converted_.data(), 3, cols_);
+  }
   Eigen::Index cols() const { return cols_; }
 
  private:
+  const double* in_place_ = nullptr;  ///< the array's buffer; null when converted
   Eigen::Matrix3Xd converted_;
-  const double* data_ = nullptr;
   Eigen::Index cols_ = 0;
 };
 

@@ -146,24 +146,27 @@ double reach(const Eigen::Vector3d& q, const Eigen::AlignedBox3d& halo_box,
   return r;
 }
 
-// The kd-tree of a tile's fit, which also keeps how far each index query looked: the squared
-// distance of its k-th neighbour (infinity with fewer than k). The estimator queries in parallel,
-// each point its own slot.
+// The kd-tree of a tile's fit, which also keeps how far each index query for the fit's k looked:
+// the squared distance of its k-th neighbour (infinity with fewer than k). The estimator queries
+// in parallel, each point its own slot.
 class LookingKdTree : public KdTreeSearch<pcl::PointXYZ> {
  public:
-  explicit LookingKdTree(std::size_t points)
-      : squared_kth_(points, std::numeric_limits<float>::infinity()) {}
+  LookingKdTree(std::size_t points, int k)
+      : k_(k), squared_kth_(points, std::numeric_limits<float>::infinity()) {}
   using KdTreeSearch<pcl::PointXYZ>::nearestKSearch;
   int nearestKSearch(const PointCloud& cloud, pcl::index_t index, int k, pcl::Indices& indices,
                      std::vector<float>& squared) const override {
     const int found =
         KdTreeSearch<pcl::PointXYZ>::nearestKSearch(cloud, index, k, indices, squared);
-    if (found >= k) squared_kth_[static_cast<std::size_t>(index)] = squared[found - 1];
+    const auto slot = static_cast<std::size_t>(index);
+    if (k == k_ && found >= k && slot < squared_kth_.size())
+      squared_kth_[slot] = squared[found - 1];
     return found;
   }
   float squaredKth(std::size_t index) const { return squared_kth_[index]; }
 
  private:
+  int k_;
   mutable std::vector<float> squared_kth_;
 };
 
@@ -239,7 +242,7 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
     }
     std::shared_ptr<LookingKdTree> search;
     if (check) {
-      search = std::make_shared<LookingKdTree>(m);
+      search = std::make_shared<LookingKdTree>(m, k);
       options.kd_tree_search = search;
     }
     auto indices = std::make_shared<pcl::Indices>(own_at, own_at + n_own);

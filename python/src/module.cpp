@@ -96,13 +96,12 @@ Eigen::Matrix3Xd positionsOf(const py::array& array, const char* name) {
 PositionsView::PositionsView(const py::array& array, const char* name) {
   if (isFloat64CContiguous(array)) {
     cols_ = rowCount(array, name);
-    data_ = static_cast<const double*>(array.data());
+    in_place_ = static_cast<const double*>(array.data());
   } else {
     converted_ = positionsOf(array, name);
     cols_ = converted_.cols();
-    data_ = converted_.data();
   }
-  lastPositionsAddress() = reinterpret_cast<std::uintptr_t>(data_);
+  lastPositionsAddress() = reinterpret_cast<std::uintptr_t>(map().data());
 }
 
 std::uintptr_t& lastPositionsAddress() {
@@ -159,7 +158,7 @@ MeshTopology topologyOf(int num_vertices, const py::object& faces, OutOfRangeFac
     const auto rows = static_cast<std::size_t>(f.shape(0));
     const auto corners = static_cast<std::size_t>(f.ndim() == 2 ? f.shape(1) : 0);
     if (corners == 3 && f.dtype().kind() == 'i' && f.dtype().itemsize() == 4 &&
-        (f.flags() & py::array::c_style) != 0) {
+        f.dtype().byteorder() != '>' && (f.flags() & py::array::c_style) != 0) {
       // int32 (m, 3) C-contiguous: the triangles' own layout, read in place and checked without
       // the GIL; copied only to drop out-of-range corners.
       const Eigen::Map<const Eigen::Matrix3Xi> in_place(static_cast<const int*>(f.data()), 3,
