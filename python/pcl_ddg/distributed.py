@@ -756,17 +756,17 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
         tool_name = "normals" if tool == "normals" else "curvature"
         writes = [([c.path for c in clouds], merge, 0)] if merge is not None else [
             ([c.path], out, c.first) for c, out in zip(clouds, outputs)]
+        # A .pcd is written from the whole cloud (binary_compressed, as the tool writes it): by
+        # the client, which no tile budget binds. The others piece by piece, by workers.
+        on_client = [w for w in writes if w[1].lower().endswith(".pcd")]
+        on_workers = [w for w in writes if w not in on_client]
         try:
-            # A .pcd is written from the whole cloud (binary_compressed, as the tool writes it):
-            # by the client, which no tile budget binds. The others piece by piece, by workers.
             futures = [client.submit(write_output, paths_in, out, results_path, first, floats,
                                      tool_name, precision, retries=retries, pure=False,
                                      key=f"pcl_ddg-write-{i}-{uuid.uuid4().hex[:8]}")
-                       for i, (paths_in, out, first) in enumerate(writes)
-                       if not out.lower().endswith(".pcd")]
-            for paths_in, out, first in writes:
-                if out.lower().endswith(".pcd"):
-                    write_output(paths_in, out, results_path, first, floats, tool_name, precision)
+                       for i, (paths_in, out, first) in enumerate(on_workers)]
+            for paths_in, out, first in on_client:
+                write_output(paths_in, out, results_path, first, floats, tool_name, precision)
             client.gather(futures)
         except Exception as error:  # noqa: BLE001
             raise DistributedError(f"writing the outputs failed: {type(error).__name__}: "
