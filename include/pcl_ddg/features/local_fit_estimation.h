@@ -30,6 +30,8 @@
 #include <optional>
 
 #include "pcl_ddg/features/consistent_orientation.h"
+#include "pcl_ddg/features/fit_orientation.h"
+#include "pcl_ddg/features/neighbourhood_fits.h"
 #include "pcl_ddg/features/normal_orientation.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 
@@ -57,8 +59,7 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
     vpy_ = vy;
     vpz_ = vz;
     use_sensor_origin_ = false;
-    orientation_ = NormalOrientation::Viewpoint;
-    orientation_chosen_ = true;
+    choose(NormalOrientation::Viewpoint);
   }
   /** The viewpoint: the one set, or the input cloud's sensor_origin_ (PCL's default; the origin
    *  before a cloud is set). */
@@ -72,8 +73,7 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   void useSensorOriginAsViewPoint() {
     use_sensor_origin_ = true;
     copySensorOrigin();
-    orientation_ = NormalOrientation::Viewpoint;
-    orientation_chosen_ = true;
+    choose(NormalOrientation::Viewpoint);
   }
 
   /**
@@ -93,18 +93,16 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
                           float& nx, float& ny, float& nz, float& curvature) const;
 
   /** Orients normals up: n . up >= 0, up = (ux, uy, uz) (setUpDirection; default +z). */
-  void setOrientationUp() {
-    orientation_ = NormalOrientation::Up;
-    orientation_chosen_ = true;
-  }
+  void setOrientationUp() { choose(NormalOrientation::Up); }
   /** The up direction of setOrientationUp, and the reference of a spanning tree not seeded
    *  facing the viewpoint (consistent_orientation.h). Unset: +z for Up, none for the tree. */
-  void setUpDirection(float ux, float uy, float uz) { up_ = Eigen::Vector3d(ux, uy, uz); }
+  void setUpDirection(float ux, float uy, float uz) {
+    orientation_.up = Eigen::Vector3d(ux, uy, uz);
+  }
   /** Orients normals like the faces of this mesh (its vertices are the input cloud's points). */
   void setOrientationMesh(std::shared_ptr<const MeshTopology> topology) {
-    orientation_mesh_ = std::move(topology);
-    orientation_ = NormalOrientation::MeshFaces;
-    orientation_chosen_ = true;
+    orientation_.mesh = std::move(topology);
+    choose(NormalOrientation::MeshFaces);
   }
   /** Orients normals consistently along a minimum spanning tree over each point's `neighbours`
    *  nearest (consistent_orientation.h) from `graph` (a search over the same input; null: the
@@ -114,17 +112,16 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
    *  indices) join the graph. */
   void setOrientationSpanningTree(int neighbours = 10, bool seed_facing_viewpoint = false,
                                   typename pcl::search::Search<PointInT>::Ptr graph = nullptr) {
-    spanning_tree_neighbours_ = neighbours;
-    seed_facing_viewpoint_ = seed_facing_viewpoint;
-    spanning_tree_graph_ = std::move(graph);
-    orientation_ = NormalOrientation::SpanningTree;
-    orientation_chosen_ = true;
+    orientation_.tree_neighbours = neighbours;
+    orientation_.seed_facing_viewpoint = seed_facing_viewpoint;
+    orientation_.tree_graph = std::move(graph);
+    choose(NormalOrientation::SpanningTree);
   }
   /** SpanningTree: what the last compute() turned (after the per-point viewpoint sign). */
-  const ConsistentOrientationReport& getOrientationReport() const { return orientation_report_; }
+  const ConsistentOrientationReport& getOrientationReport() const { return orientation_.report(); }
 
   /** The orientation used by the last compute(). */
-  NormalOrientation getOrientation() const { return used_orientation_; }
+  NormalOrientation getOrientation() const { return orientation_.used(); }
 
   /** With setRadiusSearch: at most this many neighbours, the nearest (Open3D's hybrid search);
    *  0 (the default, PCL's semantics) takes every point in the radius, which on dense or
@@ -149,20 +146,19 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   std::int64_t getFailedPoints() const { return failed_points_; }
 
  protected:
-  /** What a fit made of one neighbourhood. */
-  enum class FitOutcome { Fitted, FellBack, Failed };
+  using FitOutcome = detail::FitOutcome;
 
   bool initCompute() override;
 
-  /** Runs fit(neighbours, count, query_index, query_position, output_index) -> FitOutcome for
-   *  every query point, in parallel; neighbours holds the first count finite neighbours minus the
-   *  query position. A Failed point's output is set invalid here. */
-  template <typename Fit>
-  void fitEachNeighbourhood(PointCloudOut& output, Fit&& fit);
+  /** Runs fit for every query point, in parallel (detail::fitNeighbourhoods; the fit's
+   *  arguments are detail::NeighbourhoodFit's). A Failed point's output is set invalid here. */
+  void fitEachNeighbourhood(PointCloudOut& output, const detail::NeighbourhoodFit& fit);
 
   /** Turns n to agree with the reference of query point index (at position p); true if flipped.
    *  SpanningTree: towards the viewpoint, until makeOrientationConsistent. */
-  bool orient(Eigen::Vector3d& n, pcl::index_t index, const Eigen::Vector3d& p) const;
+  bool orient(Eigen::Vector3d& n, pcl::index_t index, const Eigen::Vector3d& p) const {
+    return orientation_.orient(n, index, p);
+  }
 
   /** SpanningTree only: turns output normals to agree along the tree, calling
    *  on_turn(output_index) after each normal it turns. */
@@ -184,6 +180,9 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   unsigned int threads_ = 0;
 
  private:
+  /** threads_, with 0 meaning every core. */
+  int threadCount() const;
+
   /** The input's sensor origin into vpx_, vpy_, vpz_; the origin without an input. */
   void copySensorOrigin() {
     const Eigen::Vector4f origin =
@@ -193,17 +192,12 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
     vpz_ = origin.z();
   }
 
-  Eigen::Vector3d viewpoint_ = Eigen::Vector3d::Zero();  ///< as used by the current compute()
-  std::optional<Eigen::Vector3d> up_;
-  NormalOrientation orientation_ = NormalOrientation::Viewpoint;
-  bool orientation_chosen_ = false;  ///< false: by the search method (see above)
-  NormalOrientation used_orientation_ = NormalOrientation::Viewpoint;
-  std::shared_ptr<const MeshTopology> orientation_mesh_;
-  Eigen::Matrix3Xd reference_normals_;  ///< MeshFaces: one per input point
-  int spanning_tree_neighbours_ = 10;
-  typename pcl::search::Search<PointInT>::Ptr spanning_tree_graph_;  ///< null: tree_
-  bool seed_facing_viewpoint_ = false;
-  ConsistentOrientationReport orientation_report_;
+  void choose(NormalOrientation policy) {
+    orientation_.policy = policy;
+    orientation_.chosen = true;
+  }
+
+  detail::FitOrientation<PointInT> orientation_;
   std::int64_t failed_points_ = 0;
 };
 
