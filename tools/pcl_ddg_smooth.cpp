@@ -1,9 +1,10 @@
-// pcl_ddg_smooth: Laplacian smoothing of a mesh's vertex positions, explicit (many small steps)
-// or implicit (few large ones), with the time step in units of the squared mean edge length.
+// pcl_ddg_smooth: Laplacian smoothing of a mesh's vertex positions, explicit (many small steps),
+// implicit (few large ones) or Taubin's lambda|mu (without shrinking); see kDescription.
 #include <pcl/exceptions.h>
 
 #include <cmath>
 #include <iostream>
+#include <sstream>
 
 #include "common/operator_options.h"
 #include "common/tool_common.h"
@@ -14,22 +15,32 @@
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/surface/mesh_smoothing.h"
+#include "pcl_ddg/surface/smoothing_steps.h"
 
 namespace {
 
 constexpr const char* kName = "pcl_ddg_smooth";
 constexpr const char* kDescription =
-    "Smooths a mesh by Laplacian flow dx/dt = M^-1 L x: explicit (forward Euler; stable only for\n"
-    "small steps, the bound is printed) or implicit (backward Euler, one sparse Cholesky or\n"
-    "conjugate-gradient solve per iteration, by default whichever costs less; any step). The time "
-    "step -lambda_dt is in units of h^2 (h = mean edge length), so\n"
-    "one command line works on any scan; -absolute_time takes it in length^2.";
+    "Smooths a mesh by Laplacian flow dx/dt = A^-1 L x: explicit (forward Euler; stable only for\n"
+    "small steps, the bound is printed), implicit (backward Euler, one sparse Cholesky or\n"
+    "conjugate-gradient solve per iteration, by default whichever costs less; any step) or Taubin\n"
+    "(a step of -lambda then one of -mu per iteration: smooths without shrinking).\n"
+    "A averages L: the vertex areas (-average area: the geometric flow, whose time step\n"
+    "-lambda_dt is in units of h^2, h = mean edge length, so one command line works on any scan;\n"
+    "-absolute_time takes it in length^2) or the vertex degrees (-average degree: each vertex\n"
+    "moves towards the mean of its neighbours; steps are dimensionless, explicit ones stable up\n"
+    "to 1). -weights umbrella is uniform weights averaged by degree, the default of -method\n"
+    "explicit and taubin; implicit defaults to cotan weights averaged by area.\n"
+    "Default weight update: the Laplacian frozen at the input, the areas following the surface\n"
+    "(rebuilt cotangent weights pinch thin triangles into slivers within a few large steps);\n"
+    "-freeze_weights freezes both, -rebuild_weights rebuilds both every iteration.";
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk} output.{ply,pcd,las}\n"
-    "         [-method explicit|implicit (default implicit)] [-weights uniform|cotan (default "
-    "cotan)]\n"
-    "         [-area mixed|voronoi|barycentric] [-lambda_dt t (default: implicit 1, explicit half "
-    "the stability bound)]\n"
+    "         [-method explicit|implicit|taubin (default implicit)]\n"
+    "         [-weights uniform|cotan|umbrella (default: cotan implicit, umbrella otherwise)]\n"
+    "         [-average area|degree] [-area mixed|voronoi|barycentric]\n"
+    "         [-lambda_dt t (default: implicit 1, explicit half the stability bound)]\n"
+    "         [-lambda l (taubin, default 0.5)] [-mu m (taubin, default -0.53)]\n"
     "         [-iterations n (default 1)] [-absolute_time] [-freeze_weights | -rebuild_weights]\n"
     "         [-fix_boundary] [-allow_unstable]\n"
     "         [-preserve volume|area] [-solver auto|cholmod|ldlt|cg] [-precision float|double]";
@@ -38,20 +49,30 @@ int run(int argc, char** argv) {
   using namespace pcl_ddg;
   const tools::ToolArguments args(
       argc, argv,
-      {"method", "weights", "area", "mass", "lambda_dt", "iterations", "preserve", "solver",
-       "precision"},
+      {"method", "weights", "average", "area", "mass", "lambda_dt", "lambda", "mu", "iterations",
+       "preserve", "solver", "precision"},
       {"absolute_time", "freeze_weights", "rebuild_weights", "fix_boundary", "allow_unstable"});
   MeshSmoothingParameters p;
-  p.scheme = args.choice("method", {"explicit", "implicit"}, "implicit") == "explicit"
-                 ? SmoothingScheme::Explicit
-                 : SmoothingScheme::Implicit;
-  p.weights = args.choice("weights", {"uniform", "cotan"}, "cotan") == "uniform"
-                  ? LaplacianWeights::Uniform
-                  : LaplacianWeights::Cotangent;
+  const std::string method = args.choice("method", {"explicit", "implicit", "taubin"}, "implicit");
+  p.scheme = method == "explicit" ? SmoothingScheme::Explicit
+             : method == "taubin" ? SmoothingScheme::Taubin
+                                  : SmoothingScheme::Implicit;
+  const std::string weights = args.choice("weights", {"uniform", "cotan", "umbrella"},
+                                          method == "implicit" ? "cotan" : "umbrella");
+  p.weights = weights == "cotan" ? LaplacianWeights::Cotangent : LaplacianWeights::Uniform;
+  if (weights == "umbrella" && args.has("average") && args.value("average") != "degree")
+    throw tools::UsageError("-weights umbrella is averaged by degree");
+  p.average = args.choice("average", {"area", "degree"},
+                          weights == "umbrella" || (!args.has("weights") && method != "implicit")
+                              ? "degree"
+                              : "area") == "degree"
+                  ? FlowAverage::Degree
+                  : FlowAverage::Area;
+  if (p.average == FlowAverage::Degree && (args.has("area") || args.has("mass")))
+    throw tools::UsageError("-area weighs the flow by vertex areas, not by degrees");
   p.mass = tools::vertexAreaArgument(args);
   p.iterations = args.integer("iterations", 1);
   if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
-  // Default: stiffness frozen at the input, mass updated (see mesh_smoothing.h).
   if (args.has("freeze_weights") && args.has("rebuild_weights"))
     throw tools::UsageError("-freeze_weights and -rebuild_weights exclude each other");
   if (args.has("freeze_weights")) p.weight_update = WeightUpdate::Frozen;
@@ -64,40 +85,36 @@ int run(int argc, char** argv) {
   const tools::SolverChoice solver = tools::solverArgument(args);
   p.implicit_solver = solver.method;
   p.solver = solver.backend;
-  if (args.has("absolute_time") && !args.has("lambda_dt"))
-    throw tools::UsageError("-absolute_time needs -lambda_dt");
-  const double lambda_dt = args.number("lambda_dt", 1.0);
-  if (!(lambda_dt > 0.0) || !std::isfinite(lambda_dt))
-    throw tools::UsageError("-lambda_dt must be > 0");
+  const bool taubin = p.scheme == SmoothingScheme::Taubin;
+  if (taubin && args.has("lambda_dt"))
+    throw tools::UsageError("-method taubin takes -lambda and -mu, not -lambda_dt");
+  if (!taubin && (args.has("lambda") || args.has("mu")))
+    throw tools::UsageError("-lambda and -mu are -method taubin's (the flow takes -lambda_dt)");
+  const char* step_option = taubin ? "lambda" : "lambda_dt";
+  if (args.has("absolute_time") && !args.has(step_option))
+    throw tools::UsageError(std::string("-absolute_time needs -") + step_option);
+  if (args.has("absolute_time") && p.average == FlowAverage::Degree)
+    throw tools::UsageError("-absolute_time is for -average area (degree steps have no unit)");
+  RelativeSteps steps;
+  if (args.has(step_option)) steps.step = args.number(step_option, 0.0);
+  steps.mu = args.number("mu", steps.mu);
+  if (steps.step && (!(*steps.step > 0.0) || !std::isfinite(*steps.step)))
+    throw tools::UsageError(std::string("-") + step_option + " must be > 0");
+  if (taubin && (!(steps.mu < -steps.step.value_or(0.5)) || !std::isfinite(steps.mu)))
+    throw tools::UsageError("-mu must be below -lambda (e.g. -lambda 0.5 -mu -0.53)");
+  steps.absolute_time = args.has("absolute_time");
+  steps.allow_unstable = args.has("allow_unstable");
   const FieldPrecision precision = tools::precisionArgument(args);
 
   return tools::forEachInput(
       args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
         tools::ToolInput in(input, kName, tools::InputKind::Mesh);
-        const double h = in.spacing();
-        if (!(h > 0.0)) throw std::runtime_error("the mesh has no edge of positive length");
-        if (p.scheme == SmoothingScheme::Explicit) {
-          const double bound =
-              explicitStabilityLimit(*in.topology, in.positions, p.weights, p.mass);
-          p.time_step = args.has("lambda_dt")
-                            ? (args.has("absolute_time") ? lambda_dt : lambda_dt * h * h)
-                            : 0.5 * bound;
-          std::cerr << kName << ": explicit step " << p.time_step / (h * h)
-                    << " h^2; stability bound " << bound / (h * h) << " h^2\n";
-          if (p.time_step > bound) {
-            if (!args.has("allow_unstable")) {
-              throw pcl::BadArgumentException(
-                  "the explicit step " + std::to_string(p.time_step / (h * h)) +
-                  " h^2 exceeds the stability bound " + std::to_string(bound / (h * h)) +
-                  " h^2: the surface would blow up (use -method implicit for large steps, or "
-                  "-allow_unstable)");
-            }
-            tools::warn(kName,
-                        "the step exceeds the explicit stability bound: expect the surface to "
-                        "blow up");
-          }
-        } else {
-          p.time_step = args.has("absolute_time") ? lambda_dt : lambda_dt * h * h;
+        const ResolvedSteps resolved = resolveSteps(*in.topology, in.positions, steps, p);
+        std::cerr << kName << ": " << describeSteps(p, resolved) << "\n";
+        if (resolved.unstable) {
+          tools::warn(kName,
+                      "the step exceeds the explicit stability bound: expect the surface to "
+                      "blow up");
         }
 
         const std::size_t points = static_cast<std::size_t>(in.positions.cols());
@@ -109,15 +126,17 @@ int run(int argc, char** argv) {
             return smoothMeshPositions(*in.topology, in.positions, p, &report,
                                        [&](int done, int total) { progress.update(done, total); });
           } catch (const SurfaceCollapseException& e) {
-            throw std::runtime_error(errorDescription(e) + ": use a smaller -lambda_dt (" +
-                                     std::to_string(p.time_step / (h * h)) + " h^2 now)");
+            std::ostringstream what;
+            what << errorDescription(e) << ": use a smaller -" << step_option << " ("
+                 << p.time_step / resolved.unit << resolved.unit_name << " now)";
+            throw std::runtime_error(what.str());
           }
         }();
         progress.finish();
         timer.done(points);
         if (p.scheme == SmoothingScheme::Implicit) {
           std::cerr << kName << ": " << report.iterations << " implicit step(s) of "
-                    << p.time_step / (h * h) << " h^2, solver ";
+                    << p.time_step / resolved.unit << resolved.unit_name << ", solver ";
           if (report.implicit_solver == ImplicitSolver::ConjugateGradient) {
             std::cerr << "conjugate gradients (" << report.conjugate_gradient_iterations
                       << " iterations)\n";

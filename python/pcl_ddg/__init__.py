@@ -227,9 +227,12 @@ def smooth(
     V: ArrayLike,
     F: Faces,
     method: str = "implicit",
-    weights: str = "cotan",
+    weights: Optional[str] = None,
+    average: Optional[str] = None,
     mass: str = "mixed",
     lambda_dt: Optional[float] = None,
+    lambda_: Optional[float] = None,
+    mu: float = -0.53,
     iterations: int = 1,
     absolute_time: bool = False,
     freeze_weights: bool = False,
@@ -239,14 +242,24 @@ def smooth(
     preserve: str = "none",
     solver: str = "auto",
 ) -> np.ndarray:
-    """Laplacian smoothing of the vertex positions (``pcl_ddg_smooth``): dx/dt = M^-1 L x.
+    """Laplacian smoothing of the vertex positions (``pcl_ddg_smooth``): dx/dt = A^-1 L x.
 
     method:
-        ``"implicit"`` (backward Euler, stable for any step) or ``"explicit"`` (forward Euler,
-        stable only below a bound; a larger step raises ValueError unless ``allow_unstable``).
+        ``"implicit"`` (backward Euler, stable for any step), ``"explicit"`` (forward Euler,
+        stable only below a bound; a larger step raises ValueError unless ``allow_unstable``) or
+        ``"taubin"`` (a step of ``lambda_`` then one of ``mu`` per iteration: no shrinkage).
+    weights:
+        ``"cotan"``, ``"uniform"`` or ``"umbrella"`` (uniform averaged by degree: each vertex moves
+        towards the mean of its neighbours). Default: cotan (implicit), umbrella (otherwise).
+    average:
+        what divides L: ``"area"`` (the vertex areas of ``mass``: the geometric flow) or
+        ``"degree"`` (each vertex's total weight). Default: degree for umbrella, else area.
     lambda_dt:
-        the time step in units of h^2 (h = mean edge length), or in length^2 with
-        ``absolute_time=True``. Default: 1 (implicit), half the stability bound (explicit).
+        the flow's time step: averaged by area in units of h^2 (h = mean edge length), or in
+        length^2 with ``absolute_time=True``; averaged by degree without unit. Default: 1
+        (implicit), half the stability bound (explicit).
+    lambda_, mu:
+        Taubin's two steps (mu < -lambda_), in lambda_dt's units; default 0.5 and -0.53.
     freeze_weights / rebuild_weights:
         by default L is frozen at the input and M follows the surface; ``freeze_weights`` freezes
         both, ``rebuild_weights`` rebuilds both every iteration (the singular mean-curvature flow).
@@ -262,8 +275,11 @@ def smooth(
         _faces(F),
         method,
         weights,
+        average,
         mass,
         lambda_dt,
+        lambda_,
+        float(mu),
         int(iterations),
         bool(absolute_time),
         bool(freeze_weights),

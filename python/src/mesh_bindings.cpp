@@ -17,6 +17,7 @@
 #include "pcl_ddg/surface/mesh_normals.h"
 #include "pcl_ddg/surface/mesh_smoothing.h"
 #include "pcl_ddg/surface/scalar_field_smoothing.h"
+#include "pcl_ddg/surface/smoothing_steps.h"
 
 namespace pcl_ddg {
 namespace python {
@@ -186,13 +187,28 @@ void bindMeshes(py::module_& m) {
   m.def(
       "smooth",
       [](const py::array& V, const py::object& F, const std::string& method,
-         const std::string& weights, const std::string& mass, std::optional<double> lambda_dt,
-         int iterations, bool absolute_time, bool freeze_weights, bool rebuild_weights,
+         std::optional<std::string> weights, std::optional<std::string> average,
+         const std::string& mass, std::optional<double> lambda_dt, std::optional<double> lambda_,
+         double mu, int iterations, bool absolute_time, bool freeze_weights, bool rebuild_weights,
          bool fix_boundary, bool allow_unstable, const std::string& preserve,
          const std::string& solver) {
+        // pcl_ddg_smooth's options and defaults (tools/pcl_ddg_smooth.cpp).
         MeshSmoothingParameters p;
-        p.scheme = schemeOf(method);
-        p.weights = weightsOf(weights);
+        const std::string scheme = choice("method", method, {"implicit", "explicit", "taubin"});
+        p.scheme = scheme == "explicit" ? SmoothingScheme::Explicit
+                   : scheme == "taubin" ? SmoothingScheme::Taubin
+                                        : SmoothingScheme::Implicit;
+        const std::string w =
+            choice("weights", weights.value_or(scheme == "implicit" ? "cotan" : "umbrella"),
+                   {"cotan", "uniform", "umbrella"});
+        p.weights = w == "cotan" ? LaplacianWeights::Cotangent : LaplacianWeights::Uniform;
+        if (w == "umbrella" && average && *average != "degree")
+          throw py::value_error("weights='umbrella' is averaged by degree");
+        const bool by_degree = w == "umbrella" || (!weights && scheme != "implicit");
+        p.average = choice("average", average.value_or(by_degree ? "degree" : "area"),
+                           {"area", "degree"}) == "degree"
+                        ? FlowAverage::Degree
+                        : FlowAverage::Area;
         p.mass = massOf(mass);
         if (iterations < 1) throw py::value_error("iterations must be at least 1");
         p.iterations = iterations;
@@ -208,38 +224,30 @@ void bindMeshes(py::module_& m) {
         const SolverChoice s = solverOf(solver);
         p.implicit_solver = s.method;
         p.solver = s.backend;
-        if (absolute_time && !lambda_dt) throw py::value_error("absolute_time needs lambda_dt");
-        if (lambda_dt && (!(*lambda_dt > 0.0) || !std::isfinite(*lambda_dt)))
-          throw py::value_error("lambda_dt must be > 0");
+        const bool taubin = p.scheme == SmoothingScheme::Taubin;
+        if (taubin && lambda_dt)
+          throw py::value_error("method='taubin' takes lambda_ and mu, not lambda_dt");
+        if (!taubin && lambda_)
+          throw py::value_error("lambda_ is method='taubin''s (the flow takes lambda_dt)");
+        RelativeSteps steps;
+        steps.step = taubin ? lambda_ : lambda_dt;
+        steps.mu = mu;
+        steps.absolute_time = absolute_time;
+        steps.allow_unstable = allow_unstable;
+        if (absolute_time && !steps.step)
+          throw py::value_error(taubin ? "absolute_time needs lambda_"
+                                       : "absolute_time needs lambda_dt");
         Mesh mesh = meshOf(V, F);
         Eigen::Matrix3Xd smoothed = compute([&] {
-          // As pcl_ddg_smooth: the step in units of h^2 unless absolute_time; the explicit
-          // default is half the stability bound, and a step above it is refused.
-          const double h = meanEdgeLength(mesh.topology, mesh.positions.map());
-          if (!(h > 0.0))
-            throw pcl::BadArgumentException("the mesh has no edge of positive length");
-          const double step = lambda_dt.value_or(1.0);
-          if (p.scheme == SmoothingScheme::Explicit) {
-            const double bound =
-                explicitStabilityLimit(mesh.topology, mesh.positions.map(), p.weights, p.mass);
-            p.time_step = lambda_dt ? (absolute_time ? step : step * h * h) : 0.5 * bound;
-            if (p.time_step > bound && !allow_unstable) {
-              throw pcl::BadArgumentException(
-                  "the explicit step " + std::to_string(p.time_step / (h * h)) +
-                  " h^2 exceeds the stability bound " + std::to_string(bound / (h * h)) +
-                  " h^2: the surface would blow up (use method='implicit' for large steps, or "
-                  "allow_unstable=True)");
-            }
-          } else {
-            p.time_step = absolute_time ? step : step * h * h;
-          }
+          resolveSteps(mesh.topology, mesh.positions.map(), steps, p);
           return smoothMeshPositions(mesh.topology, Eigen::Matrix3Xd(mesh.positions.map()), p,
                                      nullptr, checkSignals);
         });
         return rowsArray(std::move(smoothed));
       },
-      py::arg("V"), py::arg("F"), py::arg("method") = "implicit", py::arg("weights") = "cotan",
-      py::arg("mass") = "mixed", py::arg("lambda_dt") = py::none(), py::arg("iterations") = 1,
+      py::arg("V"), py::arg("F"), py::arg("method") = "implicit", py::arg("weights") = py::none(),
+      py::arg("average") = py::none(), py::arg("mass") = "mixed", py::arg("lambda_dt") = py::none(),
+      py::arg("lambda_") = py::none(), py::arg("mu") = -0.53, py::arg("iterations") = 1,
       py::arg("absolute_time") = false, py::arg("freeze_weights") = false,
       py::arg("rebuild_weights") = false, py::arg("fix_boundary") = false,
       py::arg("allow_unstable") = false, py::arg("preserve") = "none", py::arg("solver") = "auto",

@@ -55,7 +55,11 @@ def test_smooth_field_equals_pcl_ddg_curvature_smooth(tmp_path):
 
 @pytest.mark.parametrize("arguments", [[], ["-method", "explicit", "-iterations", "20"],
                                        ["-lambda_dt", "5", "-preserve", "volume",
-                                        "-freeze_weights"]])
+                                        "-freeze_weights"],
+                                       ["-method", "taubin", "-lambda", "0.4", "-mu", "-0.45",
+                                        "-iterations", "10"],
+                                       ["-method", "explicit", "-weights", "cotan",
+                                        "-average", "degree"]])
 def test_smooth_equals_pcl_ddg_smooth(tmp_path, arguments):
     source = shared_data() / "meshes" / "bunny.off"
     out = tmp_path / "smooth.ply"
@@ -73,6 +77,12 @@ def test_smooth_equals_pcl_ddg_smooth(tmp_path, arguments):
             keywords["preserve"] = value
         elif flag == "-freeze_weights":
             keywords["freeze_weights"] = True
+        elif flag == "-lambda":
+            keywords["lambda_"] = float(value)
+        elif flag == "-mu":
+            keywords["mu"] = float(value)
+        elif flag in ("-weights", "-average"):
+            keywords[flag[1:]] = value
     smoothed = pcl_ddg.smooth(mesh.points, mesh.faces, **keywords)
     np.testing.assert_array_equal(smoothed, pcl_ddg.read(out).points)
 

@@ -27,6 +27,8 @@ Eigen::Matrix3Xd smoothOrganizedPositions(const Eigen::Matrix3Xd& positions, int
   if (positions.cols() != n) badArgument("positions do not match width x height");
   if (!(p.time_step > 0.0) || !std::isfinite(p.time_step)) badArgument("time step must be > 0");
   if (p.iterations < 1) badArgument("iterations must be at least 1");
+  if (p.scheme == SmoothingScheme::Taubin)
+    badArgument("grid smoothing is explicit or implicit, not Taubin");
   if (!(p.max_depth_jump > 0.0)) badArgument("max depth jump must be > 0");
   if (!origin.allFinite()) badArgument("the sensor origin is not finite");
 

@@ -74,12 +74,19 @@ void requireNotCollapsed(const MeshTopology& topology, const Eigen::Matrix3Xd& c
   }
 }
 
+/** What divides L (see FlowAverage): the lumped mass, or the degree -diag(L). */
+Eigen::VectorXd averageOf(const Eigen::SparseMatrix<double>& l, const MeshTopology& topology,
+                          const PositionsRef& positions, MassType mass, FlowAverage average) {
+  if (average == FlowAverage::Area) return lumpedMass(topology, positions, mass);
+  return -Eigen::VectorXd(l.diagonal());
+}
+
 }  // namespace
 
 double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& positions,
-                              LaplacianWeights weights, MassType mass) {
+                              LaplacianWeights weights, MassType mass, FlowAverage average) {
   const Eigen::SparseMatrix<double> l = laplacian(topology, positions, weights);
-  const Eigen::VectorXd m = lumpedMass(topology, positions, mass);
+  const Eigen::VectorXd m = averageOf(l, topology, positions, mass, average);
   double largest = 0.0;  // max_i sum_j |L_ij| / m_i (L is symmetric: columns are rows)
   for (Eigen::Index v = 0; v < l.outerSize(); ++v) {
     if (!(m[v] > 0.0)) continue;
@@ -123,6 +130,9 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   requireFinite(positions);
   if (!(p.time_step > 0.0) || !std::isfinite(p.time_step)) badArgument("time step must be > 0");
   if (p.iterations < 1) badArgument("iterations must be at least 1");
+  if (p.scheme == SmoothingScheme::Taubin && !(p.taubin_mu < -p.time_step)) {
+    badArgument("Taubin's mu must be below -lambda (e.g. lambda 0.5, mu -0.53)");
+  }
   if (p.shrinkage != ShrinkageCorrection::None && p.boundary == BoundaryCondition::Fixed) {
     badArgument("a shrinkage correction rescales the whole mesh: it cannot keep a fixed boundary");
   }
@@ -136,9 +146,10 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   }
   detail::LaplacianFlow flow(n, std::move(fixed), p.solver, p.implicit_solver);
   flow.planSteps(p.iterations, p.weight_update == WeightUpdate::Frozen ? 1 : p.iterations);
+  Eigen::SparseMatrix<double> stiffness;
   const auto setOperator = [&](const Eigen::Matrix3Xd& at) {
-    flow.setOperator(laplacian(topology, at, p.weights, LaplacianForm::Summed),
-                     lumpedMass(topology, at, p.mass));
+    stiffness = laplacian(topology, at, p.weights, LaplacianForm::Summed);
+    flow.setOperator(stiffness, averageOf(stiffness, topology, at, p.mass, p.average));
   };
 
   // The before and after measures are for the report, and the shrinkage corrections' targets.
@@ -162,10 +173,15 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   r.fixed_vertices = n - flow.numFree();
   for (int iteration = 1; iteration <= p.iterations; ++iteration) {
     if (iteration > 1 && p.weight_update == WeightUpdate::EveryIteration) setOperator(current);
-    if (iteration > 1 && p.weight_update == WeightUpdate::FrozenStiffness)
+    // A degree average belongs to the stiffness: with it frozen, nothing follows the surface.
+    if (iteration > 1 && p.weight_update == WeightUpdate::FrozenStiffness &&
+        p.average == FlowAverage::Area)
       flow.setMass(lumpedMass(topology, current, p.mass));
     if (p.scheme == SmoothingScheme::Explicit) {
       flow.explicitStep(values, p.time_step);
+    } else if (p.scheme == SmoothingScheme::Taubin) {
+      flow.explicitStep(values, p.time_step);
+      flow.explicitStep(values, p.taubin_mu);
     } else {
       try {
         flow.implicitStep(values, p.time_step);
@@ -175,7 +191,7 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
     }
     current = values.transpose();
     if (!current.allFinite()) {
-      failedAt(iteration, p.scheme == SmoothingScheme::Explicit
+      failedAt(iteration, p.scheme != SmoothingScheme::Implicit
                               ? "non-finite positions (the explicit step is unstable: use a "
                                 "smaller time step or the implicit scheme)"
                               : "non-finite positions");

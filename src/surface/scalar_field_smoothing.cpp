@@ -24,6 +24,7 @@ Eigen::MatrixXd smoothScalarFields(const MeshTopology& topology, const Positions
   if (!(p.diffusion_time > 0.0) || !std::isfinite(p.diffusion_time))
     bad("diffusion time must be > 0");
   if (p.iterations < 1) bad("iterations must be at least 1");
+  if (p.scheme == SmoothingScheme::Taubin) bad("heat flow is explicit or implicit, not Taubin");
 
   const Eigen::VectorXd mass = lumpedMass(topology, positions, p.mass);
   // Massless vertices keep their values (NaN allowed there); they take no part in the flow.

@@ -39,8 +39,8 @@ TEST_F(SmoothingTools, SmoothSharedMeshesBothSchemesKeepTheMeshAndPreserveVolume
     const pcl::PolygonMesh& original = original_file.mesh;
     const MeshTopology topology(original);
     const Eigen::Matrix3Xd& before = original_file.positions;
-    for (const char* options :
-         {"", "-method explicit -iterations 20", "-lambda_dt 5 -weights uniform"}) {
+    for (const char* options : {"", "-method explicit -iterations 20",
+                                "-lambda_dt 5 -weights uniform", "-method taubin -iterations 20"}) {
       SCOPED_TRACE(options);
       const ToolRun run =
           runTool(PCL_DDG_SMOOTH_TOOL, input + " " + path("out.ply") + " " + options);
@@ -100,14 +100,35 @@ TEST_F(SmoothingTools, ExplicitStepsAboveTheStabilityBoundAreRefusedUnlessAllowe
   ASSERT_EQ(safe.exit_code, 0) << safe.err;
   EXPECT_NE(safe.err.find("stability bound"), std::string::npos) << safe.err;
   EXPECT_EQ(safe.err.find("warning"), std::string::npos) << safe.err;
+  // The umbrella operator (explicit's default) is stable up to a step of 1, without unit.
+  EXPECT_NE(safe.err.find("explicit step 0.5 (averaged by degree); stability bound 1\n"),
+            std::string::npos)
+      << safe.err;
   const ToolRun refused =
-      runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("b.ply") + " -method explicit -lambda_dt 1");
+      runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("b.ply") + " -method explicit -lambda_dt 1.5");
   EXPECT_EQ(refused.exit_code, 2);
-  EXPECT_NE(refused.err.find("pcl_ddg_smooth: error: the explicit step 1"), std::string::npos)
+  EXPECT_NE(refused.err.find("pcl_ddg_smooth: error: the explicit step 1.5 exceeds the stability "
+                             "bound 1:"),
+            std::string::npos)
       << refused.err;
   EXPECT_FALSE(std::filesystem::exists(path("b.ply")));
+  // Cotangent weights over vertex areas: a bound in h^2, a fraction of one on the cow.
+  const ToolRun cotan = runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("b.ply") +
+                                                         " -method explicit -weights cotan "
+                                                         "-lambda_dt 1");
+  EXPECT_EQ(cotan.exit_code, 2);
+  EXPECT_NE(cotan.err.find("error: the explicit step 1 h^2 exceeds the stability bound 0.0"),
+            std::string::npos)
+      << cotan.err;
+  const ToolRun taubin = runTool(PCL_DDG_SMOOTH_TOOL,
+                                 cow + " " + path("b.ply") + " -method taubin -lambda 1 -mu -1.1");
+  EXPECT_EQ(taubin.exit_code, 2);
+  EXPECT_NE(taubin.err.find("error: the Taubin step 1.1 exceeds the stability bound 1:"),
+            std::string::npos)
+      << taubin.err;
+  EXPECT_FALSE(std::filesystem::exists(path("b.ply")));
   const ToolRun allowed = runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("c.ply") +
-                                                           " -method explicit -lambda_dt 1 "
+                                                           " -method explicit -lambda_dt 1.5 "
                                                            "-iterations 2 -allow_unstable");
   EXPECT_NE(allowed.err.find("warning: the step exceeds the explicit stability bound"),
             std::string::npos)

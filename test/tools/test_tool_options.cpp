@@ -419,17 +419,22 @@ TEST_F(ToolOptions, CurvatureEqualsTheLibraryForEveryAreaFitSmoothingAndColour) 
 // ---------------------------------------------------------------------------------------------
 // pcl_ddg_smooth
 
-// The tool's time step: -lambda_dt in h^2 (length^2 with -absolute_time); explicit without
-// -lambda_dt: half the stability bound.
+// The tool's time step: -lambda_dt (Taubin: -lambda, and -mu) in h^2 when averaged by area
+// (length^2 with -absolute_time), without unit when averaged by degree; the flow's explicit
+// default: half the stability bound; Taubin's: 0.5 and -0.53.
 Fields smoothedMesh(const Input& in, MeshSmoothingParameters p, std::optional<double> lambda_dt,
                     bool absolute_time = false) {
-  if (!lambda_dt) {
-    p.time_step =
-        p.scheme == SmoothingScheme::Explicit
-            ? 0.5 * explicitStabilityLimit(*in.topology, in.positions(), p.weights, p.mass)
-            : in.h * in.h;
+  const double unit = p.average == FlowAverage::Area && !absolute_time ? in.h * in.h : 1.0;
+  p.taubin_mu *= unit;
+  if (p.scheme == SmoothingScheme::Taubin) {
+    p.time_step = lambda_dt.value_or(0.5) * unit;
+  } else if (!lambda_dt) {
+    p.time_step = p.scheme == SmoothingScheme::Explicit
+                      ? 0.5 * explicitStabilityLimit(*in.topology, in.positions(), p.weights,
+                                                     p.mass, p.average)
+                      : unit;
   } else {
-    p.time_step = absolute_time ? *lambda_dt : *lambda_dt * in.h * in.h;
+    p.time_step = *lambda_dt * unit;
   }
   return {{"x", "y", "z"}, smoothMeshPositions(*in.topology, in.positions(), p)};
 }
@@ -445,10 +450,23 @@ TEST_F(ToolOptions, SmoothEqualsTheLibraryForEveryScheme) {
   // The settings, each one change from the library's defaults (which are the tool's).
   const P implicit;
   P explicit_scheme, explicit5, uniform, voronoi, barycentric, explicit_barycentric, three, frozen,
-      rebuilt, volume, area, fixed;
-  explicit_scheme.scheme = explicit5.scheme = explicit_barycentric.scheme =
+      rebuilt, volume, area, fixed, umbrella, umbrella5, degree, taubin, taubin5, explicit_cotan,
+      explicit_cotan5;
+  explicit_cotan.scheme = explicit_cotan5.scheme = explicit_barycentric.scheme =
       SmoothingScheme::Explicit;
-  explicit5.iterations = 5;
+  explicit_cotan5.iterations = 5;
+  // Explicit and Taubin default to the umbrella operator: uniform weights averaged by degree.
+  for (P* p : {&explicit_scheme, &explicit5, &umbrella, &umbrella5, &taubin, &taubin5}) {
+    p->weights = LaplacianWeights::Uniform;
+    p->average = FlowAverage::Degree;
+  }
+  explicit_scheme.scheme = explicit5.scheme = SmoothingScheme::Explicit;
+  explicit5.iterations = umbrella5.iterations = 5;
+  degree.average = FlowAverage::Degree;
+  taubin.scheme = taubin5.scheme = SmoothingScheme::Taubin;
+  taubin5.iterations = 5;
+  P taubin5_default_mu = taubin5;
+  taubin5.taubin_mu = -0.45;
   uniform.weights = LaplacianWeights::Uniform;
   voronoi.mass = MassType::Voronoi;
   barycentric.mass = explicit_barycentric.mass = MassType::Barycentric;
@@ -463,16 +481,26 @@ TEST_F(ToolOptions, SmoothEqualsTheLibraryForEveryScheme) {
   const std::vector<OptionCase> table = {
       {"", cow_default, {}},
       {"-method explicit", on(cow, explicit_scheme), cow_default},
-      {"-method explicit -lambda_dt 4e-4 -iterations 5", on(cow, explicit5, 4e-4),
+      {"-method explicit -lambda_dt 0.3 -iterations 5", on(cow, explicit5, 0.3),
        on(cow, explicit5)},
+      {"-method explicit -weights cotan", on(cow, explicit_cotan), on(cow, explicit_scheme)},
+      {"-method explicit -weights cotan -lambda_dt 4e-4 -iterations 5",
+       on(cow, explicit_cotan5, 4e-4), on(cow, explicit_cotan5)},
+      {"-method explicit -weights umbrella", on(cow, explicit_scheme), on(cow, explicit_cotan)},
+      {"-weights umbrella", on(cow, umbrella), on(cow, uniform)},
+      {"-weights uniform -average degree -iterations 5", on(cow, umbrella5), on(cow, umbrella)},
+      {"-average degree", on(cow, degree), cow_default},
+      {"-method taubin", on(cow, taubin), on(cow, explicit_scheme)},
+      {"-method taubin -lambda 0.4 -mu -0.45 -iterations 5", on(cow, taubin5, 0.4),
+       on(cow, taubin5_default_mu, 0.4)},
       {"-weights uniform", on(cow, uniform), cow_default},
       {"-weights cotan", cow_default, on(cow, uniform)},  // the default: the first row pins it
       {"-area voronoi", on(cow, voronoi), cow_default},
       {"-mass voronoi", on(cow, voronoi), cow_default},  // the former name
       {"-area barycentric", on(cow, barycentric), cow_default},
       // The explicit default step is half the stability bound of the chosen mass.
-      {"-method explicit -area barycentric", on(cow, explicit_barycentric),
-       on(cow, explicit_scheme)},
+      {"-method explicit -weights cotan -area barycentric", on(cow, explicit_barycentric),
+       on(cow, explicit_cotan)},
       {"-lambda_dt 3", on(cow, implicit, 3.0), cow_default},
       {"-iterations 3", cow_three, cow_default},
       // 1e-5 in length^2 is about 0.02 h^2 on the cow; read in h^2 it would be 5e-9 length^2.

@@ -10,14 +10,24 @@
  *             or conjugate-gradient solve per iteration (implicit_solver.h; by default whichever
  *             costs less for the run), x, y, z as three right-hand sides. Stable for any tau, so
  *             one large step replaces thousands of small ones.
- * L is the summed uniform or cotangent Laplacian (laplacian.h), M the lumped mass of the chosen
- * type. By default L is frozen at the input and M follows the current positions (Kazhdan et al.
- * 2012, "Can mean-curvature flow be modified to be non-singular?"; libigl's smoothing tutorial):
- * rebuilding cotangent weights every iteration is the singular mean-curvature flow, which pinches
- * triangles into slivers within a few large steps. Both can also be rebuilt every iteration or
- * both frozen at the input. With Cholesky the system's pattern is analysed once and refactorised
- * per iteration.
- * The report gives the triangles' angle quality before and after (slivers: a corner under 1 deg).
+ *   Taubin    x <- x + lambda M^-1 L x, then x <- x + mu M^-1 L x (mu < -lambda < 0) per
+ *             iteration (Taubin 1995, "A signal processing approach to fair surface design"): a
+ *             low-pass filter that, unlike the flow, does not shrink the surface; lambda is
+ *             time_step, mu taubin_mu. Usually with the umbrella operator (below): lambda 0.5,
+ *             mu -0.53 and tens of iterations.
+ * L is the summed uniform or cotangent Laplacian (laplacian.h). M averages it: by default
+ * (FlowAverage::Area) the lumped mass of the chosen type, so M^-1 L approximates the
+ * Laplace-Beltrami operator and tau is a time in length^2; or (FlowAverage::Degree) each vertex's
+ * total weight D = -diag(L), so D^-1 L x is the weighted mean of the neighbours minus x, with
+ * uniform weights the umbrella operator, and tau is dimensionless: explicit steps are stable up to
+ * tau = 1 whatever the triangles' areas (a scan's tiny vertex areas put the Area bound at 1e-3 h^2
+ * and below). By default L is frozen at the input and M follows the current positions (Kazhdan et
+ * al. 2012, "Can mean-curvature flow be modified to be non-singular?"; libigl's smoothing
+ * tutorial): rebuilding cotangent weights every iteration is the singular mean-curvature flow,
+ * which pinches triangles into slivers within a few large steps. Both can also be rebuilt every
+ * iteration or both frozen at the input. With Cholesky the system's pattern is analysed once and
+ * refactorised per iteration. The report gives the triangles' angle quality before and after
+ * (slivers: a corner under 1 deg).
  *
  * Boundary vertices move (Free, default) or keep their position (Fixed). Vertices without mass
  * (isolated, or only on degenerate triangles) never move. Laplacian flow shrinks a surface; the
@@ -26,12 +36,13 @@
  * of the input.
  *
  * Errors: InvalidMeshException for an empty mesh or non-finite input; pcl::BadArgumentException for
- * bad parameters (tau <= 0, iterations < 1, volume correction on an open mesh, a correction with a
- * fixed boundary); pcl::ComputeFailedException when an iteration produces a non-finite position
- * or a singular system, naming the iteration; SurfaceCollapseException when a step collapses the
- * surface (before any correction): area or enclosed volume below 1e-6 of the input's, or every
- * vertex within one mean edge length h of the input of the centroid. A correction would only
- * blow such a remnant up again. The input is never modified.
+ * bad parameters (tau <= 0, Taubin's mu not below -tau, iterations < 1, volume correction on an
+ * open mesh, a correction with a fixed boundary); pcl::ComputeFailedException when an iteration
+ * produces a non-finite position or a singular system, naming the iteration;
+ * SurfaceCollapseException when a step collapses the surface (before any correction): area or
+ * enclosed volume below 1e-6 of the input's, or every vertex within one mean edge length h of the
+ * input of the centroid. A correction would only blow such a remnant up again. The input is never
+ * modified.
  */
 #include <pcl/PolygonMesh.h>
 #include <pcl/exceptions.h>
@@ -57,7 +68,10 @@ class SurfaceCollapseException : public pcl::ComputeFailedException {
       : pcl::ComputeFailedException(description) {}
 };
 
-enum class SmoothingScheme { Explicit, Implicit };
+enum class SmoothingScheme { Explicit, Implicit, Taubin };
+/** What divides the Laplacian: vertex areas (the geometric flow) or vertex degrees (the umbrella
+ *  operator with uniform weights); see above. */
+enum class FlowAverage { Area, Degree };
 /** What of the operator follows the moving surface: nothing (Frozen), the mass only
  *  (FrozenStiffness, the default), or the Laplacian and the mass (EveryIteration). */
 enum class WeightUpdate { FrozenStiffness, Frozen, EveryIteration };
@@ -67,8 +81,12 @@ enum class ShrinkageCorrection { None, PreserveVolume, PreserveArea };
 struct MeshSmoothingParameters {
   SmoothingScheme scheme = SmoothingScheme::Implicit;
   LaplacianWeights weights = LaplacianWeights::Cotangent;
-  MassType mass = MassType::MixedVoronoi;
-  double time_step = 0.0;  ///< tau, in length^2 (e.g. 0.1 * h^2 explicit, 10 * h^2 implicit)
+  MassType mass = MassType::MixedVoronoi;  ///< with FlowAverage::Area
+  FlowAverage average = FlowAverage::Area;
+  /** tau (Taubin: lambda): Area in length^2 (e.g. 0.1 * h^2 explicit, 10 * h^2 implicit), Degree
+   *  dimensionless (e.g. 0.5) */
+  double time_step = 0.0;
+  double taubin_mu = -0.53;  ///< Taubin's second factor, in time_step's units
   int iterations = 1;
   WeightUpdate weight_update = WeightUpdate::FrozenStiffness;
   BoundaryCondition boundary = BoundaryCondition::Free;
@@ -101,11 +119,14 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
 /**
  * A time step up to which the explicit scheme is stable on this mesh: 2 / max_i sum_j |L_ij| / m_i,
  * the Gershgorin bound on the spectrum of M^-1 L (sufficient; the sharp limit is usually 1-3x
- * larger). In length^2; on scans often 1e-3 h^2 or less, because of tiny vertex areas.
+ * larger). Averaged by Area: in length^2, on scans often 1e-3 h^2 or less, because of tiny vertex
+ * areas. Averaged by Degree: dimensionless, 1 whenever no weight is negative (always for uniform
+ * weights: the umbrella operator).
  */
 double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& positions,
                               LaplacianWeights weights = LaplacianWeights::Cotangent,
-                              MassType mass = MassType::MixedVoronoi);
+                              MassType mass = MassType::MixedVoronoi,
+                              FlowAverage average = FlowAverage::Area);
 
 /** Volume enclosed by a closed, consistently oriented mesh (divergence theorem; positive for
  *  outward faces). */
@@ -129,6 +150,8 @@ class MeshSmoothing {
   void setScheme(SmoothingScheme scheme) { parameters_.scheme = scheme; }
   void setWeights(LaplacianWeights weights) { parameters_.weights = weights; }
   void setMassType(MassType mass) { parameters_.mass = mass; }
+  void setAverage(FlowAverage average) { parameters_.average = average; }
+  void setTaubinMu(double mu) { parameters_.taubin_mu = mu; }
   void setTimeStep(double tau) { parameters_.time_step = tau; }
   void setNumberOfIterations(int iterations) { parameters_.iterations = iterations; }
   void setWeightUpdate(WeightUpdate update) { parameters_.weight_update = update; }
