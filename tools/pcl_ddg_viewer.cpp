@@ -25,7 +25,8 @@ std::string syntax() {
          "  method=uniform|area|angle|mean_curvature|pca|quadric  k=N  neighbours=rings|kdtree\n"
          "  field=none|mean|gauss|k1|k2|angle|compare|<property of the file>\n"
          "  reference=auto|<method> (what field=angle compares with)\n"
-         "  smooth=explicit|implicit[:t] (t: step in h^2)  step=t  weights=uniform|cotan\n"
+         "  smooth=explicit|implicit|taubin[:t] (t: step in h^2, umbrella: no unit)  step=t\n"
+         "  weights=cotan|uniform|umbrella\n"
          "  frozen=on|off  undo  normals=on|off  shading=flat|smooth  screenshot\n"
          "Keys:\n" +
          pcl_ddg::viewer::keyHelp();

@@ -48,22 +48,30 @@ ColorRange colorRange(const Eigen::VectorXd& values, ColorMap map, const ColorSc
   return range;
 }
 
-Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorize(const Eigen::VectorXd& values, ColorMap map,
-                                                        const ColorScale& scale) {
+std::array<std::uint8_t, 3> colorAt(ColorMap map, double t) {
   static const std::array<Rgb, 3> kDiverging = {{{59, 76, 192}, {240, 240, 240}, {180, 4, 38}}};
   static const std::array<Rgb, 5> kSequential = {
       {{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
+  const Rgb c =
+      map == ColorMap::Diverging ? interpolate(kDiverging, t) : interpolate(kSequential, t);
+  std::array<std::uint8_t, 3> rgb;
+  for (int k = 0; k < 3; ++k) rgb[k] = static_cast<std::uint8_t>(std::lround(c[k]));
+  return rgb;
+}
+
+Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorize(const Eigen::VectorXd& values, ColorMap map,
+                                                        const ColorScale& scale) {
   const ColorRange limits = colorRange(values, map, scale);
   const double lo = limits.low;
   const double range = limits.high > lo ? limits.high - lo : 1.0;
   Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> rgb(3, values.size());
   for (Eigen::Index i = 0; i < values.size(); ++i) {
-    Rgb c = {128, 128, 128};
-    if (std::isfinite(values[i])) {
-      const double t = (values[i] - lo) / range;
-      c = map == ColorMap::Diverging ? interpolate(kDiverging, t) : interpolate(kSequential, t);
+    if (!std::isfinite(values[i])) {
+      rgb.col(i).setConstant(128);
+      continue;
     }
-    for (int k = 0; k < 3; ++k) rgb(k, i) = static_cast<std::uint8_t>(std::lround(c[k]));
+    const std::array<std::uint8_t, 3> c = colorAt(map, (values[i] - lo) / range);
+    for (int k = 0; k < 3; ++k) rgb(k, i) = c[k];
   }
   return rgb;
 }

@@ -2,6 +2,7 @@
 
 #include <stb_image_write.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -17,8 +18,9 @@ namespace {
 Eigen::Matrix3d viewRotation(const RenderOptions& o) {
   const double deg = 3.14159265358979323846 / 180.0;
   const Eigen::Vector3d up = o.up.normalized();
-  const Eigen::Vector3d side =
-      std::abs(up.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
+  Eigen::Vector3d side = o.front - o.front.dot(up) * up;
+  if (!(side.norm() > 1e-6))
+    side = std::abs(up.z()) < 0.9 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitX();
   const Eigen::Vector3d front0 = (side - side.dot(up) * up).normalized();
   const Eigen::Vector3d towards_viewer =
       Eigen::AngleAxisd(o.azimuth_degrees * deg, up) *
@@ -72,6 +74,58 @@ Image blankImage(const RenderOptions& options) {
 }
 
 }  // namespace
+
+DefaultView defaultView(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xd& normals,
+                        bool geographic) {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Index count = 0;
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+    if (positions.col(i).allFinite()) centre += positions.col(i), ++count;
+  }
+  DefaultView view{Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitY()};
+  if (count < 3) return view;
+  centre /= static_cast<double>(count);
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d facing = Eigen::Vector3d::Zero();
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+    if (!positions.col(i).allFinite()) continue;
+    const Eigen::Vector3d d = positions.col(i) - centre;
+    covariance += d * d.transpose();
+    if (normals.cols() == positions.cols() && normals.col(i).allFinite()) facing += normals.col(i);
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> axes(covariance);
+  const Eigen::Vector3d smallest = axes.eigenvectors().col(0);
+  const Eigen::Vector3d largest = axes.eigenvectors().col(2);
+  const Eigen::Vector3d vertical = geographic ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
+  // The side the normals face; without them (or undecided) the side of +z, then of +y.
+  double side = facing.dot(smallest);
+  if (std::abs(side) < 1e-3 * facing.norm() || facing.norm() == 0.0) side = smallest.z();
+  if (std::abs(side) < 1e-6) side = smallest.y();
+  view.front = side < 0.0 ? Eigen::Vector3d(-smallest) : smallest;
+  // Up: the file's vertical as seen from there (scans and models are stored upright far more
+  // often than along their largest axis: a cow is longer than tall), unless the view looks within
+  // 30 degrees of it; then the largest principal axis, or north on a map seen from above.
+  const Eigen::Vector3d projected = vertical - vertical.dot(view.front) * view.front;
+  if (projected.norm() > 0.5) {
+    view.up = projected.normalized();
+  } else if (geographic) {
+    view.up = (Eigen::Vector3d::UnitY() - view.front.y() * view.front).normalized();
+  } else {
+    view.up = largest.dot(vertical) < 0.0 ? Eigen::Vector3d(-largest) : largest;
+  }
+  return view;
+}
+
+bool farFromOrigin(const Eigen::Matrix3Xd& positions) {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+    if (!positions.col(i).allFinite()) continue;
+    low = low.cwiseMin(positions.col(i));
+    high = high.cwiseMax(positions.col(i));
+  }
+  return high.x() >= low.x() && (0.5 * (low + high)).norm() > 100.0 * (high - low).norm();
+}
 
 Image renderMesh(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xi& triangles,
                  const Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic>& colors,

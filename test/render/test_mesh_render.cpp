@@ -1,7 +1,9 @@
 // The renderer and colour maps behind the README pictures.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 #include <vector>
@@ -9,6 +11,7 @@
 #include <stb_image.h>
 
 #include "analytic_surfaces.h"
+#include "pcl_ddg/render/color_bar.h"
 #include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/render/mesh_render.h"
 #include "test_data.h"
@@ -137,6 +140,107 @@ TEST(ColorMap, PercentilesClampOutliers) {
   EXPECT_EQ(rgb.col(98), rgb.col(100));
   EXPECT_NE(rgb.col(0), rgb.col(50));
   EXPECT_NE(rgb.col(50), rgb.col(98));
+}
+
+// Points on an ellipsoid with semi-axes 3, 2, 1 along the columns of a rotation, far from the
+// origin.
+Eigen::Matrix3Xd ellipsoid(const Eigen::Matrix3d& rotation) {
+  Eigen::Matrix3Xd points(3, 2000);
+  for (int i = 0; i < 2000; ++i) {
+    const double theta = std::acos(1.0 - 2.0 * (i + 0.5) / 2000.0), phi = 2.399963 * i;
+    const Eigen::Vector3d unit(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                               std::cos(theta));
+    points.col(i) = rotation * Eigen::Vector3d(3.0, 2.0, 1.0).cwiseProduct(unit) +
+                    Eigen::Vector3d(5e5, 4e6, 100.0);
+  }
+  points(0, 7) = std::numeric_limits<double>::quiet_NaN();  // skipped
+  return points;
+}
+
+// The default view looks along the shortest axis (the largest projected area), with the vertical
+// up as seen from there, or the longest axis when the view looks along the vertical.
+TEST(DefaultView, LooksAlongTheSmallestAxisWithTheVerticalOrTheLargestAxisUp) {
+  const Eigen::Matrix3d rotation = (Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()) *
+                                    Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()))
+                                       .toRotationMatrix();
+  const Eigen::Matrix3Xd points = ellipsoid(rotation);
+  const DefaultView view = defaultView(points, Eigen::Matrix3Xd(), false);
+  const Eigen::Vector3d smallest = rotation.col(2);
+  EXPECT_GT(std::abs(view.front.dot(smallest)), 1.0 - 1e-6);
+  EXPECT_GE(view.front.z(), 0.0);  // no normals: from the side of +z
+  ASSERT_GT(std::abs(smallest.y()), 0.0);
+  ASSERT_LT(std::abs(smallest.y()), 0.85);  // +y is more than 30 degrees from the view
+  const Eigen::Vector3d y_seen = (Eigen::Vector3d::UnitY() - smallest.y() * smallest).normalized();
+  EXPECT_GT(view.up.dot(y_seen), 1.0 - 1e-6);
+  // Normals facing -front on the whole put the camera on their side, -front; facing front, on
+  // front's.
+  Eigen::Matrix3Xd normals = Eigen::Matrix3Xd::Zero(3, 2000);
+  normals.col(3) = -view.front;
+  EXPECT_LT(defaultView(points, normals, false).front.dot(view.front), -1.0 + 1e-9);
+  normals.col(3) = view.front;
+  EXPECT_GT(defaultView(points, normals, false).front.dot(view.front), 1.0 - 1e-9);
+  // Seen along +y (its smallest axis): the largest axis (x) is up.
+  const Eigen::Matrix3d lying =
+      (Eigen::Matrix3d() << 1, 0, 0, 0, 0, 1, 0, -1, 0).finished();  // axes x, -z, y
+  const DefaultView along_y = defaultView(ellipsoid(lying), Eigen::Matrix3Xd(), false);
+  EXPECT_GT(std::abs(along_y.front.y()), 1.0 - 1e-6);
+  EXPECT_GT(std::abs(along_y.up.x()), 1.0 - 1e-6);
+  // Far from the origin for its size: geographic by position. +z up in a side view; a flat
+  // terrain (smallest axis z) is a map seen from above, north (+y) up.
+  EXPECT_TRUE(farFromOrigin(points));
+  EXPECT_FALSE(farFromOrigin(points.colwise() - Eigen::Vector3d(5e5, 4e6, 100.0)));
+  const Eigen::Matrix3d standing =
+      (Eigen::Matrix3d() << 0, 1, 0, 0, 0, 1, 1, 0, 0).finished();  // axes z, x, y
+  const DefaultView side = defaultView(ellipsoid(standing), Eigen::Matrix3Xd(), true);
+  EXPECT_GT(std::abs(side.front.y()), 1.0 - 1e-6);
+  EXPECT_GT(side.up.z(), 1.0 - 1e-6);
+  Eigen::Matrix3Xd terrain = points;
+  terrain.row(2) = 50.0 + 0.01 * points.row(0).array();
+  const DefaultView above = defaultView(terrain, Eigen::Matrix3Xd(), true);
+  EXPECT_GT(above.front.z(), 0.99);
+  EXPECT_GT(above.up.y(), 0.99);
+}
+
+TEST(ColorBar, AStripBesideThePictureWithTheMapHighAtTheTopAndDarkLabels) {
+  Image picture;
+  picture.width = 300;
+  picture.height = 400;
+  picture.rgb.assign(static_cast<std::size_t>(300) * 400 * 3, 90);
+  const Image bar = withColorBar(picture, ColorMap::Diverging, {-2.5, 2.5}, "k1 [1/length]");
+  ASSERT_EQ(bar.height, 400);
+  ASSERT_GE(bar.width, 300 + 100);
+  // The picture is kept as it was, pixel for pixel.
+  for (int y = 0; y < 400; y += 7) {
+    for (int x = 0; x < 300; x += 7) EXPECT_EQ(pixel(bar, x, y), (std::array<int, 3>{90, 90, 90}));
+  }
+  // In the strip: a column whose colours run from the map's high end (red, top) through its
+  // middle to its low end (blue, bottom), and dark text beside and above it.
+  int bar_column = -1, dark = 0;
+  for (int x = 300; x < bar.width && bar_column < 0; ++x) {
+    for (int y = 0; y < bar.height; ++y) {
+      const std::array<int, 3> c = pixel(bar, x, y);
+      if (c[0] == 180 && c[1] == 4 && c[2] == 38) {  // the diverging map's red end
+        bar_column = x;
+        break;
+      }
+    }
+  }
+  ASSERT_GE(bar_column, 0) << "no red end of the map in the strip";
+  std::vector<std::array<int, 3>> column;
+  for (int y = 0; y < bar.height; ++y) {
+    const std::array<int, 3> c = pixel(bar, bar_column, y);
+    // The bar's pixels: neither the background nor the (dark grey) text above it.
+    if (c != std::array<int, 3>{255, 255, 255} && c != std::array<int, 3>{30, 30, 30})
+      column.push_back(c);
+  }
+  ASSERT_GT(column.size(), 200u);
+  EXPECT_EQ(column.front(), (std::array<int, 3>{180, 4, 38}));
+  EXPECT_EQ(column.back(), (std::array<int, 3>{59, 76, 192}));
+  EXPECT_NEAR(column[column.size() / 2][0], column[column.size() / 2][2], 6);  // neutral: r = b
+  for (int y = 0; y < bar.height; ++y) {
+    for (int x = 300; x < bar.width; ++x) dark += pixel(bar, x, y)[0] < 60;
+  }
+  EXPECT_GT(dark, 200) << "no text in the strip";
 }
 
 }  // namespace

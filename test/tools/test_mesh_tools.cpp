@@ -12,10 +12,13 @@
 #include <cmath>
 #include <cstdio>
 
+#include <stb_image.h>
+
 #include "analytic_surfaces.h"
 #include "data_catalogue.h"
 #include "estimator_support.h"
 #include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "test_data.h"
@@ -463,6 +466,32 @@ TEST_F(MeshTools, RenderMakesAPicture) {
   // The error names what there is to choose from.
   EXPECT_NE(missing.err.find("no 'nothing' field (it has: x y z)"), std::string::npos)
       << missing.err;
+  // A field: coloured between its 2nd and 98th percentiles, which the tool says, with a colour
+  // bar beside the picture (a wider image).
+  ASSERT_EQ(runTool(PCL_DDG_CURVATURE_TOOL, sharedData("meshes/cow.off") + " " + path("k.ply") +
+                                                " -precision double")
+                .exit_code,
+            0);
+  const ToolRun field =
+      runTool(PCL_DDG_RENDER_TOOL, path("k.ply") + " " + path("k.png") + " -field k1 -size 200");
+  ASSERT_EQ(field.exit_code, 0) << field.err;
+  std::vector<double> k1;
+  const pcl::PolygonMesh curvatures = loadMesh(path("k.ply"));
+  const Eigen::VectorXd values = vertexScalarField(curvatures.cloud, "k1");
+  for (Eigen::Index i = 0; i < values.size(); ++i)
+    if (std::isfinite(values[i])) k1.push_back(values[i]);
+  std::sort(k1.begin(), k1.end());
+  const auto at = [&](double percent) {
+    return k1[static_cast<std::size_t>(std::lround(percent / 100.0 * (k1.size() - 1)))];
+  };
+  const double end = std::max(std::abs(at(2.0)), std::abs(at(98.0)));  // diverging: symmetric
+  char expected[96];
+  std::snprintf(expected, sizeof expected, "k1 coloured from %g to %g (2nd and 98th", -end, end);
+  EXPECT_NE(field.err.find(expected), std::string::npos) << field.err << "\nexpected " << expected;
+  int width = 0, height = 0, channels = 0;
+  ASSERT_TRUE(stbi_info(path("k.png").c_str(), &width, &height, &channels));
+  EXPECT_EQ(height, 200);
+  EXPECT_GT(width, 200 + 100);
   // Clouds are drawn too (splats in the cloud's own colours).
   const ToolRun cloud = runTool(PCL_DDG_RENDER_TOOL, sharedData("clouds/office1.pcd") + " " +
                                                          path("office.png") + " -size 64");

@@ -26,11 +26,13 @@
 
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
+#include "pcl_ddg/features/normal_orientation.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/operators/curvature.h"
+#include "pcl_ddg/render/color_bar.h"
 #include "pcl_ddg/render/color_map.h"
 #include "pcl_ddg/render/mesh_render.h"
 #include "pcl_ddg/surface/grid_smoothing.h"
@@ -674,16 +676,31 @@ TEST_F(ToolOptions, RenderEqualsTheLibraryForEveryCameraAndColourOption) {
   }
   const MeshFile file = readMeshFile(path("cow.ply"));
   const MeshTopology topology(file.mesh, OutOfRangeFacePolicy::Drop);
+  // Without -up the view that shows the most of the cow (defaultView, its faces' side); with a
+  // field, the colour bar beside the picture.
+  const DefaultView shown =
+      defaultView(file.positions, meshOrientationNormals(topology, file.positions), false);
   const auto picture = [&](std::function<void(RenderOptions&)> set, std::string field = "",
                            ColorMap map = ColorMap::Diverging) {
     return [&, set, field, map] {
       RenderOptions o;
       o.width = o.height = 96;
+      o.front = shown.front;
+      o.up = shown.up;
       set(o);
       VertexColors colors(3, file.positions.cols());
       colors.setConstant(215);  // no field, no colours of its own: light grey
-      if (!field.empty()) colors = colorize(vertexScalarField(file.mesh.cloud, field), map);
-      return renderMesh(file.positions, topology.triangles(), colors, o);
+      if (field.empty()) return renderMesh(file.positions, topology.triangles(), colors, o);
+      const Eigen::VectorXd values = vertexScalarField(file.mesh.cloud, field);
+      return withColorBar(
+          renderMesh(file.positions, topology.triangles(), colorize(values, map), o), map,
+          colorRange(values, map), field);
+    };
+  };
+  const auto up = [](const Eigen::Vector3d& axis) {
+    return [axis](RenderOptions& o) {
+      o.up = axis;
+      o.front.setZero();  // -up: from the fixed side
     };
   };
   const auto camera = [](RenderOptions&) {};
@@ -697,10 +714,15 @@ TEST_F(ToolOptions, RenderEqualsTheLibraryForEveryCameraAndColourOption) {
        picture([](RenderOptions& o) { o.azimuth_degrees = 90; })},
       {"-size 96 -elevation 60", picture([](RenderOptions& o) { o.elevation_degrees = 60; }),
        picture(camera)},
-      {"-size 96 -up z", picture([](RenderOptions& o) { o.up = Eigen::Vector3d::UnitZ(); }),
-       picture(camera)},
-      {"-size 96 -up x", picture([](RenderOptions& o) { o.up = Eigen::Vector3d::UnitX(); }),
-       picture(camera)},
+      {"-size 96 -up z", picture(up(Eigen::Vector3d::UnitZ())), picture(camera)},
+      {"-size 96 -up x", picture(up(Eigen::Vector3d::UnitX())), picture(camera)},
+      // (On the cow, y up from the fixed side is nearly its default view: compared with x.)
+      {"-size 96 -up y", picture(up(Eigen::Vector3d::UnitY())),
+       picture(up(Eigen::Vector3d::UnitX()))},
+      {"-size 96 -up -y", picture(up(-Eigen::Vector3d::UnitY())),
+       picture(up(Eigen::Vector3d::UnitY()))},
+      {"-size 96 -up -z", picture(up(-Eigen::Vector3d::UnitZ())),
+       picture(up(Eigen::Vector3d::UnitZ()))},
       {"-size 96 -field height", picture(camera, "height"), picture(camera)},
       {"-size 96 -field height -map sequential", picture(camera, "height", ColorMap::Sequential),
        picture(camera, "height")},

@@ -2,7 +2,9 @@
 
 #include <pcl/console/time.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "common/fit_steps.h"
@@ -13,6 +15,7 @@
 #include "pcl_ddg/operators/curvature.h"
 #include "pcl_ddg/surface/mesh_normals.h"
 #include "pcl_ddg/surface/mesh_smoothing.h"
+#include "pcl_ddg/surface/smoothing_steps.h"
 
 namespace pcl_ddg {
 namespace viewer {
@@ -22,8 +25,8 @@ constexpr double kDegreesPerRadian = 57.295779513082320876798;
 
 std::string stepKey(const SmoothingStep& s) {
   std::ostringstream key;
-  key << (s.implicit ? 'I' : 'E') << s.time_step << (s.cotan ? 'c' : 'u') << (s.frozen ? 'f' : 'r')
-      << ';';
+  key << static_cast<int>(s.method) << 'm' << s.time_step << 't' << static_cast<int>(s.weights)
+      << 'w' << (s.frozen ? 'f' : 'r') << ';';
   return key.str();
 }
 
@@ -60,7 +63,19 @@ ViewerModel::ViewerModel(tools::ToolInput input, std::string path)
   capabilities_.is_mesh = static_cast<bool>(input_.topology);
   capabilities_.points = static_cast<int>(input_.positions.cols());
   capabilities_.properties = colourableProperties(input_.mesh.cloud);
+  if (vertexColorLayout(input_.mesh.cloud)) {
+    capabilities_.has_colors = true;
+    file_colors_ = vertexColors(input_.mesh.cloud);
+  }
   spacing_ = input_.spacing();
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  for (Eigen::Index i = 0; i < input_.positions.cols(); ++i) {
+    if (!input_.positions.col(i).allFinite()) continue;
+    low = low.cwiseMin(input_.positions.col(i));
+    high = high.cwiseMax(input_.positions.col(i));
+  }
+  diagonal_ = high.x() >= low.x() ? (high - low).norm() : 0.0;
   if (!(spacing_ > 0.0)) spacing_ = 1.0;
   positions_["input;"] = std::make_shared<const Eigen::Matrix3Xd>(input_.positions);
   points_["input;"] = input_.points();
@@ -76,11 +91,17 @@ ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingSt
   if (refused) return start;
 
   const SmoothingStep& step = steps.back();
-  const double h2 = spacing_ * spacing_;
   MeshSmoothingParameters parameters;
-  parameters.scheme = step.implicit ? SmoothingScheme::Implicit : SmoothingScheme::Explicit;
-  parameters.weights = step.cotan ? LaplacianWeights::Cotangent : LaplacianWeights::Uniform;
-  parameters.time_step = step.time_step * h2;
+  parameters.scheme = step.method == SmoothingMethod::Explicit ? SmoothingScheme::Explicit
+                      : step.method == SmoothingMethod::Taubin ? SmoothingScheme::Taubin
+                                                               : SmoothingScheme::Implicit;
+  parameters.weights = step.weights == SmoothingWeights::Cotan ? LaplacianWeights::Cotangent
+                                                               : LaplacianWeights::Uniform;
+  // Taubin's lambda 0.5 and mu -0.53 are steps of an operator averaged by degree.
+  parameters.average =
+      step.weights == SmoothingWeights::Umbrella || step.method == SmoothingMethod::Taubin
+          ? FlowAverage::Degree
+          : FlowAverage::Area;
   // Frozen: the Laplacian of the surface where this run of frozen steps began, so a run of n
   // frozen steps is one smoothing of n iterations from there; rebuilt: that of this step's start.
   Positions from = start;
@@ -94,18 +115,27 @@ ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingSt
   } else {
     parameters.weight_update = WeightUpdate::EveryIteration;
   }
-  if (!step.implicit) {
-    // Forward Euler beyond its stability bound blows up: the step is capped there, and said so.
-    const double limit = 0.9 * explicitStabilityLimit(*input_.topology, *from, parameters.weights);
-    if (parameters.time_step > limit) {
-      parameters.time_step = limit;
+  // Steps averaged by area are in h^2 of the input, so that a step means the same all along.
+  const bool per_area = parameters.average == FlowAverage::Area;
+  const double h2 = spacing_ * spacing_;
+  RelativeSteps relative;
+  if (step.method != SmoothingMethod::Taubin)
+    relative.step = per_area ? step.time_step * h2 : step.time_step;
+  relative.absolute_time = per_area;
+  relative.allow_unstable = true;  // an explicit step is capped below
+  try {
+    const ResolvedSteps resolved = resolveSteps(*input_.topology, *from, relative, parameters);
+    if (resolved.unstable) {
+      if (step.method == SmoothingMethod::Taubin)
+        throw std::runtime_error("Taubin's steps exceed the stability bound on this mesh");
+      // Forward Euler beyond its stability bound blows up: the step is capped there, and said so.
+      parameters.time_step = 0.9 * resolved.bound * resolved.unit;
       std::ostringstream note;
       note.precision(3);
-      note << "explicit step capped at the stability bound, " << limit / h2 << " h^2";
+      note << "explicit step capped at the stability bound, "
+           << 0.9 * resolved.bound / (per_area ? h2 : 1.0) << (per_area ? " h^2" : "");
       warnings.push_back(note.str());
     }
-  }
-  try {
     auto result = std::make_shared<const Eigen::Matrix3Xd>(
         smoothMeshPositions(*input_.topology, *from, parameters));
     positions_[version] = result;
@@ -282,10 +312,20 @@ Frame ViewerModel::compute(const ViewerState& state) {
   }
   const std::string shown = versionOf(frame.state.steps);
   frame.normals = normalsOf(state.method, frame.state, shown, frame.positions, frame.warnings);
-  frame.glyph_length = spacing_;
+  // Glyphs a point spacing long, but at least 1 % of the object's size: visible on a 500 m
+  // terrain sampled every metre as on a finely meshed 10 cm part. Longer than the spacing, they are
+  // drawn as far apart as they are long (every n-th point, n their length over the spacing,
+  // squared, on a surface), and never more than about 20,000.
+  frame.glyph_length = std::max(spacing_, 0.01 * diagonal_);
+  const double apart = frame.glyph_length / spacing_;
+  frame.glyph_every = std::max<Eigen::Index>(
+      {1, static_cast<Eigen::Index>(apart * apart), frame.positions->cols() / 20000});
   const Eigen::Index n = frame.positions->cols();
   if (state.field == "none") {
     frame.colors = VertexColors::Constant(3, n, 200);
+    frame.field_label = "";
+  } else if (state.field == "rgb") {
+    frame.colors = file_colors_;
     frame.field_label = "";
   } else {
     frame.field = fieldOf(frame.state, shown, frame.positions, *frame.normals, frame.field_label,

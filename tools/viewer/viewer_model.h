@@ -16,6 +16,7 @@
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/render/color_map.h"
+#include "pcl_ddg/render/mesh_render.h"
 #include "viewer/viewer_state.h"
 
 namespace pcl_ddg {
@@ -30,7 +31,8 @@ struct Frame {
   ColorRange range;                                   ///< of the colour bar
   ColorMap color_map = ColorMap::Diverging;
   VertexColors colors;                ///< per vertex (grey for "none" and NaN)
-  double glyph_length = 0.0;          ///< normal glyph length: h
+  double glyph_length = 0.0;          ///< normal glyph length: h, at least 1 % of the size
+  Eigen::Index glyph_every = 1;       ///< a glyph on every n-th point
   std::vector<std::string> warnings;  ///< shown on screen
   double compute_ms = 0.0;            ///< of this frame
   bool step_refused = false;          ///< the last smoothing step failed (see warnings)
@@ -48,6 +50,10 @@ class ViewerModel {
   const Eigen::Matrix3Xd& inputPositions() const { return input_.positions; }
   /** Where the sensor was (a PCD's VIEWPOINT): clouds are first seen from there. */
   const SensorPose& sensorPose() const { return input_.sensor_pose; }
+  /** An organized cloud (width x height grid): seen from its sensor. */
+  bool organized() const { return input_.mesh.cloud.height > 1; }
+  /** A LAS survey, or coordinates far from the origin (UTM): +z is up. */
+  bool geographic() const { return input_.las || farFromOrigin(input_.positions); }
   /** Mean edge length (meshes) or mean point spacing (clouds). */
   double spacing() const { return spacing_; }
 
@@ -75,7 +81,9 @@ class ViewerModel {
   tools::ToolInput input_;
   std::string path_;
   InputCapabilities capabilities_;
+  VertexColors file_colors_;  ///< the file's own colours (capabilities_.has_colors)
   double spacing_ = 0.0;
+  double diagonal_ = 0.0;  ///< of the input's bounding box
   /** Positions after each prefix of smoothing steps, keyed by the steps' description. */
   std::map<std::string, Positions> positions_;
   std::map<std::string, std::shared_ptr<const Eigen::Matrix3Xd>> normals_;

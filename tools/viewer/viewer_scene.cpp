@@ -33,6 +33,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pcl_ddg/features/normal_orientation.h"
 #include "viewer/hidden_faces.h"
 
 namespace pcl_ddg {
@@ -71,10 +72,15 @@ std::string describe(const ViewerState& s, bool is_mesh) {
   out << "   field: " << s.field;
   if (is_mesh) {
     int explicit_steps = 0;
-    for (const SmoothingStep& step : s.steps) explicit_steps += !step.implicit;
-    out << "\nsmoothing: " << s.steps.size() << " steps (" << explicit_steps << " explicit), next "
-        << s.time_step << " h^2, " << (s.cotan ? "cotan" : "uniform") << " weights "
-        << (s.frozen ? "frozen" : "rebuilt");
+    for (const SmoothingStep& step : s.steps)
+      explicit_steps += step.method != SmoothingMethod::Implicit;
+    const bool umbrella = s.weights == SmoothingWeights::Umbrella;
+    out << "\nsmoothing: " << s.steps.size() << " steps (" << explicit_steps
+        << " explicit or Taubin), next " << s.time_step << (umbrella ? "" : " h^2") << ", "
+        << (umbrella                                 ? "umbrella"
+            : s.weights == SmoothingWeights::Uniform ? "uniform"
+                                                     : "cotan")
+        << " weights " << (s.frozen ? "frozen" : "rebuilt");
   }
   return out.str();
 }
@@ -113,6 +119,7 @@ void ViewerWindow::draw(const Frame& frame) {
     color_bar_->SetLookupTable(lookupTable(frame));
     color_bar_->SetTitle(frame.field_label.c_str());
     color_bar_->SetNumberOfLabels(5);
+    color_bar_->SetLabelFormat("%.3g");  // VTK's default "%-#6.3g" keeps a trailing dot: "-123."
     color_bar_->SetOrientationToHorizontal();
     color_bar_->SetPosition(0.55, 0.8);  // below the row of method names
     color_bar_->SetWidth(0.42);
@@ -130,17 +137,62 @@ void ViewerWindow::draw(const Frame& frame) {
 }
 
 void ViewerWindow::placeCamera() {
-  visualizer_->resetCamera();
-  if (model_.isMesh()) return;
-  // A cloud from its sensor, as pcl_viewer shows a PCD: looking along the sensor's z, y down;
-  // normals face the sensor, so the lit side is the one seen.
   const SensorPose& pose = model_.sensorPose();
-  const Eigen::Vector3d forward = pose.orientation * Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d up = pose.orientation * -Eigen::Vector3d::UnitY();
-  const Eigen::Vector3d focal = pose.origin + forward;
-  visualizer_->setCameraPosition(pose.origin.x(), pose.origin.y(), pose.origin.z(), focal.x(),
-                                 focal.y(), focal.z(), up.x(), up.y(), up.z());
-  sceneRenderer()->ResetCamera();
+  const bool from_sensor =
+      !model_.isMesh() && (model_.organized() || !pose.origin.isZero() ||
+                           !pose.orientation.isApprox(Eigen::Quaterniond::Identity()));
+  const Eigen::Matrix3Xd& positions = model_.inputPositions();
+  Eigen::Vector3d forward, up, eye;
+  if (from_sensor) {
+    // A cloud with a sensor pose (a VIEWPOINT, or a grid) from its sensor, as pcl_viewer shows a
+    // PCD: looking along the sensor's z, y down; normals face the sensor, so the lit side shows.
+    forward = pose.orientation * Eigen::Vector3d::UnitZ();
+    up = pose.orientation * -Eigen::Vector3d::UnitY();
+    eye = pose.origin;
+  } else {
+    // Otherwise the side that shows the most of the object (render/mesh_render.h).
+    const DefaultView view =
+        defaultView(positions,
+                    model_.isMesh() ? meshOrientationNormals(*model_.topology(), positions)
+                                    : Eigen::Matrix3Xd(),
+                    model_.geographic());
+    forward = -view.front;
+    up = view.up;
+    const Eigen::Vector3d centre = positions.rowwise().mean();
+    eye = centre - forward;
+  }
+  const Eigen::Vector3d focal = eye + forward;
+  visualizer_->setCameraPosition(eye.x(), eye.y(), eye.z(), focal.x(), focal.y(), focal.z(), up.x(),
+                                 up.y(), up.z());
+  vtkRenderer* renderer = sceneRenderer();
+  renderer->ResetCamera();
+  // ResetCamera fits the bounding sphere; zoom until the object itself fills 85 % of the frame's
+  // height or width (whichever binds).
+  vtkCamera* camera = renderer->GetActiveCamera();
+  double position[3], focal_point[3], view_up[3];
+  camera->GetPosition(position);
+  camera->GetFocalPoint(focal_point);
+  camera->GetViewUp(view_up);
+  const Eigen::Vector3d c(focal_point), direction = (c - Eigen::Vector3d(position)).normalized();
+  const Eigen::Vector3d screen_up = Eigen::Vector3d(view_up).normalized();
+  const Eigen::Vector3d right = direction.cross(screen_up).normalized();
+  double half_width = 0.0, half_height = 0.0;
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+    if (!positions.col(i).allFinite()) continue;
+    const Eigen::Vector3d d = positions.col(i) - c;
+    half_width = std::max(half_width, std::abs(d.dot(right)));
+    half_height = std::max(half_height, std::abs(d.dot(screen_up)));
+  }
+  const double distance = (c - Eigen::Vector3d(position)).norm();
+  constexpr double kRadiansPerDegree = 3.14159265358979323846 / 180.0;
+  const double visible_half_height =
+      distance * std::tan(0.5 * camera->GetViewAngle() * kRadiansPerDegree);
+  const int* size = visualizer_->getRenderWindow()->GetSize();
+  const double aspect = size[1] > 0 ? static_cast<double>(size[0]) / size[1] : 1.0;
+  const double fill =
+      std::max(half_height / visible_half_height, half_width / (visible_half_height * aspect));
+  if (fill > 0.0) camera->Zoom(0.85 / fill);
+  renderer->ResetCameraClippingRange();
 }
 
 void ViewerWindow::drawSurface(const Frame& frame) {
@@ -184,7 +236,7 @@ void ViewerWindow::drawSurface(const Frame& frame) {
   colors->SetNumberOfTuples(n);
   // Points are drawn unlit (VTK lights them one-sided and from the camera); uncoloured, they are
   // shaded grey by how squarely their normal faces the sensor, so that the shape shows.
-  const bool shade_points = !model_.isMesh() && frame.field_label.empty();
+  const bool shade_points = !model_.isMesh() && frame.state.field == "none";
   const Eigen::Vector3d sensor_axis = model_.sensorPose().orientation * Eigen::Vector3d::UnitZ();
   // Written through the arrays' own storage: a virtual SetTypedTuple per vertex cost more than
   // the copies.
@@ -286,8 +338,7 @@ void ViewerWindow::drawNormals(const Frame& frame) {
   if (!frame.state.show_normals) return;
   const Eigen::Matrix3Xd& positions = *frame.positions;
   const Eigen::Matrix3Xd& normals = *frame.normals;
-  // About 20,000 glyphs whatever the size: every n-th vertex.
-  const Eigen::Index every = std::max<Eigen::Index>(1, positions.cols() / 20000);
+  const Eigen::Index every = frame.glyph_every;  // viewer_model.cpp
   auto points = vtkSmartPointer<vtkPoints>::New();
   auto lines = vtkSmartPointer<vtkCellArray>::New();
   for (Eigen::Index i = 0; i < positions.cols(); i += every) {

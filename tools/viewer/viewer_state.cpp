@@ -48,6 +48,7 @@ bool twoWay(bool current, bool toggle, const std::string& action, const std::str
 std::vector<std::string> fieldsOf(const InputCapabilities& input) {
   std::vector<std::string> fields = kComputedFields;
   if (!input.is_mesh) fields.erase(std::find(fields.begin(), fields.end(), "compare"));
+  if (input.has_colors) fields.insert(fields.begin() + 1, "rgb");  // after none
   fields.insert(fields.end(), input.properties.begin(), input.properties.end());
   return fields;
 }
@@ -69,7 +70,7 @@ NormalMethod usableMethod(const InputCapabilities& input, const std::string& act
 bool ViewerState::operator==(const ViewerState& o) const {
   return method == o.method && k == o.k && neighbours == o.neighbours && field == o.field &&
          reference == o.reference && steps == o.steps && time_step == o.time_step &&
-         cotan == o.cotan && frozen == o.frozen && show_normals == o.show_normals &&
+         weights == o.weights && frozen == o.frozen && show_normals == o.show_normals &&
          smooth_shading == o.smooth_shading && screenshots == o.screenshots;
 }
 
@@ -98,6 +99,7 @@ ViewerState initialState(const InputCapabilities& input) {
     state.neighbours = Neighbours::KdTree;
   }
   state.k = std::min(ViewerState::kDefaultK, std::max(3, input.points - 1));
+  if (input.has_colors) state.field = "rgb";
   return state;
 }
 
@@ -172,11 +174,15 @@ std::string applyAction(ViewerState& state, const InputCapabilities& input,
     needValue();
     const std::size_t colon = value.find(':');
     const std::string scheme = value.substr(0, colon);
-    if (scheme != "explicit" && scheme != "implicit") refuse(action, "expected explicit|implicit");
+    if (scheme != "explicit" && scheme != "implicit" && scheme != "taubin")
+      refuse(action, "expected explicit|implicit|taubin");
     if (!input.is_mesh) refuse(action, "smoothing needs a mesh");
     if (colon != std::string::npos)
       state.time_step = positiveNumber(action, value.substr(colon + 1));
-    state.steps.push_back({scheme == "implicit", state.time_step, state.cotan, state.frozen});
+    const SmoothingMethod method = scheme == "explicit" ? SmoothingMethod::Explicit
+                                   : scheme == "taubin" ? SmoothingMethod::Taubin
+                                                        : SmoothingMethod::Implicit;
+    state.steps.push_back({method, state.time_step, state.weights, state.frozen});
   } else if (action == "undo") {
     if (!state.steps.empty()) state.steps.pop_back();
   } else if (name == "step" || action == "step*" || action == "step/") {
@@ -188,8 +194,21 @@ std::string applyAction(ViewerState& state, const InputCapabilities& input,
       needValue();
       state.time_step = positiveNumber(action, value);
     }
-  } else if (action == "weights+" || name == "weights") {
-    state.cotan = twoWay(state.cotan, action == "weights+", action, value, "cotan", "uniform");
+  } else if (action == "weights+") {
+    state.weights = state.weights == SmoothingWeights::Cotan     ? SmoothingWeights::Uniform
+                    : state.weights == SmoothingWeights::Uniform ? SmoothingWeights::Umbrella
+                                                                 : SmoothingWeights::Cotan;
+  } else if (name == "weights") {
+    needValue();
+    if (value == "cotan") {
+      state.weights = SmoothingWeights::Cotan;
+    } else if (value == "uniform") {
+      state.weights = SmoothingWeights::Uniform;
+    } else if (value == "umbrella") {
+      state.weights = SmoothingWeights::Umbrella;
+    } else {
+      refuse(action, "expected cotan|uniform|umbrella");
+    }
   } else if (action == "frozen+" || name == "frozen") {
     state.frozen = twoWay(state.frozen, action == "frozen+", action, value, "on", "off");
   } else if (action == "normals+" || name == "normals") {
@@ -237,10 +256,11 @@ const KeyBinding kKeys[] = {
     {"semicolon", ";", "shading+", "flat <-> smooth shading"},
     {"t", "t", "smooth=explicit", "one explicit smoothing step"},
     {"i", "i", "smooth=implicit", "one implicit smoothing step"},
+    {"a", "a", "smooth=taubin", "one Taubin step (lambda 0.5, mu -0.53: no shrinkage)"},
     {"z", "z", "undo", "undo the last smoothing step"},
     {"period", ".", "step*", "double the step size"},
     {"comma", ",", "step/", "halve the step size"},
-    {"y", "y", "weights+", "smoothing weights: cotan <-> uniform"},
+    {"y", "y", "weights+", "smoothing weights: cotan -> uniform -> umbrella"},
     {"d", "d", "frozen+", "smoothing weights frozen at the input <-> rebuilt every step"},
     {"F12", "F12", "screenshot", "screenshot to pcl_ddg_viewer_NNN.png"},
 };

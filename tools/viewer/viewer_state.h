@@ -14,13 +14,19 @@ namespace viewer {
 enum class NormalMethod { Uniform, Area, Angle, MeanCurvature, PCA, Quadric };
 enum class Neighbours { MeshRings, KdTree };
 
+enum class SmoothingMethod { Explicit, Implicit, Taubin };
+/** Umbrella: uniform weights averaged by degree (mesh_smoothing.h). */
+enum class SmoothingWeights { Cotan, Uniform, Umbrella };
+
 struct SmoothingStep {
-  bool implicit = true;
-  double time_step = 1.0;  ///< in h^2 (h: the mean edge length of the input)
-  bool cotan = true;       ///< cotangent weights, else uniform
-  bool frozen = false;     ///< weights of the input kept, else rebuilt at every step
+  SmoothingMethod method = SmoothingMethod::Implicit;
+  /** in h^2 (h: the mean edge length of the input); umbrella: without unit; Taubin: unused
+   *  (lambda 0.5, mu -0.53, averaged by degree) */
+  double time_step = 1.0;
+  SmoothingWeights weights = SmoothingWeights::Cotan;
+  bool frozen = false;  ///< weights of the input kept, else rebuilt at every step
   bool operator==(const SmoothingStep& o) const {
-    return implicit == o.implicit && time_step == o.time_step && cotan == o.cotan &&
+    return method == o.method && time_step == o.time_step && weights == o.weights &&
            frozen == o.frozen;
   }
 };
@@ -31,17 +37,17 @@ struct ViewerState {
   NormalMethod method = NormalMethod::Area;  ///< PCA on clouds (set by the model)
   int k = kDefaultK;
   Neighbours neighbours = Neighbours::MeshRings;
-  /** none, mean, gauss, k1, k2, angle (to the reference method's normals), compare (mesh rings
-   *  vs kd-tree), or the name of a scalar property of the file. */
+  /** none, rgb (the file's colours), mean, gauss, k1, k2, angle (to the reference method's
+   *  normals), compare (mesh rings vs kd-tree), or the name of a scalar property of the file. */
   std::string field = "none";
   /** The normals field=angle compares with; unset: area on meshes, PCA on clouds (and, when that
    *  is the method shown, mean_curvature or quadric). */
   std::optional<NormalMethod> reference;
   std::vector<SmoothingStep> steps;  ///< applied to the input, in order
-  double time_step = 1.0;            ///< of the next step, in h^2
-  bool cotan = true;                 ///< weights of the next step
-  bool frozen = true;                ///< of the next step (the library's default)
-  bool show_normals = false;         ///< glyphs
+  double time_step = 1.0;            ///< of the next step (SmoothingStep::time_step)
+  SmoothingWeights weights = SmoothingWeights::Cotan;  ///< of the next step
+  bool frozen = true;                                  ///< of the next step (the library's default)
+  bool show_normals = false;                           ///< glyphs
   bool smooth_shading = true;
   int screenshots = 0;  ///< taken so far (the next file's number)
 
@@ -54,19 +60,22 @@ struct InputCapabilities {
   bool is_mesh = false;
   int points = 0;
   std::vector<std::string> properties;  ///< scalar fields of the file (colourable)
+  bool has_colors = false;              ///< the file's own colours (rgb, rgba, red green blue)
 };
 
-/** The initial state for an input: area normals on meshes, PCA through the kd-tree on clouds. */
+/** The initial state for an input: area normals on meshes, PCA through the kd-tree on clouds;
+ *  the file's own colours (field=rgb) when it has them. */
 ViewerState initialState(const InputCapabilities& input);
 
 /**
  * Applies one action. The vocabulary (the same for keys and -do):
  *   method=uniform|area|angle|mean_curvature|pca|quadric   method+ (the next one)
  *   k=N  k+  k-  k=default          neighbours=bfs|knn  neighbours+ (toggle)
- *   field=none|mean|gauss|k1|k2|angle|compare|<property>  field+ (the next one)
+ *   field=none|rgb|mean|gauss|k1|k2|angle|compare|<property>  field+ (the next one; rgb: the
+ *   file's own colours, offered when it has them)
  *   reference=auto|<method>  (what field=angle compares with)
- *   smooth=explicit|implicit[:t]  (t: the step in h^2)   undo
- *   step=t  step*  step/ (double, halve)   weights=uniform|cotan  weights+ (toggle)
+ *   smooth=explicit|implicit|taubin[:t]  (t: the step in h^2, umbrella: without unit)   undo
+ *   step=t  step*  step/ (double, halve)   weights=cotan|uniform|umbrella  weights+ (the next)
  *   frozen=on|off  normals=on|off  normals+  shading=flat|smooth  shading+  screenshot
  * Throws std::invalid_argument with a message naming the action when it is unknown, malformed or
  * impossible for this input (a mesh method or bfs on a cloud, k beyond the point count).

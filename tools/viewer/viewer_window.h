@@ -54,10 +54,10 @@ class ViewerWindow {
   void setHiddenFaceCulling(bool allowed);
   /** Whether the last render left out the back faces. */
   bool culledBackFaces() const;
+  /** The visualizer's renderer: the scene's camera and actors (viewer_scene.cpp). */
+  vtkRenderer* sceneRenderer() const;
 
  private:
-  /** The visualizer's renderer (viewer_scene.cpp, with the rest of the scene). */
-  vtkRenderer* sceneRenderer() const;
   void onKey(const pcl::visualization::KeyboardEvent& event);
   /** Dispatches the pending X events and VTK timers, waiting at most kEventWaitMs for one. */
   void processEvents();

@@ -27,7 +27,6 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <memory>
-#include <optional>
 
 #include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/fit_orientation.h"

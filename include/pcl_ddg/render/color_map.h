@@ -3,6 +3,7 @@
  * Scalar fields to colours, for MeshLab (per-vertex RGB) and for pictures.
  */
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 
 namespace pcl_ddg {
@@ -25,6 +26,9 @@ struct ColorRange {
   double low = 0.0, high = 1.0;
 };
 ColorRange colorRange(const Eigen::VectorXd& values, ColorMap map, const ColorScale& scale = {});
+
+/** The colour at t in [0, 1] along the map (clamped outside). */
+std::array<std::uint8_t, 3> colorAt(ColorMap map, double t);
 
 /** One RGB colour per value, by colorRange; NaN values are grey. */
 Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorize(const Eigen::VectorXd& values, ColorMap map,

@@ -15,11 +15,29 @@ namespace pcl_ddg {
 struct RenderOptions {
   int width = 800;
   int height = 800;
-  double azimuth_degrees = 30.0;    ///< rotation about the up (y) axis
-  double elevation_degrees = 20.0;  ///< camera above the horizontal plane
+  double azimuth_degrees = 30.0;    ///< rotation about the up axis
+  double elevation_degrees = 20.0;  ///< camera above the plane normal to up
   Eigen::Vector3d up = Eigen::Vector3d::UnitY();
+  /** Towards the camera at azimuth and elevation 0 (made normal to up); zero: a fixed axis
+   *  normal to up (z, or x for an up near z). */
+  Eigen::Vector3d front = Eigen::Vector3d::Zero();
   double point_radius_pixels = 0.0;  ///< splat radius for clouds; 0 = from the point count
 };
+
+/** The view that shows the most of an object: front along its smallest principal axis (the
+ *  largest projected area), on the side its normals (3 x N, or empty) face on the whole, else
+ *  the side of +z (or +y). Up: the vertical (+y; +z for geographic data) as seen from there,
+ *  unless the view looks within 30 degrees of it; then the largest principal axis, or north (+y)
+ *  on a geographic map seen from above. NaN positions are skipped. */
+struct DefaultView {
+  Eigen::Vector3d front, up;
+};
+DefaultView defaultView(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xd& normals,
+                        bool geographic);
+
+/** Whether the finite positions' centre is more than 100 times their extent from the origin, as
+ *  projected (UTM) coordinates are: with a LAS input, what makes data geographic. */
+bool farFromOrigin(const Eigen::Matrix3Xd& positions);
 
 struct Image {
   int width = 0;
