@@ -27,7 +27,8 @@ constexpr const char* kDescription =
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk,pcd,las} output.png [-field name] [-map diverging|sequential]\n"
     "         [-azimuth deg (default 30)] [-elevation deg (default 20)]\n"
-    "         [-up x|y|z|-x|-y|-z (default: the object's largest axis, +z for geographic data)]\n"
+    "         [-up x|y|z|-x|-y|-z (default: y as seen from the side that shows the most of the\n"
+    "         object, or its largest axis when that side looks along y; z for geographic data)]\n"
     "         [-size pixels]";
 
 // The field's name with its units, for the fields this project's tools write.
@@ -70,8 +71,8 @@ int run(int argc, char** argv) {
         std::optional<ColorRange> bar;
         if (const auto field = args.value("field")) {
           const Eigen::VectorXd values = vertexScalarField(mesh.cloud, *field);
-          colors = colorize(values, map);
           bar = colorRange(values, map);
+          colors = colorizeWithin(values, map, *bar);
           std::cerr << kName << ": " << *field << " coloured from " << bar->low << " to "
                     << bar->high << " (2nd and 98th percentiles"
                     << (map == ColorMap::Diverging ? ", symmetric about 0" : "")

@@ -57,19 +57,15 @@ int run(int argc, char** argv) {
   p.scheme = method == "explicit" ? SmoothingScheme::Explicit
              : method == "taubin" ? SmoothingScheme::Taubin
                                   : SmoothingScheme::Implicit;
-  const std::string weights = args.choice("weights", {"uniform", "cotan", "umbrella"},
-                                          method == "implicit" ? "cotan" : "umbrella");
-  p.weights = weights == "cotan" ? LaplacianWeights::Cotangent : LaplacianWeights::Uniform;
-  if (weights == "umbrella" && args.has("average") && args.value("average") != "degree")
-    throw tools::UsageError("-weights umbrella is averaged by degree");
-  p.average = args.choice("average", {"area", "degree"},
-                          weights == "umbrella" || (!args.has("weights") && method != "implicit")
-                              ? "degree"
-                              : "area") == "degree"
-                  ? FlowAverage::Degree
-                  : FlowAverage::Area;
-  if (p.average == FlowAverage::Degree && (args.has("area") || args.has("mass")))
-    throw tools::UsageError("-area weighs the flow by vertex areas, not by degrees");
+  // Defaults (smoothing_steps.h): cotan by area for implicit and with -area, else umbrella.
+  const bool areas_asked = args.has("area") || args.has("mass");
+  try {
+    chooseOperator(
+        p, args.has("weights") ? args.choice("weights", {"uniform", "cotan", "umbrella"}, "") : "",
+        args.has("average") ? args.choice("average", {"area", "degree"}, "") : "", areas_asked);
+  } catch (const pcl::BadArgumentException& e) {
+    throw tools::UsageError(errorDescription(e));
+  }
   p.mass = tools::vertexAreaArgument(args);
   p.iterations = args.integer("iterations", 1);
   if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
@@ -104,6 +100,7 @@ int run(int argc, char** argv) {
     throw tools::UsageError("-mu must be below -lambda (e.g. -lambda 0.5 -mu -0.53)");
   steps.absolute_time = args.has("absolute_time");
   steps.allow_unstable = args.has("allow_unstable");
+  steps.remedy = "-method implicit for large steps, -weights umbrella, or -allow_unstable";
   const FieldPrecision precision = tools::precisionArgument(args);
 
   return tools::forEachInput(
@@ -112,9 +109,7 @@ int run(int argc, char** argv) {
         const ResolvedSteps resolved = resolveSteps(*in.topology, in.positions, steps, p);
         std::cerr << kName << ": " << describeSteps(p, resolved) << "\n";
         if (resolved.unstable) {
-          tools::warn(kName,
-                      "the step exceeds the explicit stability bound: expect the surface to "
-                      "blow up");
+          tools::warn(kName, "the steps exceed the stability bound: expect the surface to blow up");
         }
 
         const std::size_t points = static_cast<std::size_t>(in.positions.cols());

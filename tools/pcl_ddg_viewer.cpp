@@ -23,9 +23,10 @@ std::string syntax() {
          "1024x768)]\n"
          "Actions (also what the keys send):\n"
          "  method=uniform|area|angle|mean_curvature|pca|quadric  k=N  neighbours=rings|kdtree\n"
-         "  field=none|mean|gauss|k1|k2|angle|compare|<property of the file>\n"
+         "  field=none|rgb|mean|gauss|k1|k2|angle|compare|<property of the file> (rgb: its "
+         "colours)\n"
          "  reference=auto|<method> (what field=angle compares with)\n"
-         "  smooth=explicit|implicit|taubin[:t] (t: step in h^2, umbrella: no unit)  step=t\n"
+         "  smooth=explicit|implicit[:t]|taubin (t: step in h^2, umbrella: no unit)  step=t\n"
          "  weights=cotan|uniform|umbrella\n"
          "  frozen=on|off  undo  normals=on|off  shading=flat|smooth  screenshot\n"
          "Keys:\n" +

@@ -229,10 +229,10 @@ def smooth(
     method: str = "implicit",
     weights: Optional[str] = None,
     average: Optional[str] = None,
-    mass: str = "mixed",
+    mass: Optional[str] = None,
     lambda_dt: Optional[float] = None,
     lambda_: Optional[float] = None,
-    mu: float = -0.53,
+    mu: Optional[float] = None,
     iterations: int = 1,
     absolute_time: bool = False,
     freeze_weights: bool = False,
@@ -250,16 +250,19 @@ def smooth(
         ``"taubin"`` (a step of ``lambda_`` then one of ``mu`` per iteration: no shrinkage).
     weights:
         ``"cotan"``, ``"uniform"`` or ``"umbrella"`` (uniform averaged by degree: each vertex moves
-        towards the mean of its neighbours). Default: cotan (implicit), umbrella (otherwise).
+        towards the mean of its neighbours). Default: cotan for implicit steps or with ``mass``,
+        else umbrella.
     average:
-        what divides L: ``"area"`` (the vertex areas of ``mass``: the geometric flow) or
-        ``"degree"`` (each vertex's total weight). Default: degree for umbrella, else area.
+        what divides L: ``"area"`` (the vertex areas of ``mass``, default ``"mixed"``: the
+        geometric flow) or ``"degree"`` (each vertex's total weight). Default: degree for umbrella,
+        else area.
     lambda_dt:
         the flow's time step: averaged by area in units of h^2 (h = mean edge length), or in
         length^2 with ``absolute_time=True``; averaged by degree without unit. Default: 1
         (implicit), half the stability bound (explicit).
     lambda_, mu:
-        Taubin's two steps (mu < -lambda_), in lambda_dt's units; default 0.5 and -0.53.
+        Taubin's two steps (mu < -lambda_), in lambda_dt's units; default 0.5 and -0.53. Only
+        with ``method="taubin"`` (ValueError otherwise, as ``lambda_dt`` with it).
     freeze_weights / rebuild_weights:
         by default L is frozen at the input and M follows the surface; ``freeze_weights`` freezes
         both, ``rebuild_weights`` rebuilds both every iteration (the singular mean-curvature flow).
@@ -279,7 +282,7 @@ def smooth(
         mass,
         lambda_dt,
         lambda_,
-        float(mu),
+        None if mu is None else float(mu),
         int(iterations),
         bool(absolute_time),
         bool(freeze_weights),

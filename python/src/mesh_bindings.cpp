@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "binding_common.h"
+#include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_report.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -188,28 +189,22 @@ void bindMeshes(py::module_& m) {
       "smooth",
       [](const py::array& V, const py::object& F, const std::string& method,
          std::optional<std::string> weights, std::optional<std::string> average,
-         const std::string& mass, std::optional<double> lambda_dt, std::optional<double> lambda_,
-         double mu, int iterations, bool absolute_time, bool freeze_weights, bool rebuild_weights,
-         bool fix_boundary, bool allow_unstable, const std::string& preserve,
-         const std::string& solver) {
+         std::optional<std::string> mass, std::optional<double> lambda_dt,
+         std::optional<double> lambda_, std::optional<double> mu, int iterations,
+         bool absolute_time, bool freeze_weights, bool rebuild_weights, bool fix_boundary,
+         bool allow_unstable, const std::string& preserve, const std::string& solver) {
         // pcl_ddg_smooth's options and defaults (tools/pcl_ddg_smooth.cpp).
         MeshSmoothingParameters p;
         const std::string scheme = choice("method", method, {"implicit", "explicit", "taubin"});
         p.scheme = scheme == "explicit" ? SmoothingScheme::Explicit
                    : scheme == "taubin" ? SmoothingScheme::Taubin
                                         : SmoothingScheme::Implicit;
-        const std::string w =
-            choice("weights", weights.value_or(scheme == "implicit" ? "cotan" : "umbrella"),
-                   {"cotan", "uniform", "umbrella"});
-        p.weights = w == "cotan" ? LaplacianWeights::Cotangent : LaplacianWeights::Uniform;
-        if (w == "umbrella" && average && *average != "degree")
-          throw py::value_error("weights='umbrella' is averaged by degree");
-        const bool by_degree = w == "umbrella" || (!weights && scheme != "implicit");
-        p.average = choice("average", average.value_or(by_degree ? "degree" : "area"),
-                           {"area", "degree"}) == "degree"
-                        ? FlowAverage::Degree
-                        : FlowAverage::Area;
-        p.mass = massOf(mass);
+        try {
+          chooseOperator(p, weights.value_or(""), average.value_or(""), mass.has_value());
+        } catch (const pcl::BadArgumentException& e) {
+          throw py::value_error(errorDescription(e));
+        }
+        p.mass = massOf(mass.value_or("mixed"));
         if (iterations < 1) throw py::value_error("iterations must be at least 1");
         p.iterations = iterations;
         if (freeze_weights && rebuild_weights)
@@ -227,11 +222,13 @@ void bindMeshes(py::module_& m) {
         const bool taubin = p.scheme == SmoothingScheme::Taubin;
         if (taubin && lambda_dt)
           throw py::value_error("method='taubin' takes lambda_ and mu, not lambda_dt");
-        if (!taubin && lambda_)
-          throw py::value_error("lambda_ is method='taubin''s (the flow takes lambda_dt)");
+        if (!taubin && (lambda_ || mu))
+          throw py::value_error("lambda_ and mu are method='taubin''s (the flow takes lambda_dt)");
         RelativeSteps steps;
         steps.step = taubin ? lambda_ : lambda_dt;
-        steps.mu = mu;
+        steps.mu = mu.value_or(steps.mu);
+        steps.remedy =
+            "method='implicit' for large steps, weights='umbrella', or allow_unstable=True";
         steps.absolute_time = absolute_time;
         steps.allow_unstable = allow_unstable;
         if (absolute_time && !steps.step)

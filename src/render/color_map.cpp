@@ -61,7 +61,12 @@ std::array<std::uint8_t, 3> colorAt(ColorMap map, double t) {
 
 Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorize(const Eigen::VectorXd& values, ColorMap map,
                                                         const ColorScale& scale) {
-  const ColorRange limits = colorRange(values, map, scale);
+  return colorizeWithin(values, map, colorRange(values, map, scale));
+}
+
+Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorizeWithin(const Eigen::VectorXd& values,
+                                                              ColorMap map,
+                                                              const ColorRange& limits) {
   const double lo = limits.low;
   const double range = limits.high > lo ? limits.high - lo : 1.0;
   Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> rgb(3, values.size());

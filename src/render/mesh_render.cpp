@@ -82,9 +82,11 @@ DefaultView defaultView(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3X
   for (Eigen::Index i = 0; i < positions.cols(); ++i) {
     if (positions.col(i).allFinite()) centre += positions.col(i), ++count;
   }
-  DefaultView view{Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitY()};
-  if (count < 3) return view;
+  DefaultView view{Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::Zero()};
+  if (count == 0) return view;
   centre /= static_cast<double>(count);
+  view.centre = centre;
+  if (count < 3) return view;
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   Eigen::Vector3d facing = Eigen::Vector3d::Zero();
   for (Eigen::Index i = 0; i < positions.cols(); ++i) {
@@ -116,15 +118,17 @@ DefaultView defaultView(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3X
   return view;
 }
 
-bool farFromOrigin(const Eigen::Matrix3Xd& positions) {
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d high = -low;
+Eigen::AlignedBox3d finiteBounds(const Eigen::Matrix3Xd& positions) {
+  Eigen::AlignedBox3d box;  // empty
   for (Eigen::Index i = 0; i < positions.cols(); ++i) {
-    if (!positions.col(i).allFinite()) continue;
-    low = low.cwiseMin(positions.col(i));
-    high = high.cwiseMax(positions.col(i));
+    if (positions.col(i).allFinite()) box.extend(positions.col(i));
   }
-  return high.x() >= low.x() && (0.5 * (low + high)).norm() > 100.0 * (high - low).norm();
+  return box;
+}
+
+bool farFromOrigin(const Eigen::Matrix3Xd& positions) {
+  const Eigen::AlignedBox3d box = finiteBounds(positions);
+  return !box.isEmpty() && box.center().norm() > 100.0 * box.diagonal().norm();
 }
 
 Image renderMesh(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xi& triangles,

@@ -192,8 +192,8 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
     current = values.transpose();
     if (!current.allFinite()) {
       failedAt(iteration, p.scheme != SmoothingScheme::Implicit
-                              ? "non-finite positions (the explicit step is unstable: use a "
-                                "smaller time step or the implicit scheme)"
+                              ? "non-finite positions (the explicit or Taubin steps are "
+                                "unstable: use smaller steps or the implicit scheme)"
                               : "non-finite positions");
     }
     requireNotCollapsed(topology, current, r.area_before, r.volume_before, within, iteration);

@@ -9,6 +9,25 @@
 
 namespace pcl_ddg {
 
+void chooseOperator(MeshSmoothingParameters& p, const std::string& weights,
+                    const std::string& average, bool areas_asked) {
+  const auto bad = [](const std::string& what) { throw pcl::BadArgumentException(what); };
+  if (!weights.empty() && weights != "cotan" && weights != "uniform" && weights != "umbrella")
+    bad("unknown weights '" + weights + "' (cotan, uniform or umbrella)");
+  if (!average.empty() && average != "area" && average != "degree")
+    bad("unknown average '" + average + "' (area or degree)");
+  const bool implicit = p.scheme == SmoothingScheme::Implicit;
+  const std::string w = !weights.empty() ? weights : implicit || areas_asked ? "cotan" : "umbrella";
+  const bool by_degree = average.empty()
+                             ? w == "umbrella" || (weights.empty() && !implicit && !areas_asked)
+                             : average == "degree";
+  if (w == "umbrella" && !by_degree) bad("the umbrella weights are averaged by degree");
+  if (areas_asked && by_degree)
+    bad("vertex areas average the flow by area, not by degree (drop them, or average by area)");
+  p.weights = w == "cotan" ? LaplacianWeights::Cotangent : LaplacianWeights::Uniform;
+  p.average = by_degree ? FlowAverage::Degree : FlowAverage::Area;
+}
+
 ResolvedSteps resolveSteps(const MeshTopology& topology, const PositionsRef& positions,
                            const RelativeSteps& steps, MeshSmoothingParameters& p) {
   const bool taubin = p.scheme == SmoothingScheme::Taubin;
@@ -21,26 +40,30 @@ ResolvedSteps resolveSteps(const MeshTopology& topology, const PositionsRef& pos
   if (!(h > 0.0)) throw pcl::BadArgumentException("the mesh has no edge of positive length");
   ResolvedSteps r;
   r.unit = per_area && !steps.absolute_time ? h * h : 1.0;
-  r.unit_name = per_area && !steps.absolute_time ? " h^2" : "";
+  r.unit_name = !per_area ? "" : steps.absolute_time ? " length^2" : " h^2";
   if (p.scheme == SmoothingScheme::Implicit) {
     p.time_step = steps.step.value_or(1.0) * r.unit;
     return r;
   }
-  const double lambda = steps.step.value_or(0.5);
-  if (taubin && (!(steps.mu < -lambda) || !std::isfinite(steps.mu)))
-    throw pcl::BadArgumentException("mu must be below -lambda (e.g. lambda 0.5, mu -0.53)");
   r.bound = explicitStabilityLimit(topology, positions, p.weights, p.mass, p.average) / r.unit;
   // Taubin's lambda has its default; the flow's is half the bound.
-  p.time_step = (taubin || steps.step ? lambda : 0.5 * r.bound) * r.unit;
+  const double lambda = taubin || steps.step ? steps.step.value_or(0.5) : 0.5 * r.bound;
+  p.time_step = lambda * r.unit;
   p.taubin_mu = steps.mu * r.unit;
-  const double largest = taubin ? -steps.mu : p.time_step / r.unit;
-  r.unstable = largest > r.bound;
+  const double k_max = 2.0 / r.bound;  // see the header
+  const double gain = taubin ? (1.0 - lambda * k_max) * (1.0 - steps.mu * k_max) : 0.0;
+  r.unstable = taubin ? gain < -1.0 : lambda > r.bound;
   if (r.unstable && !steps.allow_unstable) {
     std::ostringstream what;
-    what << "the " << (taubin ? "Taubin" : "explicit") << " step " << largest << r.unit_name
-         << " exceeds the stability bound " << r.bound << r.unit_name
-         << ": the surface would blow up (use the implicit method for large steps, "
-         << (per_area ? "the umbrella weights, " : "") << "or allow unstable steps)";
+    if (taubin) {
+      what << "the Taubin steps " << lambda << r.unit_name << " and " << steps.mu << r.unit_name
+           << " multiply the finest wrinkles the stability bound " << r.bound << r.unit_name
+           << " allows by " << gain;
+    } else {
+      what << "the explicit step " << lambda << r.unit_name << " exceeds the stability bound "
+           << r.bound << r.unit_name;
+    }
+    what << ": the surface would blow up (" << steps.remedy << ")";
     throw pcl::BadArgumentException(what.str());
   }
   return r;

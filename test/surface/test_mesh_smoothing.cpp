@@ -16,6 +16,7 @@
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/surface/mesh_smoothing.h"
+#include "pcl_ddg/surface/smoothing_steps.h"
 #include "reference_operators.h"
 #include "smoothing_support.h"
 #include "test_data.h"
@@ -507,6 +508,57 @@ TEST(MeshSmoothing, TaubinIsALambdaStepThenAMuStep) {
   const Eigen::Matrix3Xd smoothed =
       smoothMeshPositions(topology, noisy, umbrella(SmoothingScheme::Taubin, 0.5, 4));
   EXPECT_LT((smoothed - expected).cwiseAbs().maxCoeff(), 1e-14);
+}
+
+// Steps as the tools take them (smoothing_steps.h): units, defaults and the stability checks,
+// against the spectrum's bound k_max = 2 / bound (umbrella: bound 1, k_max = 2).
+TEST(MeshSmoothing, RelativeStepsHaveTheirUnitsDefaultsAndStabilityChecks) {
+  const SurfaceSample sphere = makeIcosphere(2);
+  const MeshTopology topology = topologyOf(sphere);
+  const double h2 = squaredEdge(topology, sphere.points);
+  MeshSmoothingParameters p;
+  p.scheme = SmoothingScheme::Explicit;
+  chooseOperator(p, "", "", false);  // explicit: the umbrella operator
+  EXPECT_EQ(p.weights, LaplacianWeights::Uniform);
+  EXPECT_EQ(p.average, FlowAverage::Degree);
+  ResolvedSteps r = resolveSteps(topology, sphere.points, RelativeSteps(), p);
+  EXPECT_EQ(r.bound, 1.0);
+  EXPECT_EQ(p.time_step, 0.5);  // half the bound, without unit
+  RelativeSteps too_large;
+  too_large.step = 1.01;
+  EXPECT_THROW(resolveSteps(topology, sphere.points, too_large, p), pcl::BadArgumentException);
+  // Taubin: (1 - lambda k)(1 - mu k) at k = 2 is 0 for 0.5 | -0.53, -2.94 for 0.99 | -1.
+  p.scheme = SmoothingScheme::Taubin;
+  r = resolveSteps(topology, sphere.points, RelativeSteps(), p);
+  EXPECT_FALSE(r.unstable);
+  EXPECT_EQ(p.time_step, 0.5);
+  EXPECT_EQ(p.taubin_mu, -0.53);
+  RelativeSteps wrinkling;
+  wrinkling.step = 0.99;
+  wrinkling.mu = -1.0;
+  EXPECT_THROW(resolveSteps(topology, sphere.points, wrinkling, p), pcl::BadArgumentException);
+  wrinkling.allow_unstable = true;
+  EXPECT_TRUE(resolveSteps(topology, sphere.points, wrinkling, p).unstable);
+  // Implicit: cotan averaged by area, steps in h^2 (or length^2).
+  p.scheme = SmoothingScheme::Implicit;
+  chooseOperator(p, "", "", false);
+  EXPECT_EQ(p.weights, LaplacianWeights::Cotangent);
+  EXPECT_EQ(p.average, FlowAverage::Area);
+  RelativeSteps three;
+  three.step = 3.0;
+  EXPECT_STREQ(resolveSteps(topology, sphere.points, three, p).unit_name, " h^2");
+  EXPECT_DOUBLE_EQ(p.time_step, 3.0 * h2);
+  three.absolute_time = true;
+  EXPECT_STREQ(resolveSteps(topology, sphere.points, three, p).unit_name, " length^2");
+  EXPECT_EQ(p.time_step, 3.0);
+  // Vertex areas asked for: the area-averaged flow; umbrella by area and areas by degree: refused.
+  p.scheme = SmoothingScheme::Explicit;
+  chooseOperator(p, "", "", true);
+  EXPECT_EQ(p.weights, LaplacianWeights::Cotangent);
+  EXPECT_EQ(p.average, FlowAverage::Area);
+  EXPECT_THROW(chooseOperator(p, "umbrella", "area", false), pcl::BadArgumentException);
+  EXPECT_THROW(chooseOperator(p, "", "degree", true), pcl::BadArgumentException);
+  EXPECT_THROW(chooseOperator(p, "laplace", "", false), pcl::BadArgumentException);
 }
 
 TEST(MeshSmoothing, TaubinSmoothsANoisySphereWithoutShrinkingItWhereTheUmbrellaFlowShrinks) {

@@ -435,6 +435,22 @@ TEST_F(Viewer, TheObjectFillsTheFrameSeenFromItsWidestSide) {
     EXPECT_GT(std::abs(Eigen::Vector3d(direction).normalized().dot(axes.eigenvectors().col(0))),
               0.999);
   }
+  // A cloud without a sensor pose and with a NaN point is framed by its finite points.
+  const std::string with_nan = dir_ + "/with_nan.pcd";
+  {
+    std::ofstream out(with_nan);
+    out << "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 401\nHEIGHT 1\n"
+           "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 401\nDATA ascii\nnan nan nan\n";
+    for (int i = 0; i < 400; ++i)
+      out << (i % 20) * 0.1 << " " << (i / 20) * 0.05 << " " << 0.01 * (i % 7) << "\n";
+  }
+  auto cloud = open(with_nan);
+  ViewerWindow cloud_window(*cloud, 400, 300);
+  const Image cloud_picture = screenshot(cloud_window, "with_nan");
+  const Framing cloud_framing = framingOf(cloud_window, cloud->inputPositions());
+  EXPECT_TRUE(cloud_framing.inside);
+  EXPECT_GE(std::max(cloud_framing.width, cloud_framing.height), 0.7);
+  EXPECT_GT(cloud_picture.objectShare(), 0.01);  // 400 points, drawn where the frame is
   // Terrain in UTM coordinates: a map seen from above, north up.
   auto terrain = open(sharedData("clouds/terrain_CSite1_red2-utm.pcd"));
   ViewerWindow window(*terrain, 400, 300);

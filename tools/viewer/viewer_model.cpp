@@ -68,14 +68,8 @@ ViewerModel::ViewerModel(tools::ToolInput input, std::string path)
     file_colors_ = vertexColors(input_.mesh.cloud);
   }
   spacing_ = input_.spacing();
-  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d high = -low;
-  for (Eigen::Index i = 0; i < input_.positions.cols(); ++i) {
-    if (!input_.positions.col(i).allFinite()) continue;
-    low = low.cwiseMin(input_.positions.col(i));
-    high = high.cwiseMax(input_.positions.col(i));
-  }
-  diagonal_ = high.x() >= low.x() ? (high - low).norm() : 0.0;
+  const Eigen::AlignedBox3d box = finiteBounds(input_.positions);
+  diagonal_ = box.isEmpty() ? 0.0 : box.diagonal().norm();
   if (!(spacing_ > 0.0)) spacing_ = 1.0;
   positions_["input;"] = std::make_shared<const Eigen::Matrix3Xd>(input_.positions);
   points_["input;"] = input_.points();
@@ -331,7 +325,7 @@ Frame ViewerModel::compute(const ViewerState& state) {
     frame.field = fieldOf(frame.state, shown, frame.positions, *frame.normals, frame.field_label,
                           frame.color_map, frame.warnings);
     frame.range = colorRange(frame.field, frame.color_map);
-    frame.colors = colorize(frame.field, frame.color_map);
+    frame.colors = colorizeWithin(frame.field, frame.color_map, frame.range);
   }
   frame.compute_ms = clock.toc();
   return frame;

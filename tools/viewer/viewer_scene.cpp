@@ -158,15 +158,14 @@ void ViewerWindow::placeCamera() {
                     model_.geographic());
     forward = -view.front;
     up = view.up;
-    const Eigen::Vector3d centre = positions.rowwise().mean();
-    eye = centre - forward;
+    eye = view.centre - forward;
   }
   const Eigen::Vector3d focal = eye + forward;
   visualizer_->setCameraPosition(eye.x(), eye.y(), eye.z(), focal.x(), focal.y(), focal.z(), up.x(),
                                  up.y(), up.z());
   vtkRenderer* renderer = sceneRenderer();
   renderer->ResetCamera();
-  // ResetCamera fits the bounding sphere; zoom until the object itself fills 85 % of the frame's
+  // ResetCamera fits the bounding sphere; zoom until the object itself fills 80 % of the frame's
   // height or width (whichever binds).
   vtkCamera* camera = renderer->GetActiveCamera();
   double position[3], focal_point[3], view_up[3];
@@ -191,7 +190,7 @@ void ViewerWindow::placeCamera() {
   const double aspect = size[1] > 0 ? static_cast<double>(size[0]) / size[1] : 1.0;
   const double fill =
       std::max(half_height / visible_half_height, half_width / (visible_half_height * aspect));
-  if (fill > 0.0) camera->Zoom(0.85 / fill);
+  if (fill > 0.0) camera->Zoom(0.8 / fill);
   renderer->ResetCameraClippingRange();
 }
 

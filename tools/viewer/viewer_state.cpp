@@ -177,6 +177,8 @@ std::string applyAction(ViewerState& state, const InputCapabilities& input,
     if (scheme != "explicit" && scheme != "implicit" && scheme != "taubin")
       refuse(action, "expected explicit|implicit|taubin");
     if (!input.is_mesh) refuse(action, "smoothing needs a mesh");
+    if (scheme == "taubin" && colon != std::string::npos)
+      refuse(action, "a Taubin step takes no size (lambda 0.5, mu -0.53)");
     if (colon != std::string::npos)
       state.time_step = positiveNumber(action, value.substr(colon + 1));
     const SmoothingMethod method = scheme == "explicit" ? SmoothingMethod::Explicit
@@ -251,7 +253,9 @@ const KeyBinding kKeys[] = {
     {"bracketleft", "[", "k-", "fewer neighbours (k)"},
     {"backslash", "\\", "k=default", "k back to 16"},
     {"n", "n", "neighbours+", "neighbourhood: mesh rings <-> kd-tree (pca, quadric)"},
-    {"v", "v", "field+", "next colour field (none mean gauss k1 k2 angle compare, properties)"},
+    {"v", "v", "field+",
+     "next colour field (none rgb mean gauss k1 k2 angle compare, properties; rgb: the file's "
+     "colours)"},
     {"b", "b", "normals+", "normal glyphs on/off"},
     {"semicolon", ";", "shading+", "flat <-> smooth shading"},
     {"t", "t", "smooth=explicit", "one explicit smoothing step"},

@@ -74,7 +74,7 @@ ViewerState initialState(const InputCapabilities& input);
  *   field=none|rgb|mean|gauss|k1|k2|angle|compare|<property>  field+ (the next one; rgb: the
  *   file's own colours, offered when it has them)
  *   reference=auto|<method>  (what field=angle compares with)
- *   smooth=explicit|implicit|taubin[:t]  (t: the step in h^2, umbrella: without unit)   undo
+ *   smooth=explicit|implicit[:t]|taubin  (t: the step in h^2, umbrella: without unit)   undo
  *   step=t  step*  step/ (double, halve)   weights=cotan|uniform|umbrella  weights+ (the next)
  *   frozen=on|off  normals=on|off  normals+  shading=flat|smooth  shading+  screenshot
  * Throws std::invalid_argument with a message naming the action when it is unknown, malformed or

@@ -34,4 +34,9 @@ std::array<std::uint8_t, 3> colorAt(ColorMap map, double t);
 Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorize(const Eigen::VectorXd& values, ColorMap map,
                                                         const ColorScale& scale = {});
 
+/** The same within a given range (e.g. the one a colour bar shows), values beyond clamped. */
+Eigen::Matrix<std::uint8_t, 3, Eigen::Dynamic> colorizeWithin(const Eigen::VectorXd& values,
+                                                              ColorMap map,
+                                                              const ColorRange& range);
+
 }  // namespace pcl_ddg

@@ -6,6 +6,7 @@
  * normals when they have them; written as PNG.
  */
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -31,9 +32,13 @@ struct RenderOptions {
  *  on a geographic map seen from above. NaN positions are skipped. */
 struct DefaultView {
   Eigen::Vector3d front, up;
+  Eigen::Vector3d centre;  ///< of the finite positions, what the camera looks at
 };
 DefaultView defaultView(const Eigen::Matrix3Xd& positions, const Eigen::Matrix3Xd& normals,
                         bool geographic);
+
+/** The bounding box of the finite positions (empty if none). */
+Eigen::AlignedBox3d finiteBounds(const Eigen::Matrix3Xd& positions);
 
 /** Whether the finite positions' centre is more than 100 times their extent from the origin, as
  *  projected (UTM) coordinates are: with a LAS input, what makes data geographic. */
