@@ -468,8 +468,8 @@ TEST_F(MeshTools, RenderMakesAPicture) {
       << missing.err;
   // A field: coloured between its 2nd and 98th percentiles, which the tool says, with a colour
   // bar beside the picture (a wider image).
-  ASSERT_EQ(runTool(PCL_DDG_CURVATURE_TOOL, sharedData("meshes/cow.off") + " " + path("k.ply") +
-                                                " -precision double")
+  ASSERT_EQ(runTool(PCL_DDG_CURVATURE_TOOL,
+                    sharedData("meshes/cow.off") + " " + path("k.ply") + " -precision double")
                 .exit_code,
             0);
   const ToolRun field =
