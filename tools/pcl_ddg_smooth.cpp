@@ -31,9 +31,11 @@ constexpr const char* kDescription =
     "moves towards the mean of its neighbours; steps are dimensionless, explicit ones stable up\n"
     "to 1). -weights umbrella is uniform weights averaged by degree, the default of -method\n"
     "explicit and taubin; implicit defaults to cotan weights averaged by area.\n"
-    "Default weight update: the Laplacian frozen at the input, the areas following the surface\n"
-    "(rebuilt cotangent weights pinch thin triangles into slivers within a few large steps);\n"
-    "-freeze_weights freezes both, -rebuild_weights rebuilds both every iteration.";
+    "Default weight update: none, the Laplacian and the areas stay those of the input (of three\n"
+    "policies it makes the fewest slivers on coarse scans with thin parts, and factorises once);\n"
+    "-update_mass lets the areas follow the surface (conformalized mean-curvature flow),\n"
+    "-rebuild_weights rebuilds both every iteration (mean-curvature flow: thin parts pinch into\n"
+    "slivers). -freeze_weights, the default, is accepted for old command lines.";
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk} output.{ply,pcd,las}\n"
     "         [-method explicit|implicit|taubin (default implicit)]\n"
@@ -41,17 +43,18 @@ constexpr const char* kSyntax =
     "         [-average area|degree] [-area mixed|voronoi|barycentric]\n"
     "         [-lambda_dt t (default: implicit 1, explicit half the stability bound)]\n"
     "         [-lambda l (taubin, default 0.5)] [-mu m (taubin, default -0.53)]\n"
-    "         [-iterations n (default 1)] [-absolute_time] [-freeze_weights | -rebuild_weights]\n"
+    "         [-iterations n (default 1)] [-absolute_time]\n"
+    "         [-update_mass | -rebuild_weights | -freeze_weights (default)]\n"
     "         [-fix_boundary] [-allow_unstable]\n"
     "         [-preserve volume|area] [-solver auto|cholmod|ldlt|cg] [-precision float|double]";
 
 int run(int argc, char** argv) {
   using namespace pcl_ddg;
-  const tools::ToolArguments args(
-      argc, argv,
-      {"method", "weights", "average", "area", "mass", "lambda_dt", "lambda", "mu", "iterations",
-       "preserve", "solver", "precision"},
-      {"absolute_time", "freeze_weights", "rebuild_weights", "fix_boundary", "allow_unstable"});
+  const tools::ToolArguments args(argc, argv,
+                                  {"method", "weights", "average", "area", "mass", "lambda_dt",
+                                   "lambda", "mu", "iterations", "preserve", "solver", "precision"},
+                                  {"absolute_time", "freeze_weights", "update_mass",
+                                   "rebuild_weights", "fix_boundary", "allow_unstable"});
   MeshSmoothingParameters p;
   const std::string method = args.choice("method", {"explicit", "implicit", "taubin"}, "implicit");
   p.scheme = method == "explicit" ? SmoothingScheme::Explicit
@@ -69,9 +72,10 @@ int run(int argc, char** argv) {
   p.mass = tools::vertexAreaArgument(args);
   p.iterations = args.integer("iterations", 1);
   if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
-  if (args.has("freeze_weights") && args.has("rebuild_weights"))
-    throw tools::UsageError("-freeze_weights and -rebuild_weights exclude each other");
-  if (args.has("freeze_weights")) p.weight_update = WeightUpdate::Frozen;
+  if (args.has("freeze_weights") + args.has("update_mass") + args.has("rebuild_weights") > 1)
+    throw tools::UsageError(
+        "-freeze_weights, -update_mass and -rebuild_weights exclude each other");
+  if (args.has("update_mass")) p.weight_update = WeightUpdate::FrozenStiffness;
   if (args.has("rebuild_weights")) p.weight_update = WeightUpdate::EveryIteration;
   if (args.has("fix_boundary")) p.boundary = BoundaryCondition::Fixed;
   const std::string preserve = args.choice("preserve", {"none", "volume", "area"}, "none");

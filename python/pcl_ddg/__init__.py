@@ -236,6 +236,7 @@ def smooth(
     iterations: int = 1,
     absolute_time: bool = False,
     freeze_weights: bool = False,
+    update_mass: bool = False,
     rebuild_weights: bool = False,
     fix_boundary: bool = False,
     allow_unstable: bool = False,
@@ -263,9 +264,10 @@ def smooth(
     lambda_, mu:
         Taubin's two steps (mu < -lambda_), in lambda_dt's units; default 0.5 and -0.53. Only
         with ``method="taubin"`` (ValueError otherwise, as ``lambda_dt`` with it).
-    freeze_weights / rebuild_weights:
-        by default L is frozen at the input and M follows the surface; ``freeze_weights`` freezes
-        both, ``rebuild_weights`` rebuilds both every iteration (the singular mean-curvature flow).
+    freeze_weights / update_mass / rebuild_weights:
+        by default (``freeze_weights``) L and M stay those of the input; ``update_mass`` lets M
+        follow the surface (conformalized mean-curvature flow), ``rebuild_weights`` rebuilds both
+        every iteration (mean-curvature flow, which pinches thin parts into slivers).
     fix_boundary: boundary vertices keep their position.
     preserve: ``"none"``, ``"volume"`` (closed meshes) or ``"area"``: rescale after every step.
     solver: ``"auto"``, ``"cholmod"``, ``"ldlt"`` or ``"cg"`` (conjugate gradients).
@@ -286,6 +288,7 @@ def smooth(
         int(iterations),
         bool(absolute_time),
         bool(freeze_weights),
+        bool(update_mass),
         bool(rebuild_weights),
         bool(fix_boundary),
         bool(allow_unstable),

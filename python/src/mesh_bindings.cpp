@@ -191,8 +191,9 @@ void bindMeshes(py::module_& m) {
          std::optional<std::string> weights, std::optional<std::string> average,
          std::optional<std::string> mass, std::optional<double> lambda_dt,
          std::optional<double> lambda_, std::optional<double> mu, int iterations,
-         bool absolute_time, bool freeze_weights, bool rebuild_weights, bool fix_boundary,
-         bool allow_unstable, const std::string& preserve, const std::string& solver) {
+         bool absolute_time, bool freeze_weights, bool update_mass, bool rebuild_weights,
+         bool fix_boundary, bool allow_unstable, const std::string& preserve,
+         const std::string& solver) {
         // pcl_ddg_smooth's options and defaults (tools/pcl_ddg_smooth.cpp).
         MeshSmoothingParameters p;
         const std::string scheme = choice("method", method, {"implicit", "explicit", "taubin"});
@@ -207,9 +208,10 @@ void bindMeshes(py::module_& m) {
         p.mass = massOf(mass.value_or("mixed"));
         if (iterations < 1) throw py::value_error("iterations must be at least 1");
         p.iterations = iterations;
-        if (freeze_weights && rebuild_weights)
-          throw py::value_error("freeze_weights and rebuild_weights exclude each other");
-        if (freeze_weights) p.weight_update = WeightUpdate::Frozen;
+        if (freeze_weights + update_mass + rebuild_weights > 1)
+          throw py::value_error(
+              "freeze_weights, update_mass and rebuild_weights exclude each other");
+        if (update_mass) p.weight_update = WeightUpdate::FrozenStiffness;
         if (rebuild_weights) p.weight_update = WeightUpdate::EveryIteration;
         if (fix_boundary) p.boundary = BoundaryCondition::Fixed;
         const std::string keep = choice("preserve", preserve, {"none", "volume", "area"});
@@ -246,8 +248,9 @@ void bindMeshes(py::module_& m) {
       py::arg("average") = py::none(), py::arg("mass") = "mixed", py::arg("lambda_dt") = py::none(),
       py::arg("lambda_") = py::none(), py::arg("mu") = -0.53, py::arg("iterations") = 1,
       py::arg("absolute_time") = false, py::arg("freeze_weights") = false,
-      py::arg("rebuild_weights") = false, py::arg("fix_boundary") = false,
-      py::arg("allow_unstable") = false, py::arg("preserve") = "none", py::arg("solver") = "auto",
+      py::arg("update_mass") = false, py::arg("rebuild_weights") = false,
+      py::arg("fix_boundary") = false, py::arg("allow_unstable") = false,
+      py::arg("preserve") = "none", py::arg("solver") = "auto",
       "smoothMeshPositions with pcl_ddg_smooth's options.");
 
   m.def(

@@ -54,6 +54,8 @@ CASES = {
     "NaN time step": ("pcl_ddg.smooth(V, F, lambda_dt=float('nan'))", "ValueError"),
     "both weight updates": ("pcl_ddg.smooth(V, F, freeze_weights=True, rebuild_weights=True)",
                             "ValueError"),
+    "two weight updates": ("pcl_ddg.smooth(V, F, update_mass=True, rebuild_weights=True)",
+                           "ValueError"),
     "unknown solver": ("pcl_ddg.smooth(V, F, solver='magic')", "ValueError"),
     "Taubin mu not below -lambda": ("pcl_ddg.smooth(V, F, method='taubin', mu=-0.1)",
                                     "ValueError"),

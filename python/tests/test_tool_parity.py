@@ -55,7 +55,7 @@ def test_smooth_field_equals_pcl_ddg_curvature_smooth(tmp_path):
 
 @pytest.mark.parametrize("arguments", [[], ["-method", "explicit", "-iterations", "20"],
                                        ["-lambda_dt", "5", "-preserve", "volume",
-                                        "-freeze_weights"],
+                                        "-iterations", "3", "-update_mass"],
                                        ["-method", "taubin", "-lambda", "0.4", "-mu", "-0.45",
                                         "-iterations", "10"],
                                        ["-method", "explicit", "-weights", "cotan",
@@ -75,8 +75,8 @@ def test_smooth_equals_pcl_ddg_smooth(tmp_path, arguments):
             keywords["lambda_dt"] = float(value)
         elif flag == "-preserve":
             keywords["preserve"] = value
-        elif flag == "-freeze_weights":
-            keywords["freeze_weights"] = True
+        elif flag == "-update_mass":
+            keywords["update_mass"] = True
         elif flag == "-lambda":
             keywords["lambda_"] = float(value)
         elif flag == "-mu":

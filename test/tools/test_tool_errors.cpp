@@ -186,6 +186,7 @@ TEST_F(ToolErrors, BadOptionsFailBeforeAnyFileIsRead) {
       {PCL_DDG_COMPARE_NEIGHBOURHOODS_TOOL, "missing.ply", "-k 16 -radius 1"},
       {PCL_DDG_SMOOTH_TOOL, "missing.ply", "-lambda_dt abc"},
       {PCL_DDG_SMOOTH_TOOL, "missing.ply", "-freeze_weights -rebuild_weights"},
+      {PCL_DDG_SMOOTH_TOOL, "missing.ply", "-update_mass -rebuild_weights"},
       {PCL_DDG_SMOOTH_ORGANIZED_TOOL, "missing.pcd", "-method explicit -lambda_dt 1"},
       {PCL_DDG_SMOOTH_ORGANIZED_TOOL, "missing.pcd", "-iterations 0"},
   };

@@ -451,9 +451,9 @@ TEST_F(ToolOptions, SmoothEqualsTheLibraryForEveryScheme) {
   };
   // The settings, each one change from the library's defaults (which are the tool's).
   const P implicit;
-  P explicit_scheme, explicit5, uniform, voronoi, barycentric, explicit_barycentric, three, frozen,
-      rebuilt, volume, area, fixed, umbrella, umbrella5, degree, taubin, taubin5, explicit_cotan,
-      explicit_cotan5;
+  P explicit_scheme, explicit5, uniform, voronoi, barycentric, explicit_barycentric, three,
+      mass_follows, rebuilt, volume, area, fixed, umbrella, umbrella5, degree, taubin, taubin5,
+      explicit_cotan, explicit_cotan5;
   explicit_cotan.scheme = explicit_cotan5.scheme = explicit_barycentric.scheme =
       SmoothingScheme::Explicit;
   explicit_cotan5.iterations = 5;
@@ -472,8 +472,8 @@ TEST_F(ToolOptions, SmoothEqualsTheLibraryForEveryScheme) {
   uniform.weights = LaplacianWeights::Uniform;
   voronoi.mass = MassType::Voronoi;
   barycentric.mass = explicit_barycentric.mass = MassType::Barycentric;
-  three.iterations = frozen.iterations = rebuilt.iterations = 3;
-  frozen.weight_update = WeightUpdate::Frozen;
+  three.iterations = mass_follows.iterations = rebuilt.iterations = 3;
+  mass_follows.weight_update = WeightUpdate::FrozenStiffness;
   rebuilt.weight_update = WeightUpdate::EveryIteration;
   volume.shrinkage = ShrinkageCorrection::PreserveVolume;
   area.shrinkage = ShrinkageCorrection::PreserveArea;
@@ -508,7 +508,8 @@ TEST_F(ToolOptions, SmoothEqualsTheLibraryForEveryScheme) {
       // 1e-5 in length^2 is about 0.02 h^2 on the cow; read in h^2 it would be 5e-9 length^2.
       {"-lambda_dt 1e-5 -absolute_time", on(cow, implicit, 1e-5, true), on(cow, implicit, 1e-5)},
       // One step sees only the input's operator: the weight updates differ from the second on.
-      {"-iterations 3 -freeze_weights", on(cow, frozen), cow_three},
+      {"-iterations 3 -update_mass", on(cow, mass_follows), cow_three},
+      {"-iterations 3 -freeze_weights", cow_three, on(cow, mass_follows)},  // names the default
       {"-iterations 3 -rebuild_weights", on(cow, rebuilt), cow_three},
       {"-preserve volume", on(cow, volume), cow_default},
       {"-preserve area", on(cow, area), cow_default},

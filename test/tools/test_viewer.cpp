@@ -238,7 +238,7 @@ TEST_F(Viewer, TaubinAndUmbrellaStepsAreTheLibrarys) {
   auto model = open(file);
   const MeshFile mesh = readMeshFile(file);
   const MeshTopology topology(mesh.mesh);
-  // The library's runs the viewer's steps stand for (frozen stiffness, the viewer's default).
+  // The library's runs the viewer's steps stand for (operator frozen, the viewer's default).
   const auto library = [&](SmoothingScheme scheme, int iterations) {
     MeshSmoothingParameters p;
     p.scheme = scheme;

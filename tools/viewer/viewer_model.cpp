@@ -105,7 +105,7 @@ ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingSt
     parameters.iterations = static_cast<int>(steps.size() - first);
     from = positionsAfter(std::vector<SmoothingStep>(steps.begin(), steps.begin() + first),
                           warnings, refused);
-    parameters.weight_update = WeightUpdate::FrozenStiffness;
+    parameters.weight_update = WeightUpdate::Frozen;
   } else {
     parameters.weight_update = WeightUpdate::EveryIteration;
   }
