@@ -6,6 +6,7 @@
 #include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/ring_surface_variation.h"
 #include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/render/mesh_render.h"
 #include "pcl_ddg/surface/mesh_normals.h"
 #include "pcl_ddg/tiling/out_of_core_fit.h"
@@ -15,8 +16,9 @@ namespace {
 constexpr const char* kName = "pcl_ddg_normals";
 constexpr const char* kDescription =
     "Estimates normals of a mesh or a point cloud: from the mesh faces (uniform, area, angle,\n"
-    "mean_curvature) or by fitting a plane (pca) or a quadric to each point's neighbours, found "
-    "on\n"
+    "mean_curvature) or by fitting a plane (pca), a quadric, or a robust plane (robust: its own\n"
+    "scale up to k, not across sharp edges; writes also scale and confidence) to each point's\n"
+    "neighbours, found on\n"
     "the mesh (rings), on an organized cloud's pixel grid (grid: never across a depth jump;\n"
     "pca there fits the smallest square window of k pixels from its running window sums) or in "
     "space\n"
@@ -26,13 +28,15 @@ constexpr const char* kDescription =
     "the vertex's 1-ring).";
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk,pcd,las} output.{ply,pcd,las}\n"
-    "         [-method uniform|area|angle|mean_curvature|pca|quadric (default: area on meshes, pca "
-    "on clouds)]\n"
+    "         [-method uniform|area|angle|mean_curvature|pca|quadric|robust (default: area on "
+    "meshes,\n"
+    "                  pca on clouds)]\n"
     "         [-epsilon e (mean_curvature: |M^-1 L x| below e counts as flat; default 0.02/h)]\n"
-    "         [-neighbours rings|grid|kdtree (pca, quadric; default rings on meshes, grid on "
+    "         [-neighbours rings|grid|kdtree (pca, quadric, robust; default rings on meshes, grid "
+    "on "
     "organized "
     "clouds)]\n"
-    "         [-k N (default 16, quadric 20)]\n"
+    "         [-k N (default 16, quadric 20, robust 192: the largest neighbourhood)]\n"
     "         [-max_depth_jump f (grid: a range change above f times the range per pixel cuts the "
     "grid;\n"
     "                  default 0.02)]\n"
@@ -40,7 +44,7 @@ constexpr const char* kSyntax =
     "         [-max_nn N (with -radius: at most the N nearest; default 64)]\n"
     "         [-min_nn N (with -radius: the N nearest where the ball holds fewer)]\n"
     "         [-viewpoint x,y,z (clouds: orient normals towards it; default the PCD's VIEWPOINT)]\n"
-    "         [-orient viewpoint|up|mst|mesh (pca, quadric: towards the viewpoint (clouds' "
+    "         [-orient viewpoint|up|mst|mesh (fits: towards the viewpoint (clouds' "
     "default),\n"
     "                  up (aerial and terrestrial LiDAR: n . up >= 0), along a minimum spanning\n"
     "                  tree of the 10 nearest on the mesh, the pixel grid or in space (merged\n"
@@ -107,17 +111,17 @@ int run(int argc, char** argv) {
        "memory", "max_depth_jump", "orient", "normal_map", "up", "min_nn", "classes"},
       {});
   const FieldPrecision precision = tools::precisionArgument(args);
-  const std::vector<std::string> methods = {"uniform",        "area", "angle",
-                                            "mean_curvature", "pca",  "quadric"};
+  const std::vector<std::string> methods = {"uniform", "area",    "angle", "mean_curvature",
+                                            "pca",     "quadric", "robust"};
   const std::string requested = args.has("method") ? args.choice("method", methods, "area") : "";
-  const bool fitted = requested == "pca" || requested == "quadric";
+  const bool fitted = requested == "pca" || requested == "quadric" || requested == "robust";
   const bool neighbour_options = args.has("neighbours") || args.has("k") || args.has("radius") ||
                                  args.has("max_depth_jump") || args.has("orient") ||
                                  args.has("up") || args.has("min_nn") || args.has("classes");
   if (!requested.empty() && !fitted && neighbour_options) {
     throw tools::UsageError(
         "-neighbours, -k, -radius, -min_nn, -max_depth_jump, -orient, -up and -classes apply to "
-        "pca and quadric");
+        "pca, quadric and robust");
   }
   if (args.has("epsilon") && requested != "mean_curvature") {
     throw tools::UsageError("-epsilon applies to -method mean_curvature only");
@@ -133,7 +137,7 @@ int run(int argc, char** argv) {
     throw tools::UsageError("-orient mst takes one reference: -viewpoint or -up");
   if (args.has("memory")) {
     // A cloud larger than memory: fitted tile by tile from the file (pcl_ddg/tiling).
-    if (!requested.empty() && !fitted)
+    if ((!requested.empty() && !fitted) || requested == "robust")
       throw tools::UsageError("-memory applies to pca and quadric on clouds");
     if (!orient.empty() && orient != "viewpoint" && orient != "up")
       throw tools::UsageError("-orient " + orient +
@@ -156,7 +160,7 @@ int run(int argc, char** argv) {
           throw tools::UsageError("-orient mesh needs a mesh; this input is a point cloud");
         const std::string method =
             !requested.empty() ? requested : (in.topology && !neighbour_options ? "area" : "pca");
-        if (method != "pca" && method != "quadric") {
+        if (method != "pca" && method != "quadric" && method != "robust") {
           if (!in.topology)
             throw tools::UsageError("-method " + method +
                                     " needs a mesh; this input is a point cloud");
@@ -189,8 +193,11 @@ int run(int argc, char** argv) {
                            ringSurfaceVariation(*in.topology, positions), precision);
           }
         } else {
-          LocalFitOptions options = tools::localFitArguments(
-              args, in, method == "pca" ? LocalFitMethod::PCA : LocalFitMethod::Quadric);
+          LocalFitOptions options =
+              tools::localFitArguments(args, in,
+                                       method == "pca"       ? LocalFitMethod::PCA
+                                       : method == "quadric" ? LocalFitMethod::Quadric
+                                                             : LocalFitMethod::Robust);
           options.orientation = orient == "viewpoint" ? NormalOrientation::Viewpoint
                                 : orient == "up"      ? NormalOrientation::Up
                                 : orient == "mst"     ? NormalOrientation::SpanningTree
@@ -214,6 +221,16 @@ int run(int argc, char** argv) {
           if (orient == "mst") reportSpanningTree(result.orientation);
           if (args.has("normal_map")) saveNormalMap(*args.value("normal_map"), result.normals);
           tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
+          if (!result.scales.empty()) {  // robust: the neighbours it used, and its confidence
+            const auto field = [](const std::vector<float>& values) {
+              return Eigen::Map<const Eigen::VectorXf>(values.data(),
+                                                       static_cast<Eigen::Index>(values.size()))
+                  .cast<double>()
+                  .eval();
+            };
+            setVertexField(in.mesh.cloud, "scale", field(result.scales), precision);
+            setVertexField(in.mesh.cloud, "confidence", field(result.confidences), precision);
+          }
         }
         tools::saveResult(kName, output, in.mesh, in.positions,
                           tools::coordinatePrecision(in.coordinate_precision, precision),

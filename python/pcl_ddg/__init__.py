@@ -44,6 +44,7 @@ __all__ = [
     "Curvatures",
     "Normals",
     "PrincipalCurvatures",
+    "RobustNormals",
     "OrientedNormals",
     "NeighbourhoodComparison",
     "MeshFile",
@@ -56,6 +57,7 @@ __all__ = [
     "smooth_field",
     "estimate_normals",
     "principal_curvatures",
+    "robust_normals",
     "grid_normals",
     "orient_normals",
     "compare_neighbourhoods",
@@ -359,11 +361,13 @@ def estimate_normals(
     max_depth_jump: Optional[float] = None,
     threads: int = 0,
 ) -> Normals:
-    """Normals by fitting a plane (``"pca"``) or a quadric (``"quadric"``) to each point's
-    neighbours (``pcl_ddg_normals -method pca|quadric``).
+    """Normals by fitting a plane (``"pca"``), a quadric (``"quadric"``) or a robust plane
+    (``"robust"``: its own scale up to k, not across sharp edges; :func:`robust_normals` also
+    returns the scale and confidence) to each point's neighbours (``pcl_ddg_normals -method``).
 
     points: (n, 3), or (h, w, 3) for an organized cloud (kept: the output has its grid).
-    k: neighbours (default 16, quadric 20; at least 3, at most the point count).
+    k: neighbours (default 16, quadric 20, robust 192 or all points if fewer: the largest
+        neighbourhood it may use; at least 3, at most the point count).
     radius: a radius search instead of k, keeping at most ``max_nn`` (default 64) nearest;
         ``min_nn``: the min_nn nearest where the ball holds fewer.
     neighbours: ``"kdtree"`` (clouds' default), ``"rings"`` (rings of the mesh ``faces``; the
@@ -378,7 +382,7 @@ def estimate_normals(
 
     PCL's point types are float: the points are rounded to float as the tools read them.
     """
-    normals, curvature, valid, _ = _pcl_ddg.estimate_normals(
+    normals, curvature, valid, _, _, _ = _pcl_ddg.estimate_normals(
         _array(points, "points"),
         method,
         k,
@@ -394,6 +398,48 @@ def estimate_normals(
         int(threads),
     )
     return Normals(normals, curvature, valid)
+
+
+class RobustNormals(NamedTuple):
+    """Normals of robust planes (NaN where ``valid`` is False), with the scale each used."""
+
+    normals: np.ndarray  #: (n, 3) unit
+    curvature: np.ndarray  #: surface variation of the fit
+    valid: np.ndarray  #: bool
+    scale: np.ndarray  #: neighbours the plane used (of at most k)
+    confidence: np.ndarray  #: mean weight of the k neighbours, in [0, 1]
+
+
+def robust_normals(
+    points: ArrayLike,
+    k: Optional[int] = None,
+    neighbours: Optional[str] = None,
+    faces: Optional[Faces] = None,
+    viewpoint: Vector3 = None,
+    orient: Optional[str] = None,
+    up: Vector3 = None,
+    threads: int = 0,
+) -> RobustNormals:
+    """Normals that choose their own scale and keep sharp edges (``pcl_ddg_normals -method
+    robust``; the method: ``docs/normals.md``). k: the largest neighbourhood (default 192, or
+    all points if fewer). Options as :func:`estimate_normals`.
+    """
+    normals, curvature, valid, _, scale, confidence = _pcl_ddg.estimate_normals(
+        _array(points, "points"),
+        "robust",
+        k,
+        None,
+        None,
+        None,
+        neighbours,
+        None if faces is None else _faces(faces),
+        _vector(viewpoint, "viewpoint"),
+        orient,
+        _vector(up, "up"),
+        None,
+        int(threads),
+    )
+    return RobustNormals(normals, curvature, valid, scale, confidence)
 
 
 class PrincipalCurvatures(NamedTuple):

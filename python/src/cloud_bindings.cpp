@@ -5,6 +5,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -13,6 +14,7 @@
 #include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
+#include "pcl_ddg/features/robust_normal_estimation.h"
 
 namespace pcl_ddg {
 namespace python {
@@ -134,9 +136,10 @@ struct FitArguments {
 LocalFitOptions fitOptions(const FitArguments& a, Cloud& cloud,
                            std::shared_ptr<const MeshTopology>& topology) {
   LocalFitOptions options;
-  options.method = choice("method", a.method, {"pca", "quadric"}) == "quadric"
-                       ? LocalFitMethod::Quadric
-                       : LocalFitMethod::PCA;
+  const std::string method = choice("method", a.method, {"pca", "quadric", "robust"});
+  options.method = method == "quadric"  ? LocalFitMethod::Quadric
+                   : method == "robust" ? LocalFitMethod::Robust
+                                        : LocalFitMethod::PCA;
   if (a.k && a.radius)
     throw py::value_error("k and radius exclude each other (use radius with max_nn for both)");
   if (a.max_nn && !a.radius) throw py::value_error("max_nn needs radius");
@@ -174,7 +177,11 @@ LocalFitOptions fitOptions(const FitArguments& a, Cloud& cloud,
                           : neighbours == "grid" ? NeighbourhoodKind::Grid
                                                  : NeighbourhoodKind::KdTree;
   if (a.max_depth_jump) options.max_depth_jump = *a.max_depth_jump;
-  options.k = a.k.value_or(options.method == LocalFitMethod::Quadric ? 20 : 16);
+  // As the tool: robust's default is its largest neighbourhood, capped by the points.
+  options.k = a.k.value_or(options.method == LocalFitMethod::Quadric ? 20
+                           : options.method == LocalFitMethod::Robust
+                               ? std::min<int>(kRobustNormalNeighbours, cloud.size())
+                               : 16);
   if (!a.radius && options.k > static_cast<int>(cloud.size())) {
     throw py::value_error("k " + std::to_string(options.k) + " is more than the " +
                           std::to_string(cloud.size()) + " points of the input");
@@ -232,7 +239,12 @@ void bindClouds(py::module_& m) {
       py::array_t<double> curvature(shapeOf(*cloud, 0));
       double* c = curvature.mutable_data();
       for (std::size_t i = 0; i < cloud->size(); ++i) c[i] = result.normals[i].curvature;
-      return py::make_tuple(normals, curvature, valid, fitCounts(result));
+      if (result.scales.empty())
+        return py::make_tuple(normals, curvature, valid, fitCounts(result), py::none(), py::none());
+      py::array_t<double> scale(shapeOf(*cloud, 0)), confidence(shapeOf(*cloud, 0));
+      std::copy(result.scales.begin(), result.scales.end(), scale.mutable_data());
+      std::copy(result.confidences.begin(), result.confidences.end(), confidence.mutable_data());
+      return py::make_tuple(normals, curvature, valid, fitCounts(result), scale, confidence);
     }
     py::array_t<double> k1(shapeOf(*cloud, 0)), k2(shapeOf(*cloud, 0));
     py::array_t<double> direction(shapeOf(*cloud, 3));
@@ -268,7 +280,8 @@ void bindClouds(py::module_& m) {
       py::arg("faces") = py::none(), py::arg("viewpoint") = py::none(),
       py::arg("orient") = py::none(), py::arg("up") = py::none(),
       py::arg("max_depth_jump") = py::none(), py::arg("threads") = 0,
-      "(normals, curvature, valid, counts) of fitLocalSurfaces, as pcl_ddg_normals.");
+      "(normals, curvature, valid, counts, scale, confidence) of fitLocalSurfaces, as "
+      "pcl_ddg_normals (scale and confidence: robust's, else None).");
 
   m.def(
       "principal_curvatures",

@@ -268,18 +268,19 @@ def test_bad_inputs(tmp_path, client, scene):
 def test_worker_peak_memory_stays_under_the_limit(tmp_path):
     """A synthetic survey (a height field in flight-line order) of 600k points: fitted at once
     it takes about 10x the room the limit leaves above a worker's own ~100M."""
-    side = 775
-    u, v = np.meshgrid(np.arange(side, dtype=float), np.arange(side, dtype=float))
-    z = 2.0 * np.sin(u / 40.0) * np.cos(v / 55.0)
-    points = np.stack([u.ravel(), v.ravel() + 0.25 * (u.ravel() % 2), z.ravel()], 1)
-    survey = tmp_path / "in" / "survey.ply"
-    survey.parent.mkdir()
-    pcl_ddg.write(survey, points.astype(np.float32))
     own = dd.connect(workers=2)
     try:
         resident = max(own.run(dd._resident_bytes).values())
-        limit = resident + (24 << 20) + (32 << 20)  # ~24M of tile room above the rounding
+        limit = resident + (24 << 20) + (32 << 20)  # 24-40M of tile room above the rounding
         room = limit - ((resident // (16 << 20) + 2) * (16 << 20))
+        # At least 9x the room, whatever the worker's own size rounds to (600k points or more).
+        side = max(775, int(np.ceil(np.sqrt(9 * room / dd.BYTES_PER_POINT))))
+        u, v = np.meshgrid(np.arange(side, dtype=float), np.arange(side, dtype=float))
+        z = 2.0 * np.sin(u / 40.0) * np.cos(v / 55.0)
+        points = np.stack([u.ravel(), v.ravel() + 0.25 * (u.ravel() % 2), z.ravel()], 1)
+        survey = tmp_path / "in" / "survey.ply"
+        survey.parent.mkdir()
+        pcl_ddg.write(survey, points.astype(np.float32))
         assert len(points) * dd.BYTES_PER_POINT >= 9 * room
         out = tmp_path / "out"
         summary = dd.estimate_normals([survey], out, client=own, memory_per_worker=int(limit),

@@ -88,6 +88,7 @@ def test_smooth_equals_pcl_ddg_smooth(tmp_path, arguments):
 
 
 @pytest.mark.parametrize("arguments", [["-method", "pca"], ["-method", "quadric"],
+                                       ["-method", "robust"],
                                        ["-method", "pca", "-radius", "0.01"],
                                        ["-method", "pca", "-orient", "mst"]])
 def test_cloud_normals_equal_pcl_ddg_normals(tmp_path, arguments):
@@ -105,6 +106,11 @@ def test_cloud_normals_equal_pcl_ddg_normals(tmp_path, arguments):
     r = pcl_ddg.estimate_normals(cloud.points, **keywords)
     np.testing.assert_array_equal(r.normals, stacked(out, ["normal_x", "normal_y", "normal_z"]))
     np.testing.assert_array_equal(r.curvature, fields(out, "curvature")[0])
+    if arguments[1] == "robust":
+        robust = pcl_ddg.robust_normals(cloud.points, viewpoint=cloud.viewpoint)
+        np.testing.assert_array_equal(robust.normals, r.normals)
+        np.testing.assert_array_equal(robust.scale, fields(out, "scale")[0])
+        np.testing.assert_array_equal(robust.confidence, fields(out, "confidence")[0])
 
 
 def test_mesh_ring_normals_equal_pcl_ddg_normals(tmp_path):

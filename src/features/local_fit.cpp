@@ -5,6 +5,7 @@
 #include "pcl_ddg/features/organized_normals.h"
 #include "pcl_ddg/features/pca_normal_estimation.h"
 #include "pcl_ddg/features/quadric_normal_estimation.h"
+#include "pcl_ddg/features/robust_normal_estimation.h"
 #include "pcl_ddg/search/kd_tree_search.h"
 #include "pcl_ddg/search/mesh_ring_search.h"
 #include "pcl_ddg/search/organized_grid_search.h"
@@ -116,6 +117,14 @@ LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
     estimator.compute(result.normals);
     result.failed_points = estimator.getFailedPoints();
     result.orientation = estimator.getOrientationReport();
+  } else if (options.method == LocalFitMethod::Robust) {
+    RobustNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+    configure(estimator, cloud, topology, options, indices);
+    estimator.compute(result.normals);
+    result.failed_points = estimator.getFailedPoints();
+    result.orientation = estimator.getOrientationReport();
+    result.scales = estimator.getScales();
+    result.confidences = estimator.getConfidences();
   } else {
     QuadricNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
     configure(estimator, cloud, topology, options, indices);

@@ -12,6 +12,7 @@
 
 #include "common/tool_output.h"
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/features/robust_normal_estimation.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -140,8 +141,12 @@ LocalFitOptions localFitArguments(const ToolArguments& args, ToolInput& input,
                           : neighbours == "grid" ? NeighbourhoodKind::Grid
                                                  : NeighbourhoodKind::KdTree;
   options.max_depth_jump = args.number("max_depth_jump", options.max_depth_jump);
-  options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20 : 16);
   const auto points = static_cast<int>(input.positions.cols());
+  // Robust's k is the largest neighbourhood it may use: by default all points of a small input.
+  options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20
+                                : method == LocalFitMethod::Robust
+                                    ? std::min(kRobustNormalNeighbours, points)
+                                    : 16);
   if (!args.has("radius") && options.k > points) {
     throw std::runtime_error("-k " + std::to_string(options.k) + " is more than the " +
                              std::to_string(points) + " points of the input");

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "pcl_ddg/features/consistent_orientation.h"
 #include "pcl_ddg/features/normal_orientation.h"
@@ -20,7 +21,7 @@
 
 namespace pcl_ddg {
 
-enum class LocalFitMethod { PCA, Quadric };
+enum class LocalFitMethod { PCA, Quadric, Robust };
 
 enum class NeighbourhoodKind {
   MeshRings,  ///< MeshRingSearch over the mesh's edges (needs a topology)
@@ -61,12 +62,15 @@ struct LocalFitResult {
   /** Quadric only: principal curvatures and directions (see QuadricNormalEstimation). */
   pcl::PointCloud<pcl::PrincipalCurvatures> curvatures;
   std::int64_t failed_points = 0;
-  std::int64_t fallback_points = 0;         ///< quadric: PCA normal used
+  std::int64_t fallback_points = 0;  ///< quadric: PCA normal used
+  /** Robust only: per point the neighbours used and the confidence (RobustNormalEstimation). */
+  std::vector<float> scales, confidences;
   ConsistentOrientationReport orientation;  ///< SpanningTree: what the propagation turned
 };
 
 /**
- * Runs PCANormalEstimation or QuadricNormalEstimation on cloud. PCA on the grid of a whole
+ * Runs PCANormalEstimation, QuadricNormalEstimation or RobustNormalEstimation on cloud. PCA on
+ * the grid of a whole
  * organized cloud takes the window-sum path (computeOrganizedPCANormals) over the smallest
  * square window of at least k pixels, and keeps the cloud's width x height. With a topology (one
  * vertex per point) normals are oriented like its faces, whichever neighbourhood is used, so that

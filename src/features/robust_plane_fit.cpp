@@ -1,0 +1,258 @@
+#include "pcl_ddg/features/robust_plane_fit.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <utility>
+#include <vector>
+
+#include "pcl_ddg/features/plane_fit.h"
+
+namespace pcl_ddg {
+
+namespace {
+
+constexpr int kSmallestScale = 16;     ///< nested scales 16, 24, 32, 48, 64, 96, ... and all
+constexpr int kAnchorNeighbours = 8;   ///< planes pass through the centroid of these
+constexpr int kSeedNeighbours = 6;     ///< planes through the query and two of these
+constexpr int kScoredNeighbours = 64;  ///< the least median of squares is over these nearest
+constexpr double kMadToSigma = 1.4826;
+constexpr double kBand = 3.0;           ///< inliers are within this many sigma-hat of the plane
+constexpr double kNoiseFloor = 1e-6;    ///< of the neighbourhood's radius
+constexpr double kScaleVariance = 2.0;  ///< a plane's residual variance over a quadric's
+constexpr double kThroughQuery = 0.5;   ///< a plane through the query must halve the median
+constexpr double kSmooth = 0.01;        ///< a quadric leaves less of a plane's residual variance
+constexpr int kMaxRefinements = 5;
+constexpr double kConverged = 1e-5;  ///< normal change (radians) that ends the refinement
+
+struct Plane {
+  Eigen::Vector3d normal;
+  Eigen::Vector3d centroid;
+};
+
+/** Median of |n . (x_i - c)| over the first count columns of x. */
+double medianResidual(const Eigen::Matrix3Xd& x, int count, const Plane& plane,
+                      std::vector<double>& residuals) {
+  residuals.resize(static_cast<std::size_t>(count));
+  const double offset = plane.normal.dot(plane.centroid);
+  for (int i = 0; i < count; ++i) residuals[i] = std::abs(plane.normal.dot(x.col(i)) - offset);
+  const auto middle = residuals.begin() + count / 2;
+  std::nth_element(residuals.begin(), middle, residuals.end());
+  return *middle;
+}
+
+/** Weighted sums of points: total weight, first and second moments (the six distinct ones). */
+struct Moments {
+  double weight = 0.0;
+  int count = 0;  ///< points with a nonzero weight
+  double x = 0.0, y = 0.0, z = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
+
+  void add(const Eigen::Vector3d& p, double w) {
+    weight += w;
+    ++count;
+    const double wx = w * p.x(), wy = w * p.y(), wz = w * p.z();
+    x += wx;
+    y += wy;
+    z += wz;
+    xx += wx * p.x();
+    xy += wx * p.y();
+    xz += wx * p.z();
+    yy += wy * p.y();
+    yz += wy * p.z();
+    zz += wz * p.z();
+  }
+  Eigen::Vector3d centroid() const { return Eigen::Vector3d(x, y, z) / weight; }
+  Eigen::Matrix3d covariance() const {
+    const Eigen::Vector3d c = centroid();
+    Eigen::Matrix3d products;
+    products << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    return products / weight - c * c.transpose();
+  }
+};
+
+/** Tukey's biweight of the residuals to plane of the first count columns of x, within band. */
+Moments weighted(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double band) {
+  Moments m;
+  const double offset = plane.normal.dot(plane.centroid);
+  for (int i = 0; i < count; ++i) {
+    const double u = (plane.normal.dot(x.col(i)) - offset) / band;
+    if (std::abs(u) < 1.0) m.add(x.col(i), 1.0);
+  }
+  return m;
+}
+
+/** The least-squares height-field quadric w = a u^2 + b uv + c v^2 + d u + e v + f over the
+ *  points added so far, in a fixed frame (u, v, w along t1, t2, n about origin, in units of
+ *  scale): its residual sum of squares at any prefix of the nearest-first neighbours. */
+class NestedQuadric {
+ public:
+  NestedQuadric(const Plane& frame, double scale)
+      : t1_(frame.normal.unitOrthogonal()),
+        t2_(frame.normal.cross(t1_)),
+        normal_(frame.normal),
+        origin_(frame.centroid),
+        scale_(scale) {}
+
+  void add(const Eigen::Vector3d& p) {
+    const Eigen::Vector3d d = (p - origin_) / scale_;
+    const double u = d.dot(t1_), v = d.dot(t2_), w = d.dot(normal_);
+    Row a;
+    a << u * u, u * v, v * v, u, v, 1.0;
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c <= r; ++c) normal_matrix_(r, c) += a[r] * a[c];
+    right_ += w * a;
+    squares_ += w * w;
+    ++count_;
+  }
+  /** Residual variance SSR / (m - 6) in length^2; NaN when the system is singular. */
+  double variance() const {
+    if (count_ <= 6) return std::numeric_limits<double>::quiet_NaN();
+    const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(
+        normal_matrix_.selfadjointView<Eigen::Lower>());
+    if (solver.info() != Eigen::Success || !solver.isPositive())
+      return std::numeric_limits<double>::quiet_NaN();
+    const double residual = std::max(squares_ - right_.dot(solver.solve(right_)), 0.0);
+    return residual / (count_ - 6) * scale_ * scale_;
+  }
+
+ private:
+  using Row = Eigen::Matrix<double, 6, 1>;
+  Eigen::Vector3d t1_, t2_, normal_, origin_;
+  double scale_;
+  Eigen::Matrix<double, 6, 6> normal_matrix_ = Eigen::Matrix<double, 6, 6>::Zero();
+  Row right_ = Row::Zero();
+  double squares_ = 0.0;
+  int count_ = 0;
+};
+
+}  // namespace
+
+RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
+  RobustPlaneFit result;
+  if (count < 3) return result;
+
+  // The neighbours nearest first (k-d tree searches give them so; ties keep their order).
+  std::vector<std::pair<double, int>> by_distance(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) by_distance[i] = {points.col(i).squaredNorm(), i};
+  const auto nearer = [](const auto& a, const auto& b) { return a.first < b.first; };
+  if (!std::is_sorted(by_distance.begin(), by_distance.end(), nearer))
+    std::stable_sort(by_distance.begin(), by_distance.end(), nearer);
+  Eigen::Matrix3Xd x(3, count);
+  for (int i = 0; i < count; ++i) x.col(i) = points.col(by_distance[i].second);
+  const double radius = std::sqrt(by_distance.back().first);
+  const double floor = kNoiseFloor * radius;
+
+  // 1. Nested least-squares planes, through the centroid of the nearest few (near the surface:
+  //    through its own centroid a large plane lies off a curved surface).
+  struct Scale {
+    int k;
+    Plane plane;
+    double l0;
+  };
+  std::vector<Scale> scales;
+  Moments nested;
+  Eigen::Vector3d anchor = Eigen::Vector3d::Zero();
+  int next = std::min(kSmallestScale, count);
+  for (int i = 0; i < count; ++i) {
+    nested.add(x.col(i), 1.0);
+    if (nested.count == std::min(kAnchorNeighbours, count)) anchor = nested.centroid();
+    if (nested.count != next && nested.count != count) continue;
+    if (nested.count == next) next = (next & (next - 1)) == 0 ? next * 3 / 2 : next * 4 / 3;
+    const Eigen::Matrix3d covariance = nested.covariance();
+    const PlaneNormal fit = fitPlaneNormal(covariance);
+    if (fit.valid)
+      scales.push_back(
+          {nested.count, {fit.normal, anchor}, fit.surface_variation * covariance.trace()});
+  }
+
+  // 2. The scale (after Mitra and Nguyen 2003): the largest at which a plane explains the
+  //    neighbours as well as a quadric does, up to kScaleVariance (an F-test of the nested
+  //    models): there the residual is noise, not curvature, and more neighbours only average it.
+  //    Clean curved data keeps the smallest scale, noisy data nearly flat at its size all.
+  int chosen = scales.empty() ? -1 : 0;
+  bool smooth = false;  // the smallest scale is a smooth surface: a quadric explains it
+  if (!scales.empty()) {
+    NestedQuadric quadric(scales.back().plane, radius);
+    std::size_t j = 0;
+    for (int i = 0; i < count && j < scales.size(); ++i) {
+      quadric.add(x.col(i));
+      if (i + 1 != scales[j].k) continue;
+      const int k = scales[j].k;
+      const double plane = scales[j].l0 * k / std::max(k - 3, 1);
+      const double curved = std::max(quadric.variance(), floor * floor);
+      if (j == 0) smooth = curved < kSmooth * plane;
+      if (plane <= kScaleVariance * curved) chosen = static_cast<int>(j);
+      ++j;
+    }
+  }
+  const int used = chosen < 0 ? count : scales[chosen].k;
+
+  // 3. Least median of squares over the nearest of that scale: the nested planes up to it, or
+  //    a plane through the query and two of its nearest neighbours that halves their median
+  //    (a point on a face of an edge spans its own face with them).
+  const int scored = std::min(used, kScoredNeighbours);
+  std::vector<double> residuals;
+  double best_median = std::numeric_limits<double>::infinity();
+  Plane plane;
+  for (int j = 0; j <= chosen; ++j) {
+    const double median = medianResidual(x, scored, scales[j].plane, residuals);
+    if (median < best_median) {
+      best_median = median;
+      plane = scales[j].plane;
+    }
+  }
+  const double nested_median = best_median;
+  // Not on smooth surfaces, where a plane through the point that cuts the surface (a secant)
+  // has a smaller median than the tangent plane.
+  // Nor where a plane explains the whole neighbourhood: there is no edge in it.
+  const bool edge = !smooth && chosen + 1 < static_cast<int>(scales.size());
+  const int seeds = edge ? std::min(count, kSeedNeighbours + 1) : 0;
+  for (int i = 0; i < seeds; ++i) {
+    for (int j = i + 1; j < seeds; ++j) {
+      const Eigen::Vector3d n = x.col(i).cross(x.col(j));
+      const double size = x.col(i).norm() * x.col(j).norm();
+      if (!(n.norm() > 1e-9 * size)) continue;  // the query itself, a duplicate, or collinear
+      const Plane through{n.normalized(), Eigen::Vector3d::Zero()};
+      const double median = medianResidual(x, scored, through, residuals);
+      if (median < best_median && median < kThroughQuery * nested_median) {
+        best_median = median;
+        plane = through;
+      }
+    }
+  }
+  if (!std::isfinite(best_median)) return result;
+
+  // 4. Noise scale and band, then Tukey's reweighted fit over the scale's neighbours.
+  result.noise = std::max(kMadToSigma * best_median, floor);
+  const double band = kBand * result.noise;
+  result.surface_variation = std::numeric_limits<double>::quiet_NaN();
+  for (int iteration = 0; iteration < kMaxRefinements; ++iteration) {
+    const Moments m = weighted(x, used, plane, band);
+    if (m.count < 3) break;
+    const PlaneNormal fit = fitPlaneNormal(m.covariance());
+    if (!fit.valid) break;
+    const Plane next_plane{fit.normal.dot(plane.normal) < 0.0 ? -fit.normal : fit.normal,
+                           m.centroid()};
+    const bool converged = (next_plane.normal - plane.normal).norm() < kConverged;
+    plane = next_plane;
+    result.surface_variation = fit.surface_variation;
+    if (converged) break;
+  }
+  if (std::isnan(result.surface_variation)) {  // no reweighted plane: the best hypothesis's
+    const Eigen::Matrix3Xd centred = x.leftCols(used).colwise() - plane.centroid;
+    result.surface_variation =
+        fitPlane(plane.centroid, centred * centred.transpose() / used).surface_variation;
+  }
+  const Moments final_weights = weighted(x, used, plane, band);
+  result.normal = plane.normal;
+  result.centroid = plane.centroid;
+  result.scale = final_weights.count;
+  result.confidence = final_weights.weight / count;
+  result.valid = result.normal.allFinite() && std::isfinite(result.surface_variation);
+  return result;
+}
+
+}  // namespace pcl_ddg
