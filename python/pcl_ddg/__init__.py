@@ -407,7 +407,7 @@ class RobustNormals(NamedTuple):
     curvature: np.ndarray  #: surface variation of the fit
     valid: np.ndarray  #: bool
     scale: np.ndarray  #: neighbours the plane used (of at most k)
-    confidence: np.ndarray  #: mean weight of the k neighbours, in [0, 1]
+    confidence: np.ndarray  #: scale / k, in [0, 1]: near 1 on a plane, about half at an edge
 
 
 def robust_normals(

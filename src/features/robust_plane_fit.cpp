@@ -44,42 +44,41 @@ double medianResidual(const Eigen::Matrix3Xd& x, int count, const Plane& plane,
   return *middle;
 }
 
-/** Weighted sums of points: total weight, first and second moments (the six distinct ones). */
+/** Sums of points: their number, first and second moments (the six distinct ones). */
 struct Moments {
-  double weight = 0.0;
-  int count = 0;  ///< points with a nonzero weight
+  int count = 0;
   double x = 0.0, y = 0.0, z = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
 
-  void add(const Eigen::Vector3d& p, double w) {
-    weight += w;
+  void add(const Eigen::Vector3d& p) {
     ++count;
-    const double wx = w * p.x(), wy = w * p.y(), wz = w * p.z();
-    x += wx;
-    y += wy;
-    z += wz;
-    xx += wx * p.x();
-    xy += wx * p.y();
-    xz += wx * p.z();
-    yy += wy * p.y();
-    yz += wy * p.z();
-    zz += wz * p.z();
+    x += p.x();
+    y += p.y();
+    z += p.z();
+    xx += p.x() * p.x();
+    xy += p.x() * p.y();
+    xz += p.x() * p.z();
+    yy += p.y() * p.y();
+    yz += p.y() * p.z();
+    zz += p.z() * p.z();
   }
-  Eigen::Vector3d centroid() const { return Eigen::Vector3d(x, y, z) / weight; }
+  Eigen::Vector3d centroid() const { return Eigen::Vector3d(x, y, z) / count; }
+  /** About the centroid, divided by the number of points (relative coordinates keep the
+   *  subtraction's cancellation small). */
   Eigen::Matrix3d covariance() const {
     const Eigen::Vector3d c = centroid();
     Eigen::Matrix3d products;
     products << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-    return products / weight - c * c.transpose();
+    return products / count - c * c.transpose();
   }
 };
 
-/** Tukey's biweight of the residuals to plane of the first count columns of x, within band. */
-Moments weighted(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double band) {
+/** Moments of those of the first count columns of x within band of plane. */
+Moments within(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double band) {
   Moments m;
   const double offset = plane.normal.dot(plane.centroid);
   for (int i = 0; i < count; ++i) {
     const double u = (plane.normal.dot(x.col(i)) - offset) / band;
-    if (std::abs(u) < 1.0) m.add(x.col(i), 1.0);
+    if (std::abs(u) < 1.0) m.add(x.col(i));
   }
   return m;
 }
@@ -157,7 +156,7 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   Eigen::Vector3d anchor = Eigen::Vector3d::Zero();
   int next = std::min(kSmallestScale, count);
   for (int i = 0; i < count; ++i) {
-    nested.add(x.col(i), 1.0);
+    nested.add(x.col(i));
     if (nested.count == std::min(kAnchorNeighbours, count)) anchor = nested.centroid();
     if (nested.count != next && nested.count != count) continue;
     if (nested.count == next) next = (next & (next - 1)) == 0 ? next * 3 / 2 : next * 4 / 3;
@@ -225,12 +224,13 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   }
   if (!std::isfinite(best_median)) return result;
 
-  // 4. Noise scale and band, then Tukey's reweighted fit over the scale's neighbours.
+  // 4. Noise scale and band, then the least-squares plane of the scale's neighbours within the
+  //    band, until it settles.
   result.noise = std::max(kMadToSigma * best_median, floor);
   const double band = kBand * result.noise;
   result.surface_variation = std::numeric_limits<double>::quiet_NaN();
   for (int iteration = 0; iteration < kMaxRefinements; ++iteration) {
-    const Moments m = weighted(x, used, plane, band);
+    const Moments m = within(x, used, plane, band);
     if (m.count < 3) break;
     const PlaneNormal fit = fitPlaneNormal(m.covariance());
     if (!fit.valid) break;
@@ -241,16 +241,16 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
     result.surface_variation = fit.surface_variation;
     if (converged) break;
   }
-  if (std::isnan(result.surface_variation)) {  // no reweighted plane: the best hypothesis's
-    const Eigen::Matrix3Xd centred = x.leftCols(used).colwise() - plane.centroid;
-    result.surface_variation =
-        fitPlane(plane.centroid, centred * centred.transpose() / used).surface_variation;
+  if (std::isnan(result.surface_variation)) {  // no refit: the chosen plane's own spread
+    Moments all;
+    for (int i = 0; i < used; ++i) all.add(x.col(i));
+    result.surface_variation = fitPlane(all.centroid(), all.covariance()).surface_variation;
   }
-  const Moments final_weights = weighted(x, used, plane, band);
+  const Moments inliers = within(x, used, plane, band);
   result.normal = plane.normal;
   result.centroid = plane.centroid;
-  result.scale = final_weights.count;
-  result.confidence = final_weights.weight / count;
+  result.scale = inliers.count;
+  result.confidence = static_cast<double>(inliers.count) / count;
   result.valid = result.normal.allFinite() && std::isfinite(result.surface_variation);
   return result;
 }

@@ -28,6 +28,8 @@
 
 #include "analytic_surfaces.h"
 #include "common/tool_input.h"
+#include "common/tool_output.h"
+#include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/surface/mesh_smoothing.h"
 #include "test_data.h"
@@ -569,6 +571,22 @@ TEST_F(Viewer, FiftyKeyPressesDuringAFitAreAllApplied) {
   EXPECT_EQ(window.frame().normals->cols(), model->capabilities().points);
 }
 
+TEST_F(Viewer, RobustNormalsAreTheLibrarys) {
+  auto model = open(sharedData("clouds/milk.pcd"));
+  ViewerWindow window(*model, 200, 200);
+  window.enqueue("method=robust");
+  window.enqueue("k=40");
+  ASSERT_TRUE(window.runUntilIdle(120.0));
+  EXPECT_TRUE(window.errors().empty());
+  LocalFitOptions options;
+  options.method = LocalFitMethod::Robust;
+  options.k = 40;
+  options.viewpoint = model->sensorPose().origin;
+  const LocalFitResult library =
+      fitLocalSurfaces(tools::toXYZ(model->inputPositions()), nullptr, options);
+  EXPECT_EQ(*window.frame().normals, tools::normalsOf(library.normals));
+}
+
 TEST(ViewerActions, NeighboursByTheirNamesAndTheFormerSpellings) {
   const viewer::InputCapabilities mesh{true, 100, {}};
   ViewerState state = viewer::initialState(mesh);
@@ -604,6 +622,8 @@ TEST(ViewerActions, RefuseWhatTheInputCannotDoAndClampK) {
   EXPECT_EQ(state.k, 99);
   viewer::applyAction(state, cloud, "method+");
   EXPECT_EQ(state.method, viewer::NormalMethod::Quadric);
+  viewer::applyAction(state, cloud, "method+");
+  EXPECT_EQ(state.method, viewer::NormalMethod::Robust);
   viewer::applyAction(state, cloud, "method+");  // mesh methods are skipped on a cloud
   EXPECT_EQ(state.method, viewer::NormalMethod::PCA);
   EXPECT_EQ(viewer::splitActions("k=3 # comment\n field=none"),
@@ -620,9 +640,10 @@ TEST(ViewerActions, EveryMethodIsListedAndACloudOffersOnlyTheFittedOnes) {
     }
     return methods;
   };
-  EXPECT_EQ(viewer::methodsOffered({false, 100, {}}).size(), 6u);
-  EXPECT_EQ(offered(false), (std::vector<NormalMethod>{NormalMethod::PCA, NormalMethod::Quadric}));
-  EXPECT_EQ(offered(true).size(), 6u);
+  EXPECT_EQ(viewer::methodsOffered({false, 100, {}}).size(), 7u);
+  EXPECT_EQ(offered(false), (std::vector<NormalMethod>{NormalMethod::PCA, NormalMethod::Quadric,
+                                                       NormalMethod::Robust}));
+  EXPECT_EQ(offered(true).size(), 7u);
 }
 
 TEST_F(Viewer, TheAngleFieldComparesWithTheChosenReference) {

@@ -186,9 +186,10 @@ std::shared_ptr<const Eigen::Matrix3Xd> ViewerModel::normalsOf(NormalMethod meth
     if (method == NormalMethod::MeanCurvature) fallback = result.fallback_vertices;
     normals = std::make_shared<const Eigen::Matrix3Xd>(std::move(result.normals));
   } else {
-    const LocalFitResult result =
-        fit(method == NormalMethod::PCA ? LocalFitMethod::PCA : LocalFitMethod::Quadric, state,
-            pointsOf(version, positions));
+    const LocalFitResult result = fit(method == NormalMethod::PCA       ? LocalFitMethod::PCA
+                                      : method == NormalMethod::Quadric ? LocalFitMethod::Quadric
+                                                                        : LocalFitMethod::Robust,
+                                      state, pointsOf(version, positions));
     invalid = result.failed_points;
     fallback = result.fallback_points;
     normals = std::make_shared<const Eigen::Matrix3Xd>(tools::normalsOf(result.normals));

@@ -12,7 +12,8 @@ namespace {
 const std::vector<std::pair<NormalMethod, const char*>> kMethods = {
     {NormalMethod::Uniform, "uniform"}, {NormalMethod::Area, "area"},
     {NormalMethod::Angle, "angle"},     {NormalMethod::MeanCurvature, "mean_curvature"},
-    {NormalMethod::PCA, "pca"},         {NormalMethod::Quadric, "quadric"}};
+    {NormalMethod::PCA, "pca"},         {NormalMethod::Quadric, "quadric"},
+    {NormalMethod::Robust, "robust"}};
 
 const std::vector<std::string> kComputedFields = {"none", "mean",  "gauss",  "k1",
                                                   "k2",   "angle", "compare"};
@@ -82,7 +83,8 @@ const char* methodName(NormalMethod method) {
 }
 
 bool isMeshMethod(NormalMethod method) {
-  return method != NormalMethod::PCA && method != NormalMethod::Quadric;
+  return method != NormalMethod::PCA && method != NormalMethod::Quadric &&
+         method != NormalMethod::Robust;
 }
 
 std::vector<std::pair<NormalMethod, bool>> methodsOffered(const InputCapabilities& input) {
@@ -248,7 +250,8 @@ struct KeyBinding {
 
 // PCLVisualizer keeps p w s j c f r q + - g u o l 1-9 h; these are free.
 const KeyBinding kKeys[] = {
-    {"m", "m", "method+", "next normal method (uniform area angle mean_curvature pca quadric)"},
+    {"m", "m", "method+",
+     "next normal method (uniform area angle mean_curvature pca quadric robust)"},
     {"bracketright", "]", "k+", "more neighbours (k)"},
     {"bracketleft", "[", "k-", "fewer neighbours (k)"},
     {"backslash", "\\", "k=default", "k back to 16"},

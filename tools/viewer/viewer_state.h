@@ -11,7 +11,7 @@
 namespace pcl_ddg {
 namespace viewer {
 
-enum class NormalMethod { Uniform, Area, Angle, MeanCurvature, PCA, Quadric };
+enum class NormalMethod { Uniform, Area, Angle, MeanCurvature, PCA, Quadric, Robust };
 enum class Neighbours { MeshRings, KdTree };
 
 enum class SmoothingMethod { Explicit, Implicit, Taubin };
@@ -69,7 +69,7 @@ ViewerState initialState(const InputCapabilities& input);
 
 /**
  * Applies one action. The vocabulary (the same for keys and -do):
- *   method=uniform|area|angle|mean_curvature|pca|quadric   method+ (the next one)
+ *   method=uniform|area|angle|mean_curvature|pca|quadric|robust   method+ (the next one)
  *   k=N  k+  k-  k=default          neighbours=bfs|knn  neighbours+ (toggle)
  *   field=none|rgb|mean|gauss|k1|k2|angle|compare|<property>  field+ (the next one; rgb: the
  *   file's own colours, offered when it has them)

@@ -1,33 +1,35 @@
 #pragma once
 /** \file
  * A plane fitted to one neighbourhood that chooses its own scale and does not average across a
- * sharp edge: the robust statistics of Fleishman et al. 2005 and Li et al. 2010 (least median
- * of squares, then a reweighted fit) on a plain k-nearest neighbourhood.
+ * sharp edge. The neighbourhood is the query point q and its k nearest neighbours x_i (relative
+ * to q, nearest first); k is the largest scale it may use.
  *
- * The neighbourhood is the query point q and its K nearest neighbours x_i (relative to q).
+ * 1. **Nested planes.** The least-squares planes of the 16, 24, 32, 48, 64, 96, ... nearest and of
+ *    all k (prefix sums of the moments), each through the centroid of the 8 nearest (near the
+ *    surface: a large plane through its own centroid lies off a curved surface), with its
+ *    residual variance \f$ \lambda_0 \f$ (smallest covariance eigenvalue).
+ * 2. **Scale** (in the spirit of Mitra and Nguyen 2003): the largest scale m at which the plane
+ *    explains the neighbours nearly as well as the height-field quadric
+ *    \f$ w = a u^2 + b uv + c v^2 + d u + e v + f \f$ does (an F-test of the nested models):
+ *    \f[ \lambda_0 \frac{m}{m - 3} \le 2\, \max\left(\frac{\mathrm{SSR}_{quadric}}{m - 6},
+ *        (10^{-6} r)^2\right), \f]
+ *    r the neighbourhood's radius. There the plane's residual is noise, not curvature or an edge,
+ *    and more neighbours only average the noise: clean curved data keeps the smallest scale,
+ *    noisy data nearly flat at that size all k.
+ * 3. **Least median of squares** (Rousseeuw 1984) over the nearest min(m, 64): the nested planes
+ *    up to m; where the neighbourhood is neither a smooth surface (the quadric leaves more than
+ *    1 % of the plane's residual variance at the smallest scale) nor a plane to the largest
+ *    scale, also the planes through q and two of its 6 nearest neighbours, which win if they
+ *    halve the median: a point on one face of an edge spans its own face with its nearest
+ *    neighbours there, which hold most of any ball about it.
+ * 4. **Trimmed refit.** \f$ \hat\sigma = 1.4826\, \mathrm{med}_i |r_i| \f$ (the standard
+ *    deviation for Gaussian residuals), floored at \f$ 10^{-6} r \f$; the least-squares plane of
+ *    the m nearest within \f$ 3 \hat\sigma \f$ of the plane, repeated (at most 5 times) until the
+ *    normal turns less than 1e-5 rad: the other face of an edge and outliers drop out.
  *
- * 1. **Hypotheses.** The least-squares planes (PCA) of the 8, 16, 32, ... nearest and of all K
- *    (nested scales: prefix sums of the neighbours sorted by distance), and the planes through q
- *    and two of its 8 nearest neighbours (a point on a face of an edge spans its own face with
- *    its nearest neighbours on that face).
- * 2. **Selection by least median of squares** (Rousseeuw 1984): the hypothesis (n, c) whose
- *    median residual \f$ \mathrm{med}_i |n \cdot (x_i - c)| \f$ over all K is smallest. A plane
- *    that explains at least half of the neighbourhood wins: the face the point lies on (it holds
- *    more than half of any ball about a point on it), not the average of two faces.
- * 3. **Noise scale** \f$ \hat\sigma = 1.4826\, \mathrm{med}_i |r_i| \f$ of that plane (the
- *    residual's standard deviation for Gaussian noise), with a floor of 1e-6 of the
- *    neighbourhood's radius for noise-free data.
- * 4. **Reweighted fit** (iteratively reweighted least squares): Tukey's biweight
- *    \f$ w_i = (1 - (r_i / b)^2)^2 \f$ for \f$ |r_i| < b = 4.685\,\hat\sigma \f$ (95 % efficiency
- *    under Gaussian noise), else 0; the weighted centroid and covariance give the next plane;
- *    until the normal stops turning. The band b chooses the scale: neighbours farther from the
- *    plane than the noise explains (the other face, a curved surface's far points) get no
- *    weight, so on noisy data all K count and on clean curved data only those within the
- *    curvature's own deviation.
- *
- * Per point it reports the scale used (neighbours with a weight) and a confidence: the mean
- * weight over the K neighbours (near 0.9 for Gaussian noise on a plane, about half at an edge,
- * low where no plane explains the neighbourhood).
+ * Per point it reports the scale used (the neighbours in the final fit) and a confidence, that
+ * number over k: near 1 on a plane, about half at an edge, low where no plane explains the
+ * neighbourhood. Deterministic: the same neighbours give the same bits on any thread.
  */
 #include <Eigen/Core>
 
@@ -36,10 +38,10 @@ namespace pcl_ddg {
 struct RobustPlaneFit {
   bool valid = false;              ///< 3 neighbours not on one line
   Eigen::Vector3d normal;          ///< unit (sign arbitrary)
-  Eigen::Vector3d centroid;        ///< weighted, in the coordinates of the points
-  double surface_variation = 0.0;  ///< l0 / (l0 + l1 + l2) of the weighted covariance
-  int scale = 0;                   ///< neighbours with a nonzero weight
-  double confidence = 0.0;         ///< sum of the weights / neighbours, in [0, 1]
+  Eigen::Vector3d centroid;        ///< of the final fit, in the coordinates of the points
+  double surface_variation = 0.0;  ///< l0 / (l0 + l1 + l2) of the final fit's covariance
+  int scale = 0;                   ///< neighbours in the final fit
+  double confidence = 0.0;         ///< scale / neighbours, in [0, 1]
   double noise = 0.0;              ///< sigma-hat, the robust residual scale (length)
 };
 
