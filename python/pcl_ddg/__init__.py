@@ -407,7 +407,7 @@ class RobustNormals(NamedTuple):
     curvature: np.ndarray  #: surface variation of the fit
     valid: np.ndarray  #: bool
     scale: np.ndarray  #: neighbours the plane used (of at most k)
-    confidence: np.ndarray  #: scale / k, in [0, 1]: near 1 on a plane, about half at an edge
+    confidence: np.ndarray  #: scale / k: near 1 where one plane explains all k, small at edges
 
 
 def robust_normals(
@@ -421,8 +421,8 @@ def robust_normals(
     threads: int = 0,
 ) -> RobustNormals:
     """Normals that choose their own scale and keep sharp edges (``pcl_ddg_normals -method
-    robust``; the method: ``docs/normals.md``). k: the largest neighbourhood (default 192, or
-    all points if fewer). Options as :func:`estimate_normals`.
+    robust``; the method: ``docs/library.md``, fitted normals). k: the largest neighbourhood
+    (default 192, or all points if fewer). Options as :func:`estimate_normals`.
     """
     normals, curvature, valid, _, scale, confidence = _pcl_ddg.estimate_normals(
         _array(points, "points"),

@@ -181,10 +181,12 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
       if (i + 1 != scales[j].k) continue;
       const int k = scales[j].k;
       const double plane = scales[j].l0 * k / std::max(k - 3, 1);
-      const double curved = std::max(quadric.variance(), floor * floor);
-      if (j == 0) smooth = curved < kSmooth * plane;
-      if (plane <= kScaleVariance * curved) chosen = static_cast<int>(j);
+      const double fitted = quadric.variance();
       ++j;
+      if (std::isnan(fitted)) continue;  // no quadric: neither smooth nor explained by the plane
+      const double curved = std::max(fitted, floor * floor);
+      if (j == 1) smooth = curved < kSmooth * plane;
+      if (plane <= kScaleVariance * curved) chosen = static_cast<int>(j - 1);
     }
   }
   const int used = chosen < 0 ? count : scales[chosen].k;

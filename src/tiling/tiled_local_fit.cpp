@@ -149,6 +149,8 @@ LocalFitResult fitLocalSurfacesTiled(const pcl::PointCloud<pcl::PointXYZ>::Const
                                      const LocalFitOptions& options, const TilingOptions& tiling,
                                      TilingReport* report) {
   if (!cloud || cloud->empty()) throw pcl::BadArgumentException("the cloud is empty");
+  if (options.method == LocalFitMethod::Robust)  // its scales and confidences have no tile path
+    throw pcl::BadArgumentException("tiled fits are PCA or quadric; robust needs the whole cloud");
   const std::size_t n = cloud->size();
   Eigen::AlignedBox3d bounds;
   for (const auto& p : *cloud)

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <pcl/search/kdtree.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -229,7 +230,8 @@ TEST(RobustNormals, OneAndTwoThreadsGiveTheSameBits) {
 }
 
 TEST(RobustNormals, PointsWithoutAPlaneAreNaNAndCountedTheOthersAreFinite) {
-  // A line of 50 points (no plane), then a 10 x 10 plate: k = 60 reaches both.
+  // A line of 50 points (no plane) far from a 10 x 10 plate: the 40 nearest of a line point are
+  // on the line.
   Eigen::Matrix3Xd points(3, 150);
   for (int i = 0; i < 50; ++i) points.col(i) = Eigen::Vector3d(100.0 + i, 0.0, 0.0);
   for (int i = 0; i < 100; ++i) points.col(50 + i) = Eigen::Vector3d(i % 10, i / 10, 0.0);
@@ -243,9 +245,57 @@ TEST(RobustNormals, PointsWithoutAPlaneAreNaNAndCountedTheOthersAreFinite) {
   }
 }
 
-TEST(RobustNormals, TheDefaultNeighbourhoodNeedsNoSetKSearch) {
+TEST(RobustNormals, WithoutKTheNeighbourhoodIsTheDefaultAndARadiusSearchWorksToo) {
+  std::mt19937 rng(8);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  Sampling sampling;
+  sampling.resolution = 60;
+  SurfaceSample s = makePlane(sampling);
+  for (Eigen::Index i = 0; i < s.points.cols(); ++i) s.points(2, i) += noise(rng);
   Robust estimator;
+  estimator.setInputCloud(toCloud(s.points));
+  estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  Normals normals;
+  estimator.compute(normals);  // no setKSearch: the default
   EXPECT_EQ(estimator.getKSearch(), kRobustNormalNeighbours);
+  EXPECT_EQ(estimator.getFailedPoints(), 0);
+  const auto largest =
+      *std::max_element(estimator.getScales().begin(), estimator.getScales().end());
+  EXPECT_EQ(largest, kRobustNormalNeighbours);
+
+  Robust by_radius;
+  by_radius.setInputCloud(toCloud(s.points));
+  by_radius.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  by_radius.setRadiusSearch(0.15);  // about 60 of the plate's points (h = 1/30)
+  by_radius.compute(normals);
+  EXPECT_EQ(by_radius.getFailedPoints(), 0);
+  const AngleErrors errors = angleErrors(normalsOf(normals), s.normals, SignMode::Unsigned);
+  EXPECT_EQ(errors.invalid, 0);
+  EXPECT_LT(errors.mean, 2.0);
+}
+
+TEST(RobustPlaneFit, SmallAndDegenerateNeighbourhoodsAreFiniteOrInvalidNeverNaN) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int count = 3; count <= 20; ++count) {
+    Eigen::Matrix3Xd points(3, count);
+    for (int i = 0; i < count; ++i) points.col(i) = Eigen::Vector3d(u(rng), u(rng), 0.01 * u(rng));
+    points.col(0).setZero();
+    const RobustPlaneFit fit = fitRobustPlane(points, count);
+    ASSERT_TRUE(fit.valid) << count;
+    EXPECT_TRUE(fit.normal.allFinite() && std::isfinite(fit.surface_variation)) << count;
+    EXPECT_GT(std::abs(fit.normal.z()), 0.9) << count;
+    EXPECT_GE(fit.scale, 3);
+    EXPECT_LE(fit.confidence, 1.0);
+  }
+  const Eigen::Matrix3Xd same = Eigen::Matrix3Xd::Constant(3, 30, 2.0);  // all coincident
+  EXPECT_FALSE(fitRobustPlane(same, 30).valid);
+  Eigen::Matrix3Xd doubled(3, 40);  // every point twice
+  for (int i = 0; i < 20; ++i)
+    doubled.col(2 * i) = doubled.col(2 * i + 1) = Eigen::Vector3d(u(rng), u(rng), 0.0);
+  const RobustPlaneFit fit = fitRobustPlane(doubled, 40);
+  ASSERT_TRUE(fit.valid);
+  EXPECT_LT(degreesBetween(fit.normal, Eigen::Vector3d::UnitZ()), 1e-9);
 }
 
 }  // namespace

@@ -423,7 +423,7 @@ TEST(MeshSmoothing, NothingFreeToSolveForLeavesTheInputUnchanged) {
   }
 }
 
-TEST(MeshSmoothing, TheDefaultFrozenOperatorMakesTheFewestSlivers) {
+TEST(MeshSmoothing, TheDefaultFrozenOperatorMakesFewerSliversOnTheCoarseCow) {
   // Three implicit cotangent steps of 2 h^2 keeping the volume. Rebuilding the cotangent weights
   // every step (mean-curvature flow) pinches triangles into slivers (a corner under 1 deg); letting
   // the mass follow the surface (conformalized flow, Kazhdan et al. 2012) pinches the coarse cow's

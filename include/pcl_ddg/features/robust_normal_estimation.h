@@ -8,13 +8,14 @@
  *   pcl_ddg::RobustNormalEstimation<pcl::PointXYZ, pcl::Normal> robust;
  *   robust.setInputCloud(cloud);
  *   robust.setSearchMethod(search);   // pcl::search::KdTree or pcl_ddg::MeshRingSearch
- *   robust.compute(normals);          // k = kRobustNormalNeighbours unless setKSearch
- *   robust.getScales();               // per output point: neighbours used
+ *   robust.compute(normals);          // k = kRobustNormalNeighbours, or setKSearch /
+ * setRadiusSearch robust.getScales();               // per output point: neighbours used
  *
  * Output: normal_x/y/z (unit, oriented as the other estimators: local_fit_estimation.h) and
  * curvature = the surface variation of the final fit. getScales() and getConfidences() hold, per
- * output point, the neighbours the plane used and their share of the k (robust_plane_fit.h);
- * NaN where the point failed (fewer than 3 finite neighbours, or all on one line).
+ * output point, the neighbours the plane used and their share of the neighbours found
+ * (robust_plane_fit.h); NaN where the point failed (fewer than 3 finite neighbours, or all on
+ * one line).
  */
 #include <vector>
 
@@ -37,15 +38,19 @@ class RobustNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
   explicit RobustNormalEstimation(unsigned int nr_threads = 0) {
     this->feature_name_ = "RobustNormalEstimation";
     this->setNumberOfThreads(nr_threads);
-    this->setKSearch(kRobustNormalNeighbours);
   }
 
   /** Per output point of the last compute(): the neighbours in the final fit. */
   const std::vector<float>& getScales() const { return scales_; }
-  /** Per output point of the last compute(): that number over k, in [0, 1]. */
+  /** Per output point of the last compute(): that number over the neighbours found, in [0, 1]. */
   const std::vector<float>& getConfidences() const { return confidences_; }
 
  protected:
+  /** Neither setKSearch nor setRadiusSearch: k = kRobustNormalNeighbours. */
+  bool initCompute() override {
+    if (this->k_ == 0 && this->search_radius_ == 0.0) this->k_ = kRobustNormalNeighbours;
+    return LocalFitEstimation<PointInT, PointOutT>::initCompute();
+  }
   void computeFeature(PointCloudOut& output) override;
   void setInvalid(PointOutT& point) const override;
 

@@ -17,19 +17,22 @@
  *    and more neighbours only average the noise: clean curved data keeps the smallest scale,
  *    noisy data nearly flat at that size all k.
  * 3. **Least median of squares** (Rousseeuw 1984) over the nearest min(m, 64): the nested planes
- *    up to m; where the neighbourhood is neither a smooth surface (the quadric leaves more than
- *    1 % of the plane's residual variance at the smallest scale) nor a plane to the largest
+ *    up to m; and, where the neighbourhood is neither smooth (at the smallest scale the quadric
+ *    leaves less than 1 % of the plane's residual variance) nor one plane up to the largest
  *    scale, also the planes through q and two of its 6 nearest neighbours, which win if they
  *    halve the median: a point on one face of an edge spans its own face with its nearest
- *    neighbours there, which hold most of any ball about it.
+ *    neighbours there, which hold most of any ball about it. (Where no quadric can be fitted,
+ *    the plane counts as not explained.)
  * 4. **Trimmed refit.** \f$ \hat\sigma = 1.4826\, \mathrm{med}_i |r_i| \f$ (the standard
  *    deviation for Gaussian residuals), floored at \f$ 10^{-6} r \f$; the least-squares plane of
  *    the m nearest within \f$ 3 \hat\sigma \f$ of the plane, repeated (at most 5 times) until the
  *    normal turns less than 1e-5 rad: the other face of an edge and outliers drop out.
  *
- * Per point it reports the scale used (the neighbours in the final fit) and a confidence, that
- * number over k: near 1 on a plane, about half at an edge, low where no plane explains the
- * neighbourhood. Deterministic: the same neighbours give the same bits on any thread.
+ * Per point it reports the scale used (the neighbours in the final fit) and a confidence: that
+ * number over the neighbours found (k). It is near 1 where one plane explains the whole
+ * neighbourhood (flat parts, or noise that hides the curvature) and small where the fit had to
+ * stay local: clean curved parts (about 16 / k), edges and corners. Deterministic: the same
+ * neighbours give the same bits on any thread.
  */
 #include <Eigen/Core>
 
@@ -41,7 +44,7 @@ struct RobustPlaneFit {
   Eigen::Vector3d centroid;        ///< of the final fit, in the coordinates of the points
   double surface_variation = 0.0;  ///< l0 / (l0 + l1 + l2) of the final fit's covariance
   int scale = 0;                   ///< neighbours in the final fit
-  double confidence = 0.0;         ///< scale / neighbours, in [0, 1]
+  double confidence = 0.0;         ///< scale / neighbours found, in [0, 1]
   double noise = 0.0;              ///< sigma-hat, the robust residual scale (length)
 };
 

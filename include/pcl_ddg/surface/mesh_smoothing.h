@@ -21,11 +21,11 @@
  * total weight D = -diag(L), so D^-1 L x is the weighted mean of the neighbours minus x, with
  * uniform weights the umbrella operator, and tau is dimensionless: explicit steps are stable up to
  * tau = 1 whatever the triangles' areas (a scan's tiny vertex areas put the Area bound at 1e-3 h^2
- * and below). By default L is frozen at the input and M follows the current positions (Kazhdan et
- * al. 2012, "Can mean-curvature flow be modified to be non-singular?"; libigl's smoothing
- * tutorial): rebuilding cotangent weights every iteration is the singular mean-curvature flow,
- * which pinches triangles into slivers within a few large steps. Both can also be rebuilt every
- * iteration or both frozen at the input. With Cholesky the system's pattern is analysed once and
+ * and below). By default L and M are frozen at the input (WeightUpdate below): rebuilding cotangent
+ * weights every iteration is the singular mean-curvature flow, which pinches triangles into slivers
+ * within a few large steps; M alone can follow the positions (Kazhdan et al. 2012, "Can
+ * mean-curvature flow be modified to be non-singular?"; libigl's smoothing tutorial). With
+ * Cholesky the system's pattern is analysed once; frozen, it is factorised once, otherwise
  * refactorised per iteration. The report gives the triangles' angle quality before and after
  * (slivers: a corner under 1 deg).
  *
