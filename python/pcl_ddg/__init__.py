@@ -366,8 +366,8 @@ def estimate_normals(
     returns the scale and confidence) to each point's neighbours (``pcl_ddg_normals -method``).
 
     points: (n, 3), or (h, w, 3) for an organized cloud (kept: the output has its grid).
-    k: neighbours (default 16, quadric 20, robust 192 or all points if fewer: the largest
-        neighbourhood it may use; at least 3, at most the point count).
+    k: neighbours (default 16, quadric 20, robust 128 or all points if fewer: the
+        neighbourhood searched, beyond which robust widens only on noisy data; at least 3, at most the point count).
     radius: a radius search instead of k, keeping at most ``max_nn`` (default 64) nearest;
         ``min_nn``: the min_nn nearest where the ball holds fewer.
     neighbours: ``"kdtree"`` (clouds' default), ``"rings"`` (rings of the mesh ``faces``; the
@@ -422,7 +422,7 @@ def robust_normals(
 ) -> RobustNormals:
     """Normals that choose their own scale and keep sharp edges (``pcl_ddg_normals -method
     robust``; the method: ``docs/library.md``, fitted normals). k: the largest neighbourhood
-    (default 192, or all points if fewer). Options as :func:`estimate_normals`.
+    (default 128, or all points if fewer). Options as :func:`estimate_normals`.
     """
     normals, curvature, valid, _, scale, confidence = _pcl_ddg.estimate_normals(
         _array(points, "points"),

@@ -167,6 +167,9 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   /** Sets every field of a point that cannot be estimated to NaN. */
   virtual void setInvalid(PointOutT& point) const = 0;
 
+  /** threads_, with 0 meaning every core. */
+  int threadCount() const;
+
   unsigned int max_neighbours_ = 0;
   unsigned int min_neighbours_ = 0;
   std::int64_t fallback_points_ = 0;  ///< counted by fitEachNeighbourhood (FitOutcome::FellBack)
@@ -179,9 +182,6 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   unsigned int threads_ = 0;
 
  private:
-  /** threads_, with 0 meaning every core. */
-  int threadCount() const;
-
   /** The input's sensor origin into vpx_, vpy_, vpz_; the origin without an input. */
   void copySensorOrigin() {
     const Eigen::Vector4f origin =

@@ -2,20 +2,23 @@
 /** \file
  * Normals that choose their own scale and keep sharp edges: a robust plane (robust_plane_fit.h:
  * the scale by an F-test of plane against quadric, least median of squares over nested-scale and
- * through-the-point planes, a trimmed refit) over each point's k nearest neighbours, k the
- * largest neighbourhood it may use.
+ * through-the-point planes, a trimmed refit) over each point's k nearest neighbours; then, with
+ * a k-nearest search (not a radius), where that plane's neighbourhood is noise, a wider plane
+ * summed along the 32-nearest-neighbour graph (widening_planes.h) while its residual stays noise.
  *
  *   pcl_ddg::RobustNormalEstimation<pcl::PointXYZ, pcl::Normal> robust;
  *   robust.setInputCloud(cloud);
- *   robust.setSearchMethod(search);   // pcl::search::KdTree or pcl_ddg::MeshRingSearch
- *   robust.compute(normals);          // k = kRobustNormalNeighbours, or setKSearch /
- * setRadiusSearch robust.getScales();               // per output point: neighbours used
+ *   robust.setSearchMethod(search);  // pcl::search::KdTree or pcl_ddg::MeshRingSearch
+ *   robust.compute(normals);         // k = kRobustNormalNeighbours unless setKSearch/-Radius
+ *   robust.getScales();              // per output point: neighbours used
  *
  * Output: normal_x/y/z (unit, oriented as the other estimators: local_fit_estimation.h) and
- * curvature = the surface variation of the final fit. getScales() and getConfidences() hold, per
- * output point, the neighbours the plane used and their share of the neighbours found
- * (robust_plane_fit.h); NaN where the point failed (fewer than 3 finite neighbours, or all on
- * one line).
+ * curvature = the surface variation of the robust plane. getScales() and getConfidences() hold,
+ * per output point, the neighbours the plane used and their share of the neighbours found
+ * (robust_plane_fit.h); for a wider plane of level l, about the points it reaches,
+ * 32 (l + 1)^2, and 1. NaN where the point failed (fewer than 3 finite neighbours, or all on one
+ * line). The wider planes are formed over the whole search surface (every point of it is a node
+ * of the graph), also when only some indices are estimated.
  */
 #include <vector>
 
@@ -23,9 +26,16 @@
 
 namespace pcl_ddg {
 
-/** The largest neighbourhood by default (bench/bench_normal_accuracy.py: about 3.4x the time of
- *  a k = 112 plane fit, most of it the search for the neighbours). */
-constexpr int kRobustNormalNeighbours = 192;
+/** The neighbourhood searched by default; wider planes reach beyond it where the data are noisy
+ *  (bench/bench_normal_accuracy.py: docs/benchmarks.md has the time against a k = 112 plane
+ *  fit). */
+constexpr int kRobustNormalNeighbours = 128;
+/** The nearest-neighbour graph along which wider planes are summed (widening_planes.h). */
+constexpr int kWideGraphWidth = 32;
+/** A wider plane replaces the robust one while its residual variance is at most this many times
+ *  the robust fit's noise variance: what it adds (curvature, another face) stays below the noise.
+ */
+constexpr double kWideResidual = 2.0;
 
 template <typename PointInT, typename PointOutT>
 class RobustNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
@@ -55,6 +65,13 @@ class RobustNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
   void setInvalid(PointOutT& point) const override;
 
  private:
+  /** Orients normal (for query point index at position) into out's normal fields. */
+  void write(PointOutT& out, Eigen::Vector3d normal, pcl::index_t index,
+             const Eigen::Vector3d& position) const;
+  /** Where the robust plane explained most of its neighbourhood and a plane wider than it keeps
+   *  explaining the points as noise (widening_planes.h), that plane's normal instead. */
+  void widen(PointCloudOut& output, const std::vector<double>& largest_reference);
+
   std::vector<float> scales_, confidences_;
 };
 

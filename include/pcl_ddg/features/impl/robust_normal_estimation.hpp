@@ -1,8 +1,12 @@
 #pragma once
+#include <pcl/common/point_tests.h>
+
+#include <algorithm>
 #include <limits>
 
 #include "pcl_ddg/features/robust_normal_estimation.h"
 #include "pcl_ddg/features/robust_plane_fit.h"
+#include "pcl_ddg/features/widening_planes.h"
 
 namespace pcl_ddg {
 
@@ -12,24 +16,103 @@ void RobustNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& 
   constexpr float nan = std::numeric_limits<float>::quiet_NaN();
   scales_.assign(output.size(), nan);
   confidences_.assign(output.size(), nan);
+  std::vector<double> largest_reference(output.size(), -1.0);  // none: no wider plane
   this->fitEachNeighbourhood(
-      output, [this, &output](const Eigen::Matrix3Xd& neighbours, int count, pcl::index_t index,
-                              const Eigen::Vector3d& position, std::size_t i) {
+      output, [this, &output, &largest_reference](const Eigen::Matrix3Xd& neighbours, int count,
+                                                  pcl::index_t index,
+                                                  const Eigen::Vector3d& position, std::size_t i) {
         if (!position.allFinite()) return Outcome::Failed;
         const RobustPlaneFit plane = fitRobustPlane(neighbours, count);
         if (!plane.valid) return Outcome::Failed;
-        Eigen::Vector3d normal = plane.normal;
-        this->orient(normal, index, position);
-        PointOutT& out = output[i];
-        out.normal_x = static_cast<float>(normal.x());
-        out.normal_y = static_cast<float>(normal.y());
-        out.normal_z = static_cast<float>(normal.z());
-        out.curvature = static_cast<float>(plane.surface_variation);
+        write(output[i], plane.normal, index, position);
+        output[i].curvature = static_cast<float>(plane.surface_variation);
         scales_[i] = static_cast<float>(plane.scale);
         confidences_[i] = static_cast<float>(plane.confidence);
+        largest_reference[i] = kWideResidual * plane.noise * plane.noise;
         return Outcome::Fitted;
       });
+  if (this->k_ > 0 && this->search_radius_ == 0.0) widen(output, largest_reference);
   this->makeOrientationConsistent(output, [](std::size_t) {});
+}
+
+template <typename PointInT, typename PointOutT>
+void RobustNormalEstimation<PointInT, PointOutT>::write(PointOutT& out, Eigen::Vector3d normal,
+                                                        pcl::index_t index,
+                                                        const Eigen::Vector3d& position) const {
+  this->orient(normal, index, position);
+  out.normal_x = static_cast<float>(normal.x());
+  out.normal_y = static_cast<float>(normal.y());
+  out.normal_z = static_cast<float>(normal.z());
+}
+
+template <typename PointInT, typename PointOutT>
+void RobustNormalEstimation<PointInT, PointOutT>::widen(
+    PointCloudOut& output, const std::vector<double>& largest_reference) {
+  const pcl::PointCloud<PointInT>& surface = *this->surface_;
+  const pcl::PointCloud<PointInT>& input = *this->input_;
+  const pcl::Indices& indices = *this->indices_;
+  pcl::search::Search<PointInT>& tree = *this->tree_;
+  const int threads = this->threadCount();
+  // Coordinates relative to one point of the cloud, in double.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  for (const PointInT& p : surface)
+    if (pcl::isXYZFinite(p)) {
+      origin = p.getVector3fMap().template cast<double>();
+      break;
+    }
+  const auto relative = [&origin](const PointInT& p) -> Eigen::Vector3d {
+    return p.getVector3fMap().template cast<double>() - origin;
+  };
+  // Row i: the finite ones of the graph width nearest of point i (of cloud), -1 padded.
+  const auto graphOf = [&](const pcl::PointCloud<PointInT>& cloud, const pcl::Indices* rows,
+                           std::size_t size) {
+    NeighbourGraph graph;
+    graph.width = kWideGraphWidth;
+    graph.neighbours.assign(size * kWideGraphWidth, -1);
+#pragma omp parallel num_threads(threads)
+    {
+      pcl::Indices found;
+      std::vector<float> distances;
+#pragma omp for schedule(dynamic, 256)
+      for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(size); ++i) {
+        const pcl::index_t row = rows ? (*rows)[i] : static_cast<pcl::index_t>(i);
+        if (!pcl::isXYZFinite(cloud[row])) continue;
+        found.resize(kWideGraphWidth);
+        distances.resize(kWideGraphWidth);
+        const int count =
+            std::min<int>(tree.nearestKSearch(cloud, row, kWideGraphWidth, found, distances),
+                          static_cast<int>(found.size()));
+        int n = 0;
+        for (int f = 0; f < count; ++f)
+          if (pcl::isXYZFinite(surface[found[f]]))
+            graph.neighbours[static_cast<std::size_t>(i) * kWideGraphWidth + n++] = found[f];
+      }
+    }
+    return graph;
+  };
+  std::vector<Eigen::Vector3d> nodes(surface.size());
+  for (std::size_t j = 0; j < surface.size(); ++j)
+    nodes[j] = pcl::isXYZFinite(surface[j]) ? relative(surface[j]) : Eigen::Vector3d::Zero();
+  const NeighbourGraph node_graph = graphOf(surface, nullptr, surface.size());
+  std::vector<Eigen::Vector3d> queries(indices.size());
+  for (std::size_t i = 0; i < indices.size(); ++i) queries[i] = relative(input[indices[i]]);
+  // On the input itself a query is its node.
+  std::vector<int> query_nodes(indices.size(), -1);
+  NeighbourGraph query_graph;
+  if (this->surface_ == this->input_)
+    std::copy(indices.begin(), indices.end(), query_nodes.begin());
+  else
+    query_graph = graphOf(input, &indices, indices.size());
+  const std::vector<WidePlane> planes = widestPlanes(nodes, node_graph, queries, query_nodes,
+                                                     query_graph, largest_reference, threads);
+  for (std::size_t i = 0; i < planes.size(); ++i) {
+    if (planes[i].level < 0) continue;
+    write(output[i], planes[i].normal, indices[i],
+          input[indices[i]].getVector3fMap().template cast<double>());
+    const int l = planes[i].level + 1;
+    scales_[i] = static_cast<float>(kWideGraphWidth * l * l);
+    confidences_[i] = 1.0f;
+  }
 }
 
 template <typename PointInT, typename PointOutT>

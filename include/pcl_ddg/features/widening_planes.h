@@ -1,0 +1,58 @@
+#pragma once
+/** \file
+ * Planes wider than the neighbourhood searched, from moments summed along the nearest-neighbour
+ * graph (RobustNormalEstimation on noisy data).
+ *
+ * Each node j of a graph (its w nearest neighbours N(j), w = 32) has the moments of its
+ * neighbourhood \f$ A_0(j) = \sum_{x \in N(j)} (1, x, x x^T) \f$; a level wider they are summed
+ * over the neighbours, \f$ A_{l+1}(j) = \sum_{m \in N(j)} A_l(m) \f$: each point weighted by
+ * the number of (l + 1)-step walks to it, a kernel that reaches l + 1 neighbourhood radii but
+ * whose mass spreads as a random walk's, about \f$ \sqrt{l + 1} \f$ radii, for the cost of
+ * adding w moments per point and level. Moments are kept about their own node and moved by the
+ * parallel-axis rule, so far from the origin nothing cancels.
+ *
+ * Scale: the plane (PCA of the moments) of level l >= kFirstWideLevel is kept, and the next
+ * tried, while its residual variance \f$ \lambda_0(l) \f$ stays within 1.5 times that of level
+ * kFirstWideLevel - 1 (about the size searched), and only where that reference is itself noise
+ * (at most largest_reference, which the caller derives from its own noise estimate): residual
+ * that does not grow with the scale is noise, which a wider plane averages; residual that grows
+ * is curvature or another face, where the plane stops. On a noise-free curved surface
+ * \f$ \lambda_0 \propto r^4 \f$ grows about 1.8 times from level 2 to 3: no wider plane.
+ */
+#include <Eigen/Core>
+#include <vector>
+
+namespace pcl_ddg {
+
+/** Neighbour lists of a fixed width, row-major: node i's are neighbours[i * width + n], -1 for
+ *  none. */
+struct NeighbourGraph {
+  int width = 0;
+  std::vector<int> neighbours;
+};
+
+/** Levels 0 .. kWideLevels - 1 are formed; the first kFirstWideLevel only lead up to the rest. */
+constexpr int kWideLevels = 7;
+constexpr int kFirstWideLevel = 3;
+
+/** The widest plane of a query point. */
+struct WidePlane {
+  int level = -1;  ///< the level kept, -1 for none (a residual that grows from the start)
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit, sign arbitrary; level >= 0
+};
+
+/**
+ * For each query (at queries[q]): the plane of the widest level kept (see the file's comment).
+ * A query that is a node (query_nodes[q] >= 0) has that node's moments; one that is not
+ * (query_nodes[q] = -1) sums its own neighbours among the nodes, query_graph's row q. nodes and
+ * queries in double relative to any common origin near the cloud. Deterministic: the same input
+ * gives the same bits on any number of threads.
+ */
+std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
+                                    const NeighbourGraph& node_graph,
+                                    const std::vector<Eigen::Vector3d>& queries,
+                                    const std::vector<int>& query_nodes,
+                                    const NeighbourGraph& query_graph,
+                                    const std::vector<double>& largest_reference, int threads);
+
+}  // namespace pcl_ddg

@@ -1,0 +1,120 @@
+#include "pcl_ddg/features/widening_planes.h"
+
+#include <cstddef>
+
+#include "pcl_ddg/features/plane_fit.h"
+#include "pcl_ddg/features/spatial_order.h"
+
+namespace pcl_ddg {
+
+namespace {
+
+constexpr double kGrowth = 1.5;  ///< of a kept level's residual variance over the reference's
+
+/** Weighted sums of points about a reference point: weight, first moments and the six distinct
+ *  second moments. */
+struct Moments {
+  double w = 0.0, x = 0.0, y = 0.0, z = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0,
+         zz = 0.0;
+
+  /** Adds other, taken about a reference d from this one's: x - ours = (x - theirs) + d. */
+  void addMoved(const Moments& o, const Eigen::Vector3d& d) {
+    w += o.w;
+    x += o.x + o.w * d.x();
+    y += o.y + o.w * d.y();
+    z += o.z + o.w * d.z();
+    xx += o.xx + 2.0 * o.x * d.x() + o.w * d.x() * d.x();
+    yy += o.yy + 2.0 * o.y * d.y() + o.w * d.y() * d.y();
+    zz += o.zz + 2.0 * o.z * d.z() + o.w * d.z() * d.z();
+    xy += o.xy + o.x * d.y() + o.y * d.x() + o.w * d.x() * d.y();
+    xz += o.xz + o.x * d.z() + o.z * d.x() + o.w * d.x() * d.z();
+    yz += o.yz + o.y * d.z() + o.z * d.y() + o.w * d.y() * d.z();
+  }
+  /** The covariance about the centroid, divided by the weight. */
+  Eigen::Matrix3d covariance() const {
+    const Eigen::Vector3d c(x / w, y / w, z / w);
+    Eigen::Matrix3d products;
+    products << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    return products / w - c * c.transpose();
+  }
+};
+
+/** The moments about `at` of the nodes of a graph row, each as a point (previous == nullptr) or
+ *  as its moments of the previous level. */
+Moments sumOverRow(const Eigen::Vector3d& at, const int* row, int width,
+                   const std::vector<Eigen::Vector3d>& nodes,
+                   const std::vector<Moments>* previous) {
+  static const Moments kPoint{1.0};
+  Moments sum;
+  for (int n = 0; n < width; ++n) {
+    const int j = row[n];
+    if (j >= 0) sum.addMoved(previous ? (*previous)[j] : kPoint, nodes[j] - at);
+  }
+  return sum;
+}
+
+}  // namespace
+
+std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
+                                    const NeighbourGraph& node_graph,
+                                    const std::vector<Eigen::Vector3d>& queries,
+                                    const std::vector<int>& query_nodes,
+                                    const NeighbourGraph& query_graph,
+                                    const std::vector<double>& largest_reference, int threads) {
+  // Nodes renumbered in space-filling order: a row's moments then lie near each other in memory.
+  std::vector<Eigen::Vector3f> approximate(nodes.size());
+  for (std::size_t j = 0; j < nodes.size(); ++j) approximate[j] = nodes[j].cast<float>();
+  const std::vector<int> order = detail::spatialOrder(approximate);
+  std::vector<int> rank(nodes.size());
+  for (std::size_t r = 0; r < order.size(); ++r) rank[order[r]] = static_cast<int>(r);
+  const int width = node_graph.width;
+  std::vector<Eigen::Vector3d> at(nodes.size());
+  std::vector<int> rows(node_graph.neighbours.size());
+  for (std::size_t r = 0; r < order.size(); ++r) {
+    at[r] = nodes[order[r]];
+    for (int n = 0; n < width; ++n) {
+      const int j = node_graph.neighbours[static_cast<std::size_t>(order[r]) * width + n];
+      rows[r * width + n] = j < 0 ? -1 : rank[j];
+    }
+  }
+  std::vector<int> query_rows(query_graph.neighbours.size());
+  for (std::size_t i = 0; i < query_rows.size(); ++i)
+    query_rows[i] = query_graph.neighbours[i] < 0 ? -1 : rank[query_graph.neighbours[i]];
+
+  std::vector<WidePlane> planes(queries.size());
+  std::vector<double> reference(queries.size());  // lambda0 of level kFirstWideLevel - 1
+  std::vector<char> stopped(queries.size(), 0);   // a level's residual was too large
+  std::vector<Moments> level_moments, previous;   // A_l and A_{l-1} of the nodes
+  for (int level = 0; level < kWideLevels; ++level) {
+    std::swap(previous, level_moments);
+    level_moments.resize(at.size());
+    const std::vector<Moments>* below = level == 0 ? nullptr : &previous;
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (std::ptrdiff_t r = 0; r < static_cast<std::ptrdiff_t>(at.size()); ++r)
+      level_moments[r] = sumOverRow(at[r], &rows[r * width], width, at, below);
+    if (level + 1 < kFirstWideLevel) continue;
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (std::ptrdiff_t q = 0; q < static_cast<std::ptrdiff_t>(queries.size()); ++q) {
+      if (stopped[q]) continue;
+      const int node = query_nodes[q];
+      const Moments m = node >= 0 ? level_moments[rank[node]]
+                                  : sumOverRow(queries[q], &query_rows[q * query_graph.width],
+                                               query_graph.width, at, below);
+      const Eigen::Matrix3d covariance = m.covariance();
+      const PlaneNormal fit = m.w >= 3.0 ? fitPlaneNormal(covariance) : PlaneNormal{};
+      const double lambda0 = fit.surface_variation * covariance.trace();
+      const bool wide = level >= kFirstWideLevel;
+      if (!fit.valid || !(lambda0 <= (wide ? kGrowth * reference[q] : largest_reference[q]))) {
+        stopped[q] = 1;
+        continue;
+      }
+      if (wide)
+        planes[q] = {level, fit.normal};
+      else
+        reference[q] = lambda0;
+    }
+  }
+  return planes;
+}
+
+}  // namespace pcl_ddg
