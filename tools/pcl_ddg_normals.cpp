@@ -36,7 +36,7 @@ constexpr const char* kSyntax =
     "on "
     "organized "
     "clouds)]\n"
-    "         [-k N (default 16, quadric 20, robust 128 or all points: the "
+    "         [-k N (default 16, quadric 20, robust 96 or all points: the "
     "neighbourhood searched)]\n"
     "         [-max_depth_jump f (grid: a range change above f times the range per pixel cuts the "
     "grid;\n"

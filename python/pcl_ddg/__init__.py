@@ -366,7 +366,7 @@ def estimate_normals(
     returns the scale and confidence) to each point's neighbours (``pcl_ddg_normals -method``).
 
     points: (n, 3), or (h, w, 3) for an organized cloud (kept: the output has its grid).
-    k: neighbours (default 16, quadric 20, robust 128 or all points if fewer: the
+    k: neighbours (default 16, quadric 20, robust 96 or all points if fewer: the
         neighbourhood searched, beyond which robust widens only on noisy data; at least 3, at most the point count).
     radius: a radius search instead of k, keeping at most ``max_nn`` (default 64) nearest;
         ``min_nn``: the min_nn nearest where the ball holds fewer.
@@ -406,8 +406,8 @@ class RobustNormals(NamedTuple):
     normals: np.ndarray  #: (n, 3) unit
     curvature: np.ndarray  #: surface variation of the fit
     valid: np.ndarray  #: bool
-    scale: np.ndarray  #: neighbours the plane used (of at most k)
-    confidence: np.ndarray  #: scale / k: near 1 where one plane explains all k, small at edges
+    scale: np.ndarray  #: neighbours the plane used; a wider plane: about 32 (level + 1)^2
+    confidence: np.ndarray  #: share of the k found used: near 1 on one plane, small at edges
 
 
 def robust_normals(
@@ -422,7 +422,7 @@ def robust_normals(
 ) -> RobustNormals:
     """Normals that choose their own scale and keep sharp edges (``pcl_ddg_normals -method
     robust``; the method: ``docs/library.md``, fitted normals). k: the largest neighbourhood
-    (default 128, or all points if fewer). Options as :func:`estimate_normals`.
+    (default 96, or all points if fewer). Options as :func:`estimate_normals`.
     """
     normals, curvature, valid, _, scale, confidence = _pcl_ddg.estimate_normals(
         _array(points, "points"),

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <utility>
 #include <vector>
 
@@ -133,13 +132,18 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   RobustPlaneFit result;
   if (count < 3) return result;
 
+  // Buffers reused by each thread's next neighbourhood (a fit takes microseconds; allocating
+  // them per point was a tenth of that).
+  thread_local std::vector<std::pair<double, int>> by_distance;
+  thread_local Eigen::Matrix3Xd x;
+  thread_local std::vector<double> residuals;
   // The neighbours nearest first (k-d tree searches give them so; ties keep their order).
-  std::vector<std::pair<double, int>> by_distance(static_cast<std::size_t>(count));
+  by_distance.resize(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) by_distance[i] = {points.col(i).squaredNorm(), i};
   const auto nearer = [](const auto& a, const auto& b) { return a.first < b.first; };
   if (!std::is_sorted(by_distance.begin(), by_distance.end(), nearer))
     std::stable_sort(by_distance.begin(), by_distance.end(), nearer);
-  Eigen::Matrix3Xd x(3, count);
+  x.resize(3, count);
   for (int i = 0; i < count; ++i) x.col(i) = points.col(by_distance[i].second);
   const double radius = std::sqrt(by_distance.back().first);
   const double floor = kNoiseFloor * radius;
@@ -151,7 +155,8 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
     Plane plane;
     double l0;
   };
-  std::vector<Scale> scales;
+  thread_local std::vector<Scale> scales;
+  scales.clear();
   Moments nested;
   Eigen::Vector3d anchor = Eigen::Vector3d::Zero();
   int next = std::min(kSmallestScale, count);
@@ -195,7 +200,6 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   //    a plane through the query and two of its nearest neighbours that halves their median
   //    (a point on a face of an edge spans its own face with them).
   const int scored = std::min(used, kScoredNeighbours);
-  std::vector<double> residuals;
   double best_median = std::numeric_limits<double>::infinity();
   Plane plane;
   for (int j = 0; j <= chosen; ++j) {
@@ -234,19 +238,23 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   for (int iteration = 0; iteration < kMaxRefinements; ++iteration) {
     const Moments m = within(x, used, plane, band);
     if (m.count < 3) break;
-    const PlaneNormal fit = fitPlaneNormal(m.covariance());
+    const Eigen::Matrix3d covariance = m.covariance();
+    const PlaneNormal fit = fitPlaneNormal(covariance);
     if (!fit.valid) break;
     const Plane next_plane{fit.normal.dot(plane.normal) < 0.0 ? -fit.normal : fit.normal,
                            m.centroid()};
     const bool converged = (next_plane.normal - plane.normal).norm() < kConverged;
     plane = next_plane;
     result.surface_variation = fit.surface_variation;
+    result.residual = fit.surface_variation * covariance.trace() * m.count / (m.count - 2);
     if (converged) break;
   }
   if (std::isnan(result.surface_variation)) {  // no refit: the chosen plane's own spread
     Moments all;
     for (int i = 0; i < used; ++i) all.add(x.col(i));
-    result.surface_variation = fitPlane(all.centroid(), all.covariance()).surface_variation;
+    const PlaneFit fit = fitPlane(all.centroid(), all.covariance());
+    result.surface_variation = fit.surface_variation;
+    result.residual = fit.eigenvalues[0] * all.count / std::max(all.count - 2, 1);
   }
   const Moments inliers = within(x, used, plane, band);
   result.normal = plane.normal;

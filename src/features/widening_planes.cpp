@@ -1,6 +1,8 @@
 #include "pcl_ddg/features/widening_planes.h"
 
+#include <algorithm>
 #include <cstddef>
+#include <numeric>
 
 #include "pcl_ddg/features/plane_fit.h"
 #include "pcl_ddg/features/spatial_order.h"
@@ -9,7 +11,7 @@ namespace pcl_ddg {
 
 namespace {
 
-constexpr double kGrowth = 1.5;  ///< of a kept level's residual variance over the reference's
+constexpr double kGrowth = 2.0;  ///< of a kept level's residual variance over the reference's
 
 /** Weighted sums of points about a reference point: weight, first moments and the six distinct
  *  second moments. */
@@ -81,7 +83,15 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
   for (std::size_t i = 0; i < query_rows.size(); ++i)
     query_rows[i] = query_graph.neighbours[i] < 0 ? -1 : rank[query_graph.neighbours[i]];
 
-  std::vector<WidePlane> planes(queries.size());
+  // Queries visited in their nodes' order (the others after them, as given), and their state
+  // kept in that order: each level then reads the moments in sequence.
+  std::vector<int> visit(queries.size());
+  std::iota(visit.begin(), visit.end(), 0);
+  const auto key = [&](int q) {
+    return query_nodes[q] >= 0 ? rank[query_nodes[q]] : static_cast<int>(nodes.size());
+  };
+  std::stable_sort(visit.begin(), visit.end(), [&](int a, int b) { return key(a) < key(b); });
+  std::vector<WidePlane> kept(queries.size());
   std::vector<double> reference(queries.size());  // lambda0 of level kFirstWideLevel - 1
   std::vector<char> stopped(queries.size(), 0);   // a level's residual was too large
   std::vector<Moments> level_moments, previous;   // A_l and A_{l-1} of the nodes
@@ -93,9 +103,11 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
     for (std::ptrdiff_t r = 0; r < static_cast<std::ptrdiff_t>(at.size()); ++r)
       level_moments[r] = sumOverRow(at[r], &rows[r * width], width, at, below);
     if (level + 1 < kFirstWideLevel) continue;
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (std::ptrdiff_t q = 0; q < static_cast<std::ptrdiff_t>(queries.size()); ++q) {
-      if (stopped[q]) continue;
+    std::ptrdiff_t widening = 0;
+#pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : widening)
+    for (std::ptrdiff_t v = 0; v < static_cast<std::ptrdiff_t>(queries.size()); ++v) {
+      if (stopped[v]) continue;
+      const int q = visit[v];
       const int node = query_nodes[q];
       const Moments m = node >= 0 ? level_moments[rank[node]]
                                   : sumOverRow(queries[q], &query_rows[q * query_graph.width],
@@ -104,16 +116,20 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
       const PlaneNormal fit = m.w >= 3.0 ? fitPlaneNormal(covariance) : PlaneNormal{};
       const double lambda0 = fit.surface_variation * covariance.trace();
       const bool wide = level >= kFirstWideLevel;
-      if (!fit.valid || !(lambda0 <= (wide ? kGrowth * reference[q] : largest_reference[q]))) {
-        stopped[q] = 1;
+      if (!fit.valid || !(lambda0 <= (wide ? kGrowth * reference[v] : largest_reference[q]))) {
+        stopped[v] = 1;
         continue;
       }
       if (wide)
-        planes[q] = {level, fit.normal};
+        kept[v] = {level, fit.normal};
       else
-        reference[q] = lambda0;
+        reference[v] = lambda0;
+      ++widening;
     }
+    if (widening == 0) break;  // clean data: no plane widens, no need for the next level
   }
+  std::vector<WidePlane> planes(queries.size());
+  for (std::size_t v = 0; v < visit.size(); ++v) planes[visit[v]] = kept[v];
   return planes;
 }
 

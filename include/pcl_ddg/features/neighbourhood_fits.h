@@ -24,11 +24,12 @@ namespace detail {
 enum class FitOutcome { Fitted, FellBack, Failed };
 
 /** Fits one query point: neighbours' first count columns are its finite neighbours minus its
- *  position (count may be below 3, and the position non-finite: the fit then fails), index is
- *  its input index and place its place in the output. Called from several threads at once. */
-using NeighbourhoodFit =
-    std::function<FitOutcome(const Eigen::Matrix3Xd& neighbours, int count, pcl::index_t index,
-                             const Eigen::Vector3d& position, std::size_t place)>;
+ *  position (count may be below 3, and the position non-finite: the fit then fails), found's
+ *  first count entries their indices in the search surface, index is the query's input index
+ *  and place its place in the output. Called from several threads at once. */
+using NeighbourhoodFit = std::function<FitOutcome(
+    const Eigen::Matrix3Xd& neighbours, int count, const pcl::Indices& found, pcl::index_t index,
+    const Eigen::Vector3d& position, std::size_t place)>;
 
 /** The type of pcl::Feature's search_method_surface_. */
 template <typename PointInT>

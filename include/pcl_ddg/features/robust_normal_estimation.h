@@ -15,26 +15,28 @@
  * Output: normal_x/y/z (unit, oriented as the other estimators: local_fit_estimation.h) and
  * curvature = the surface variation of the robust plane. getScales() and getConfidences() hold,
  * per output point, the neighbours the plane used and their share of the neighbours found
- * (robust_plane_fit.h); for a wider plane of level l, about the points it reaches,
- * 32 (l + 1)^2, and 1. NaN where the point failed (fewer than 3 finite neighbours, or all on one
- * line). The wider planes are formed over the whole search surface (every point of it is a node
- * of the graph), also when only some indices are estimated.
+ * (robust_plane_fit.h); for a wider plane of level l, the points its kernel reaches, about
+ * 32 (l + 1)^2 (most of the weight within sqrt(l + 1) neighbourhood radii), and 1. NaN where the
+ * point failed (fewer than 3 finite neighbours, or all on one line). The wider planes are formed
+ * over the whole search surface (every point of it is a node of the graph), also when only some
+ * indices are estimated.
  */
 #include <vector>
 
 #include "pcl_ddg/features/local_fit_estimation.h"
+#include "pcl_ddg/features/widening_planes.h"
 
 namespace pcl_ddg {
 
 /** The neighbourhood searched by default; wider planes reach beyond it where the data are noisy
  *  (bench/bench_normal_accuracy.py: docs/benchmarks.md has the time against a k = 112 plane
  *  fit). */
-constexpr int kRobustNormalNeighbours = 128;
+constexpr int kRobustNormalNeighbours = 96;
 /** The nearest-neighbour graph along which wider planes are summed (widening_planes.h). */
 constexpr int kWideGraphWidth = 32;
-/** A wider plane replaces the robust one while its residual variance is at most this many times
- *  the robust fit's noise variance: what it adds (curvature, another face) stays below the noise.
- */
+/** Planes widen from a point only where the plane of about the searched size leaves at most this
+ *  many times the residual variance of the robust fit's inliers (widening_planes.h): noise there,
+ *  not another face or curvature. */
 constexpr double kWideResidual = 2.0;
 
 template <typename PointInT, typename PointOutT>
@@ -68,9 +70,11 @@ class RobustNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
   /** Orients normal (for query point index at position) into out's normal fields. */
   void write(PointOutT& out, Eigen::Vector3d normal, pcl::index_t index,
              const Eigen::Vector3d& position) const;
-  /** Where the robust plane explained most of its neighbourhood and a plane wider than it keeps
-   *  explaining the points as noise (widening_planes.h), that plane's normal instead. */
-  void widen(PointCloudOut& output, const std::vector<double>& largest_reference);
+  /** Where the plane of about the searched size is noise and a wider one keeps explaining the
+   *  points as noise (widening_planes.h), that plane's normal instead. query_graph: each
+   *  query's nearest kWideGraphWidth of the neighbours its fit searched. */
+  void widen(PointCloudOut& output, const std::vector<double>& largest_reference,
+             const NeighbourGraph& query_graph);
 
   std::vector<float> scales_, confidences_;
 };

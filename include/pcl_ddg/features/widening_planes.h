@@ -12,12 +12,12 @@
  * parallel-axis rule, so far from the origin nothing cancels.
  *
  * Scale: the plane (PCA of the moments) of level l >= kFirstWideLevel is kept, and the next
- * tried, while its residual variance \f$ \lambda_0(l) \f$ stays within 1.5 times that of level
- * kFirstWideLevel - 1 (about the size searched), and only where that reference is itself noise
- * (at most largest_reference, which the caller derives from its own noise estimate): residual
- * that does not grow with the scale is noise, which a wider plane averages; residual that grows
- * is curvature or another face, where the plane stops. On a noise-free curved surface
- * \f$ \lambda_0 \propto r^4 \f$ grows about 1.8 times from level 2 to 3: no wider plane.
+ * tried, while its residual variance \f$ \lambda_0(l) \f$ stays within twice that of level
+ * kFirstWideLevel - 1 (about the size searched), and only where that reference is itself noise:
+ * at most largest_reference, which the caller sets from the residual of its own robust plane.
+ * Residual that does not grow with the scale is noise, which a wider plane averages; residual
+ * that grows is curvature or another face, where the plane stops. On clean curved data the
+ * reference is curvature, far above a small plane's residual, and no level is kept.
  */
 #include <Eigen/Core>
 #include <vector>
@@ -32,7 +32,7 @@ struct NeighbourGraph {
 };
 
 /** Levels 0 .. kWideLevels - 1 are formed; the first kFirstWideLevel only lead up to the rest. */
-constexpr int kWideLevels = 7;
+constexpr int kWideLevels = 13;
 constexpr int kFirstWideLevel = 3;
 
 /** The widest plane of a query point. */

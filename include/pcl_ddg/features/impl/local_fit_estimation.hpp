@@ -109,9 +109,9 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(
   queries.min_neighbours = min_neighbours_;
   queries.threads = threadCount();
   const detail::FitCounts counts = detail::fitNeighbourhoods(
-      queries, [&](const Eigen::Matrix3Xd& neighbours, int count, pcl::index_t index,
-                   const Eigen::Vector3d& position, std::size_t place) {
-        const FitOutcome outcome = fit(neighbours, count, index, position, place);
+      queries, [&](const Eigen::Matrix3Xd& neighbours, int count, const pcl::Indices& found,
+                   pcl::index_t index, const Eigen::Vector3d& position, std::size_t place) {
+        const FitOutcome outcome = fit(neighbours, count, found, index, position, place);
         if (outcome == FitOutcome::Failed) setInvalid(output[place]);
         return outcome;
       });

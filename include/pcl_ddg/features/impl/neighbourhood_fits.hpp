@@ -32,7 +32,7 @@ FitCounts fitNeighbourhoods(const NeighbourhoodQueries<PointInT>& queries,
 #pragma omp parallel num_threads(queries.threads) reduction(+ : failed, fell_back)
   {
     // Per-thread buffers, grown once and reused for every point.
-    pcl::Indices neighbours;
+    pcl::Indices neighbours, finite_neighbours;
     std::vector<float> squared_distances;
     Eigen::Matrix3Xd local(3, 64);
 #pragma omp for schedule(dynamic, 256)
@@ -60,14 +60,17 @@ FitCounts fitNeighbourhoods(const NeighbourhoodQueries<PointInT>& queries,
       found = std::min(found, static_cast<int>(neighbours.size()));
       const Eigen::Vector3d origin = query.getVector3fMap().template cast<double>();
       if (local.cols() < found) local.resize(3, found);
+      finite_neighbours.resize(std::max(found, 0));
       int count = 0;
       for (int n = 0; n < found; ++n) {
         const pcl::index_t j = neighbours[n];
         if (pcl::isXYZFinite(surface[j])) {
+          finite_neighbours[count] = j;
           local.col(count++) = surface[j].getVector3fMap().template cast<double>() - origin;
         }
       }
-      const FitOutcome outcome = fit(local, count, indices[i], origin, static_cast<std::size_t>(i));
+      const FitOutcome outcome =
+          fit(local, count, finite_neighbours, indices[i], origin, static_cast<std::size_t>(i));
       if (outcome == FitOutcome::Failed) ++failed;
       if (outcome == FitOutcome::FellBack) ++fell_back;
     }

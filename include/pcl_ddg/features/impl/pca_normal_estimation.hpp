@@ -10,8 +10,8 @@ template <typename PointInT, typename PointOutT>
 void PCANormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& output) {
   using Outcome = typename LocalFitEstimation<PointInT, PointOutT>::FitOutcome;
   this->fitEachNeighbourhood(
-      output, [this, &output](const Eigen::Matrix3Xd& neighbours, int count, pcl::index_t index,
-                              const Eigen::Vector3d& position, std::size_t i) {
+      output, [this, &output](const Eigen::Matrix3Xd& neighbours, int count, const pcl::Indices&,
+                              pcl::index_t index, const Eigen::Vector3d& position, std::size_t i) {
         PointOutT& out = output[i];
         const PlaneFit plane = fitPlane(neighbours, count);
         if (!plane.valid) return Outcome::Failed;

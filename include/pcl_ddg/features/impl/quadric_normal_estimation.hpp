@@ -37,8 +37,8 @@ void QuadricNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut&
     curvatures_->height = output.height;
   }
   this->fitEachNeighbourhood(
-      output, [&](const Eigen::Matrix3Xd& neighbours, int count, pcl::index_t index,
-                  const Eigen::Vector3d& position, std::size_t i) {
+      output, [&](const Eigen::Matrix3Xd& neighbours, int count, const pcl::Indices&,
+                  pcl::index_t index, const Eigen::Vector3d& position, std::size_t i) {
         PointOutT& out = output[i];
         const PlaneFit plane = fitPlane(neighbours, count);
         if (!plane.valid) return Outcome::Failed;

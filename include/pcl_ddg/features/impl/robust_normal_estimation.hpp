@@ -17,10 +17,16 @@ void RobustNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& 
   scales_.assign(output.size(), nan);
   confidences_.assign(output.size(), nan);
   std::vector<double> largest_reference(output.size(), -1.0);  // none: no wider plane
+  // Each query's nearest kWideGraphWidth of those searched: its row of the graph wider planes
+  // are summed along.
+  NeighbourGraph rows;
+  rows.width = kWideGraphWidth;
+  rows.neighbours.assign(output.size() * kWideGraphWidth, -1);
   this->fitEachNeighbourhood(
-      output, [this, &output, &largest_reference](const Eigen::Matrix3Xd& neighbours, int count,
-                                                  pcl::index_t index,
-                                                  const Eigen::Vector3d& position, std::size_t i) {
+      output, [&](const Eigen::Matrix3Xd& neighbours, int count, const pcl::Indices& found,
+                  pcl::index_t index, const Eigen::Vector3d& position, std::size_t i) {
+        std::copy_n(found.begin(), std::min(count, kWideGraphWidth),
+                    rows.neighbours.begin() + i * kWideGraphWidth);
         if (!position.allFinite()) return Outcome::Failed;
         const RobustPlaneFit plane = fitRobustPlane(neighbours, count);
         if (!plane.valid) return Outcome::Failed;
@@ -28,10 +34,10 @@ void RobustNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& 
         output[i].curvature = static_cast<float>(plane.surface_variation);
         scales_[i] = static_cast<float>(plane.scale);
         confidences_[i] = static_cast<float>(plane.confidence);
-        largest_reference[i] = kWideResidual * plane.noise * plane.noise;
+        largest_reference[i] = kWideResidual * plane.residual;
         return Outcome::Fitted;
       });
-  if (this->k_ > 0 && this->search_radius_ == 0.0) widen(output, largest_reference);
+  if (this->k_ > 0 && this->search_radius_ == 0.0) widen(output, largest_reference, rows);
   this->makeOrientationConsistent(output, [](std::size_t) {});
 }
 
@@ -47,7 +53,8 @@ void RobustNormalEstimation<PointInT, PointOutT>::write(PointOutT& out, Eigen::V
 
 template <typename PointInT, typename PointOutT>
 void RobustNormalEstimation<PointInT, PointOutT>::widen(
-    PointCloudOut& output, const std::vector<double>& largest_reference) {
+    PointCloudOut& output, const std::vector<double>& largest_reference,
+    const NeighbourGraph& query_graph) {
   const pcl::PointCloud<PointInT>& surface = *this->surface_;
   const pcl::PointCloud<PointInT>& input = *this->input_;
   const pcl::Indices& indices = *this->indices_;
@@ -63,46 +70,47 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
   const auto relative = [&origin](const PointInT& p) -> Eigen::Vector3d {
     return p.getVector3fMap().template cast<double>() - origin;
   };
-  // Row i: the finite ones of the graph width nearest of point i (of cloud), -1 padded.
-  const auto graphOf = [&](const pcl::PointCloud<PointInT>& cloud, const pcl::Indices* rows,
-                           std::size_t size) {
-    NeighbourGraph graph;
-    graph.width = kWideGraphWidth;
-    graph.neighbours.assign(size * kWideGraphWidth, -1);
-#pragma omp parallel num_threads(threads)
-    {
-      pcl::Indices found;
-      std::vector<float> distances;
-#pragma omp for schedule(dynamic, 256)
-      for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(size); ++i) {
-        const pcl::index_t row = rows ? (*rows)[i] : static_cast<pcl::index_t>(i);
-        if (!pcl::isXYZFinite(cloud[row])) continue;
-        found.resize(kWideGraphWidth);
-        distances.resize(kWideGraphWidth);
-        const int count =
-            std::min<int>(tree.nearestKSearch(cloud, row, kWideGraphWidth, found, distances),
-                          static_cast<int>(found.size()));
-        int n = 0;
-        for (int f = 0; f < count; ++f)
-          if (pcl::isXYZFinite(surface[found[f]]))
-            graph.neighbours[static_cast<std::size_t>(i) * kWideGraphWidth + n++] = found[f];
-      }
-    }
-    return graph;
-  };
   std::vector<Eigen::Vector3d> nodes(surface.size());
   for (std::size_t j = 0; j < surface.size(); ++j)
     nodes[j] = pcl::isXYZFinite(surface[j]) ? relative(surface[j]) : Eigen::Vector3d::Zero();
-  const NeighbourGraph node_graph = graphOf(surface, nullptr, surface.size());
   std::vector<Eigen::Vector3d> queries(indices.size());
   for (std::size_t i = 0; i < indices.size(); ++i) queries[i] = relative(input[indices[i]]);
-  // On the input itself a query is its node.
+
+  // The nodes' rows: on the input itself a query is its node and brings its row; the other
+  // nodes (all of a separate search surface) search for theirs.
+  const std::size_t width = kWideGraphWidth;
+  NeighbourGraph node_graph;
+  node_graph.width = kWideGraphWidth;
+  node_graph.neighbours.assign(surface.size() * width, -1);
+  std::vector<char> has_row(surface.size(), 0);
   std::vector<int> query_nodes(indices.size(), -1);
-  NeighbourGraph query_graph;
-  if (this->surface_ == this->input_)
-    std::copy(indices.begin(), indices.end(), query_nodes.begin());
-  else
-    query_graph = graphOf(input, &indices, indices.size());
+  if (this->surface_ == this->input_) {
+    for (std::size_t i = 0; i < indices.size(); ++i) {
+      const pcl::index_t node = indices[i];
+      query_nodes[i] = node;
+      if (has_row[node]) continue;
+      has_row[node] = 1;
+      std::copy_n(query_graph.neighbours.begin() + i * width, width,
+                  node_graph.neighbours.begin() + node * width);
+    }
+  }
+#pragma omp parallel num_threads(threads)
+  {
+    pcl::Indices found;
+    std::vector<float> distances;
+#pragma omp for schedule(dynamic, 256)
+    for (std::ptrdiff_t j = 0; j < static_cast<std::ptrdiff_t>(surface.size()); ++j) {
+      if (has_row[j] || !pcl::isXYZFinite(surface[j])) continue;
+      found.resize(width);
+      distances.resize(width);
+      const int answered = tree.nearestKSearch(surface, static_cast<pcl::index_t>(j),
+                                               kWideGraphWidth, found, distances);
+      const int count = std::min({answered, kWideGraphWidth, static_cast<int>(found.size())});
+      int n = 0;
+      for (int f = 0; f < count; ++f)
+        if (pcl::isXYZFinite(surface[found[f]])) node_graph.neighbours[j * width + n++] = found[f];
+    }
+  }
   const std::vector<WidePlane> planes = widestPlanes(nodes, node_graph, queries, query_nodes,
                                                      query_graph, largest_reference, threads);
   for (std::size_t i = 0; i < planes.size(); ++i) {
