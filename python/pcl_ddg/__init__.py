@@ -407,7 +407,7 @@ class RobustNormals(NamedTuple):
     curvature: np.ndarray  #: surface variation of the fit
     valid: np.ndarray  #: bool
     scale: np.ndarray  #: neighbours the plane used; a wider plane: about 32 (level + 1)^2
-    confidence: np.ndarray  #: share of the k found used: near 1 on one plane, small at edges
+    confidence: np.ndarray  #: share of the k found used (1: a wider plane); small at edges
 
 
 def robust_normals(
@@ -421,7 +421,7 @@ def robust_normals(
     threads: int = 0,
 ) -> RobustNormals:
     """Normals that choose their own scale and keep sharp edges (``pcl_ddg_normals -method
-    robust``; the method: ``docs/library.md``, fitted normals). k: the largest neighbourhood
+    robust``; the method: ``docs/library.md``, fitted normals). k: the neighbourhood searched
     (default 96, or all points if fewer). Options as :func:`estimate_normals`.
     """
     normals, curvature, valid, _, scale, confidence = _pcl_ddg.estimate_normals(

@@ -177,7 +177,7 @@ LocalFitOptions fitOptions(const FitArguments& a, Cloud& cloud,
                           : neighbours == "grid" ? NeighbourhoodKind::Grid
                                                  : NeighbourhoodKind::KdTree;
   if (a.max_depth_jump) options.max_depth_jump = *a.max_depth_jump;
-  // As the tool: robust's default is its largest neighbourhood, capped by the points.
+  // As the tool: robust's default neighbourhood, capped by the points.
   options.k = a.k.value_or(options.method == LocalFitMethod::Quadric ? 20
                            : options.method == LocalFitMethod::Robust
                                ? std::min<int>(kRobustNormalNeighbours, cloud.size())

@@ -132,8 +132,7 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   RobustPlaneFit result;
   if (count < 3) return result;
 
-  // Buffers reused by each thread's next neighbourhood (a fit takes microseconds; allocating
-  // them per point was a tenth of that).
+  // Buffers reused by each thread's next neighbourhood: a fit takes microseconds.
   thread_local std::vector<std::pair<double, int>> by_distance;
   thread_local Eigen::Matrix3Xd x;
   thread_local std::vector<double> residuals;
@@ -246,7 +245,8 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
     const bool converged = (next_plane.normal - plane.normal).norm() < kConverged;
     plane = next_plane;
     result.surface_variation = fit.surface_variation;
-    result.residual = fit.surface_variation * covariance.trace() * m.count / (m.count - 2);
+    result.residual =
+        fit.surface_variation * covariance.trace() * m.count / std::max(m.count - 3, 1);
     if (converged) break;
   }
   if (std::isnan(result.surface_variation)) {  // no refit: the chosen plane's own spread
@@ -254,7 +254,7 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
     for (int i = 0; i < used; ++i) all.add(x.col(i));
     const PlaneFit fit = fitPlane(all.centroid(), all.covariance());
     result.surface_variation = fit.surface_variation;
-    result.residual = fit.eigenvalues[0] * all.count / std::max(all.count - 2, 1);
+    result.residual = fit.eigenvalues[0] * all.count / std::max(all.count - 3, 1);
   }
   const Moments inliers = within(x, used, plane, band);
   result.normal = plane.normal;

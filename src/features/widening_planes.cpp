@@ -11,8 +11,6 @@ namespace pcl_ddg {
 
 namespace {
 
-constexpr double kGrowth = 2.0;  ///< of a kept level's residual variance over the reference's
-
 /** Weighted sums of points about a reference point: weight, first moments and the six distinct
  *  second moments. */
 struct Moments {
@@ -79,7 +77,10 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
       rows[r * width + n] = j < 0 ? -1 : rank[j];
     }
   }
-  std::vector<int> query_rows(query_graph.neighbours.size());
+  // Rows of the queries that are not nodes (none where every query is one).
+  const bool all_nodes =
+      std::all_of(query_nodes.begin(), query_nodes.end(), [](int node) { return node >= 0; });
+  std::vector<int> query_rows(all_nodes ? 0 : query_graph.neighbours.size());
   for (std::size_t i = 0; i < query_rows.size(); ++i)
     query_rows[i] = query_graph.neighbours[i] < 0 ? -1 : rank[query_graph.neighbours[i]];
 
@@ -109,14 +110,16 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
       if (stopped[v]) continue;
       const int q = visit[v];
       const int node = query_nodes[q];
-      const Moments m = node >= 0 ? level_moments[rank[node]]
-                                  : sumOverRow(queries[q], &query_rows[q * query_graph.width],
-                                               query_graph.width, at, below);
+      const Moments m =
+          node >= 0
+              ? level_moments[rank[node]]
+              : sumOverRow(queries[q], &query_rows[static_cast<std::size_t>(q) * query_graph.width],
+                           query_graph.width, at, below);
       const Eigen::Matrix3d covariance = m.covariance();
       const PlaneNormal fit = m.w >= 3.0 ? fitPlaneNormal(covariance) : PlaneNormal{};
       const double lambda0 = fit.surface_variation * covariance.trace();
       const bool wide = level >= kFirstWideLevel;
-      if (!fit.valid || !(lambda0 <= (wide ? kGrowth * reference[v] : largest_reference[q]))) {
+      if (!fit.valid || !(lambda0 <= (wide ? kWideGrowth * reference[v] : largest_reference[q]))) {
         stopped[v] = 1;
         continue;
       }

@@ -304,14 +304,6 @@ TEST(RobustPlaneFit, SmallAndDegenerateNeighbourhoodsAreFiniteOrInvalidNeverNaN)
   EXPECT_LT(degreesBetween(fit.normal, Eigen::Vector3d::UnitZ()), 1e-9);
 }
 
-}  // namespace
-}  // namespace test
-}  // namespace pcl_ddg
-
-namespace pcl_ddg {
-namespace test {
-namespace {
-
 /** Unit sphere of n points uniform by area, Gaussian noise sigma on every coordinate; normals
  *  exact (of the point before the noise). */
 SurfaceSample noisySphere(int n, double sigma, std::uint32_t seed) {
@@ -416,6 +408,53 @@ TEST(RobustNormals, AQueryThatIsNotAPointOfTheSurfaceTakesTheSamePlanes) {
     ASSERT_EQ(same.normals[i].normal_z, apart.normals[i].normal_z) << i;
   }
   EXPECT_EQ(same.scales, apart.scales);
+}
+
+TEST(RobustNormals, ASubsetOfIndicesGetsTheNormalsOfTheWholeCloud) {
+  // The graph is the whole surface's either way; the points not estimated search their own
+  // rows (for a k-d tree the first 32 of the 96 are the 32 nearest): the same bits.
+  const SurfaceSample s = noisySphere(4000, 0.02, 7);
+  const RobustResult all = robust(s.points);
+  Robust estimator;
+  estimator.setInputCloud(toCloud(s.points));
+  estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  auto some = std::make_shared<pcl::Indices>();
+  for (int i = 0; i < 4000; i += 7) some->push_back(i);
+  estimator.setIndices(some);
+  Normals normals;
+  estimator.compute(normals);
+  ASSERT_EQ(normals.size(), some->size());
+  int wide = 0;
+  for (std::size_t n = 0; n < some->size(); ++n) {
+    const int i = (*some)[n];
+    ASSERT_EQ(normals[n].normal_x, all.normals[i].normal_x) << i;
+    ASSERT_EQ(normals[n].normal_y, all.normals[i].normal_y) << i;
+    ASSERT_EQ(normals[n].normal_z, all.normals[i].normal_z) << i;
+    ASSERT_EQ(estimator.getScales()[n], all.scales[i]) << i;
+    wide += all.scales[i] > kRobustNormalNeighbours;
+  }
+  EXPECT_GT(wide, 0.9 * some->size());  // the comparison covers the wider planes
+}
+
+TEST(RobustNormals, PlanesWidenOnlyFromAKNearestSearchOfAtLeastTheGraphsWidth) {
+  // The same noisy sphere: with 96 nearest most planes widen; with 24 nearest (fewer than a
+  // graph row) or a radius none does, and no scale exceeds the neighbours found.
+  const SurfaceSample s = noisySphere(4000, 0.02, 7);
+  const RobustResult k96 = robust(s.points), k24 = robust(s.points, 24);
+  const auto widest = [](const std::vector<float>& scales) {
+    return *std::max_element(scales.begin(), scales.end());
+  };
+  EXPECT_GT(widest(k96.scales), kRobustNormalNeighbours);
+  EXPECT_LE(widest(k24.scales), 24);
+  Robust by_radius;
+  by_radius.setInputCloud(toCloud(s.points));
+  by_radius.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  by_radius.setRadiusSearch(0.2);  // about 40 points (spacing 0.056)
+  by_radius.setRadiusSearchMaxNeighbours(200);
+  Normals normals;
+  by_radius.compute(normals);
+  EXPECT_LE(widest(by_radius.getScales()), 200);
+  EXPECT_LT(widest(by_radius.getScales()), kWideGraphWidth * (kFirstWideLevel + 1));
 }
 
 }  // namespace

@@ -142,7 +142,7 @@ LocalFitOptions localFitArguments(const ToolArguments& args, ToolInput& input,
                                                  : NeighbourhoodKind::KdTree;
   options.max_depth_jump = args.number("max_depth_jump", options.max_depth_jump);
   const auto points = static_cast<int>(input.positions.cols());
-  // Robust's k is the largest neighbourhood it may use: by default all points of a small input.
+  // Robust's default neighbourhood, or all points of a smaller input.
   options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20
                                 : method == LocalFitMethod::Robust
                                     ? std::min(kRobustNormalNeighbours, points)

@@ -13,13 +13,15 @@
  *   robust.getScales();              // per output point: neighbours used
  *
  * Output: normal_x/y/z (unit, oriented as the other estimators: local_fit_estimation.h) and
- * curvature = the surface variation of the robust plane. getScales() and getConfidences() hold,
- * per output point, the neighbours the plane used and their share of the neighbours found
- * (robust_plane_fit.h); for a wider plane of level l, the points its kernel reaches, about
- * 32 (l + 1)^2 (most of the weight within sqrt(l + 1) neighbourhood radii), and 1. NaN where the
- * point failed (fewer than 3 finite neighbours, or all on one line). The wider planes are formed
- * over the whole search surface (every point of it is a node of the graph), also when only some
- * indices are estimated.
+ * curvature = the surface variation of the robust plane (also where a wider plane gave the
+ * normal). getScales() and getConfidences() hold, per output point, the neighbours the plane used
+ * and their share of the neighbours found (robust_plane_fit.h); for a wider plane of level l its
+ * worth, 32 (l + 1) points (its weight spreads over about l + 1 neighbourhoods), at most the
+ * surface's, and 1. NaN where the point failed (fewer than 3 finite neighbours, or all on one
+ * line). Planes widen only with k >= kWideGraphWidth nearest (not a radius); the graph rows are
+ * the first 32 neighbours the search returns (the nearest, for a k-d tree). The wider planes
+ * are formed over the whole search surface (every point of it is a node of the graph), also
+ * when only some indices are estimated: their cost is the surface's.
  */
 #include <vector>
 
@@ -52,9 +54,11 @@ class RobustNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
     this->setNumberOfThreads(nr_threads);
   }
 
-  /** Per output point of the last compute(): the neighbours in the final fit. */
+  /** Per output point of the last compute(): the neighbours in the final fit (a wider plane:
+   *  32 (level + 1)). */
   const std::vector<float>& getScales() const { return scales_; }
-  /** Per output point of the last compute(): that number over the neighbours found, in [0, 1]. */
+  /** Per output point of the last compute(): the robust fit's neighbours over those found, in
+   *  [0, 1]; 1 for a wider plane. */
   const std::vector<float>& getConfidences() const { return confidences_; }
 
  protected:
@@ -74,7 +78,7 @@ class RobustNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
    *  points as noise (widening_planes.h), that plane's normal instead. query_graph: each
    *  query's nearest kWideGraphWidth of the neighbours its fit searched. */
   void widen(PointCloudOut& output, const std::vector<double>& largest_reference,
-             const NeighbourGraph& query_graph);
+             NeighbourGraph query_graph);
 
   std::vector<float> scales_, confidences_;
 };

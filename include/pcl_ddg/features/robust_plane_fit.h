@@ -46,8 +46,8 @@ struct RobustPlaneFit {
   int scale = 0;                   ///< neighbours in the final fit
   double confidence = 0.0;         ///< scale / neighbours found, in [0, 1]
   double noise = 0.0;              ///< sigma-hat, the robust residual scale (length)
-  /** The final fit's residual variance (length^2), lambda0 m / (m - 2) over its m points: the
-   *  noise variance where its plane is the surface. */
+  /** The final fit's residual variance (length^2), lambda0 m / (m - 3) over its m points (a plane
+   * takes 3 degrees of freedom): the noise variance where its plane is the surface. */
   double residual = 0.0;
 };
 

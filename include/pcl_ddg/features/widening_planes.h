@@ -31,13 +31,16 @@ struct NeighbourGraph {
   std::vector<int> neighbours;
 };
 
-/** Levels 0 .. kWideLevels - 1 are formed; the first kFirstWideLevel only lead up to the rest. */
+/** Levels 0 .. kWideLevels - 1 are formed; the first kFirstWideLevel only lead up to the rest,
+ *  level kFirstWideLevel - 1 being the reference. */
 constexpr int kWideLevels = 13;
 constexpr int kFirstWideLevel = 3;
+/** A kept level's residual variance is at most this many times the reference level's. */
+constexpr double kWideGrowth = 2.0;
 
 /** The widest plane of a query point. */
 struct WidePlane {
-  int level = -1;  ///< the level kept, -1 for none (a residual that grows from the start)
+  int level = -1;  ///< the level kept; -1 for none (the reference or the first wide level failed)
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit, sign arbitrary; level >= 0
 };
 
@@ -46,7 +49,8 @@ struct WidePlane {
  * A query that is a node (query_nodes[q] >= 0) has that node's moments; one that is not
  * (query_nodes[q] = -1) sums its own neighbours among the nodes, query_graph's row q. nodes and
  * queries in double relative to any common origin near the cloud. Deterministic: the same input
- * gives the same bits on any number of threads.
+ * gives the same bits on any number of threads. largest_reference[q]: the most residual
+ * variance the reference level of query q may have for any level to be kept (-1: none).
  */
 std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
                                     const NeighbourGraph& node_graph,

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
 
 #include "pcl_ddg/features/robust_normal_estimation.h"
 #include "pcl_ddg/features/robust_plane_fit.h"
@@ -17,16 +18,18 @@ void RobustNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& 
   scales_.assign(output.size(), nan);
   confidences_.assign(output.size(), nan);
   std::vector<double> largest_reference(output.size(), -1.0);  // none: no wider plane
-  // Each query's nearest kWideGraphWidth of those searched: its row of the graph wider planes
-  // are summed along.
+  // Planes widen from a k-nearest search (not a radius) along a graph whose rows are each
+  // query's first kWideGraphWidth neighbours found.
+  const bool widening = this->search_radius_ == 0.0 && this->k_ >= kWideGraphWidth;
   NeighbourGraph rows;
   rows.width = kWideGraphWidth;
-  rows.neighbours.assign(output.size() * kWideGraphWidth, -1);
+  if (widening) rows.neighbours.assign(output.size() * kWideGraphWidth, -1);
   this->fitEachNeighbourhood(
       output, [&](const Eigen::Matrix3Xd& neighbours, int count, const pcl::Indices& found,
                   pcl::index_t index, const Eigen::Vector3d& position, std::size_t i) {
-        std::copy_n(found.begin(), std::min(count, kWideGraphWidth),
-                    rows.neighbours.begin() + i * kWideGraphWidth);
+        if (widening)
+          std::copy_n(found.begin(), std::min(count, kWideGraphWidth),
+                      rows.neighbours.begin() + i * kWideGraphWidth);
         if (!position.allFinite()) return Outcome::Failed;
         const RobustPlaneFit plane = fitRobustPlane(neighbours, count);
         if (!plane.valid) return Outcome::Failed;
@@ -37,7 +40,7 @@ void RobustNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& 
         largest_reference[i] = kWideResidual * plane.residual;
         return Outcome::Fitted;
       });
-  if (this->k_ > 0 && this->search_radius_ == 0.0) widen(output, largest_reference, rows);
+  if (widening) widen(output, largest_reference, std::move(rows));
   this->makeOrientationConsistent(output, [](std::size_t) {});
 }
 
@@ -54,7 +57,7 @@ void RobustNormalEstimation<PointInT, PointOutT>::write(PointOutT& out, Eigen::V
 template <typename PointInT, typename PointOutT>
 void RobustNormalEstimation<PointInT, PointOutT>::widen(
     PointCloudOut& output, const std::vector<double>& largest_reference,
-    const NeighbourGraph& query_graph) {
+    NeighbourGraph query_graph) {
   const pcl::PointCloud<PointInT>& surface = *this->surface_;
   const pcl::PointCloud<PointInT>& input = *this->input_;
   const pcl::Indices& indices = *this->indices_;
@@ -91,8 +94,9 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
       if (has_row[node]) continue;
       has_row[node] = 1;
       std::copy_n(query_graph.neighbours.begin() + i * width, width,
-                  node_graph.neighbours.begin() + node * width);
+                  node_graph.neighbours.begin() + static_cast<std::size_t>(node) * width);
     }
+    query_graph = NeighbourGraph();  // every query is a node: its rows are no longer needed
   }
 #pragma omp parallel num_threads(threads)
   {
@@ -113,12 +117,13 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
   }
   const std::vector<WidePlane> planes = widestPlanes(nodes, node_graph, queries, query_nodes,
                                                      query_graph, largest_reference, threads);
+  const auto finite = static_cast<int>(std::count_if(
+      surface.begin(), surface.end(), [](const PointInT& p) { return pcl::isXYZFinite(p); }));
   for (std::size_t i = 0; i < planes.size(); ++i) {
     if (planes[i].level < 0) continue;
     write(output[i], planes[i].normal, indices[i],
           input[indices[i]].getVector3fMap().template cast<double>());
-    const int l = planes[i].level + 1;
-    scales_[i] = static_cast<float>(kWideGraphWidth * l * l);
+    scales_[i] = static_cast<float>(std::min(kWideGraphWidth * (planes[i].level + 1), finite));
     confidences_[i] = 1.0f;
   }
 }
