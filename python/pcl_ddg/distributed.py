@@ -343,6 +343,12 @@ def _peak_bytes() -> int:
     return _status_bytes("VmHWM", 0)
 
 
+def worker_baseline_bytes(resident: int) -> int:
+    """Where a tile's room starts: a worker's resident memory rounded down to a 16M step, plus 32M
+    for what it allocates around a tile (Dask's buffers, the output's serialisation)."""
+    return (resident // (16 << 20) + 2) * (16 << 20)
+
+
 def _resident_bytes() -> int:
     """This process's resident memory now (VmRSS)."""
     return _status_bytes("VmRSS", WORKER_BASELINE_BYTES)
@@ -379,6 +385,15 @@ def _fit(xyz, own_positions, options, halo_lo, halo_hi, bounds, mode):
         xyz, own_positions, o["method"], o["k"], o["radius"], o["max_nn"], list(o["viewpoint"]),
         o["orient"], None if o["up"] is None else list(o["up"]),
         None if halo_lo is None else list(halo_lo) + list(halo_hi), bounds, mode, o["threads"])
+
+
+def _read_json(path: str) -> Any:
+    """A state file's content, or None when it is missing or torn."""
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
 
 
 def _write_atomic(path: str, data: bytes) -> None:
@@ -665,13 +680,7 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
               "inputs": [(c.path, os.path.getsize(c.path), os.path.getmtime(c.path))
                          for c in clouds]}
     config_path = os.path.join(state, "run.json")
-    previous = None
-    if os.path.exists(config_path):
-        try:
-            with open(config_path) as f:
-                previous = json.load(f)
-        except (OSError, ValueError):
-            previous = None
+    previous = _read_json(config_path)
     if previous != json.loads(json.dumps(config)) or not resume:
         shutil.rmtree(state, ignore_errors=True)
     for sub in ("tiles", "attempts"):
@@ -685,29 +694,29 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
         dashboard = _dashboard(client)
         if progress:
             stream.write(f"pcl_ddg.distributed: dashboard {dashboard}\n")
-        # The tile size: what the limit leaves above the workers' own resident memory (rounded
-        # up to 16M, so that a resumed run cuts the same plan).
+        # The tile size: what the limit leaves above the workers' own resident memory.
         try:
             resident = max(client.run(_resident_bytes).values())
         except Exception:  # noqa: BLE001
             resident = WORKER_BASELINE_BYTES
-        baseline = (resident // (16 << 20) + 2) * (16 << 20)
-        points_per_tile = (memory - baseline) // BYTES_PER_POINT
+        points_per_tile = (memory - worker_baseline_bytes(resident)) // BYTES_PER_POINT
+        plan_path = os.path.join(state, "plan.json")
+        # A resumed run keeps its tiles while they still fit under the limit: the workers'
+        # resident memory drifts between runs, and a new tile size would discard finished tiles.
+        started_plan = _read_json(plan_path) if resume else None
+        if started_plan and 4096 <= started_plan.get("points_per_tile", 0) \
+                <= (memory - resident) // BYTES_PER_POINT:
+            points_per_tile = started_plan["points_per_tile"]
         if points_per_tile < 4096:
             raise ValueError(f"--memory-per-worker {memory_per_worker} leaves no room for a tile "
                              f"(the workers hold {resident >> 20}M before any point)")
-        plan_path = os.path.join(state, "plan.json")
         started = time.perf_counter()
         plan = make_plan(client, clouds, points_per_tile, options)
         seconds_plan = time.perf_counter() - started
         described = json.loads(json.dumps({
             "lo": plan.lo, "hi": plan.hi, "dims": plan.dims, "tiles": plan.tiles,
             "points_per_tile": plan.points_per_tile, "halo_guess": plan.halo_guess}))
-        try:
-            with open(plan_path) as f:
-                same_plan = json.load(f) == described
-        except (OSError, ValueError):
-            same_plan = False
+        same_plan = _read_json(plan_path) == described
         if not same_plan:  # tiles of another plan are not this one's
             shutil.rmtree(os.path.join(state, "tiles"), ignore_errors=True)
             os.makedirs(os.path.join(state, "tiles"))

@@ -20,9 +20,17 @@ from conftest import run_tool, shared_data
 distributed = pytest.importorskip("distributed")
 import pcl_ddg.distributed as dd  # noqa: E402
 
-# Small tiles, so that the 131k-point scan is cut into several tiles (the workers hold about
-# 100M before any point; the tiles get what is left).
+# For a cluster of fresh workers (about 100M each before any point): tiles of about 30k points,
+# so that the 131k-point scan is cut into several.
 MEMORY = "140M"
+
+
+def memory(client, points=30000):
+    """A limit that leaves tiles of `points` points above what the client's workers hold now:
+    they grow from test to test (from about 100M to 112M on some machines), which a fixed
+    limit would leave no room above."""
+    resident = max(client.run(dd._resident_bytes).values())
+    return dd.worker_baseline_bytes(resident) + points * dd.BYTES_PER_POINT
 
 
 @pytest.fixture(scope="module")
@@ -101,7 +109,7 @@ def test_merged_normals_equal_the_tool_on_the_merged_cloud(tmp_path, client, sce
     run_tool("pcl_ddg_normals", merged, expected, *args)
     out = tmp_path / "out"
     summary = dd.estimate_normals(paths, out, client=client, merge=str(out / "merged.ply"),
-                                  memory_per_worker=MEMORY, **keywords(args))
+                                  memory_per_worker=memory(client), **keywords(args))
     assert summary["tiles"] >= 4 and summary["points"] == 131622
     assert (out / "merged.ply").read_bytes() == expected.read_bytes()
 
@@ -118,7 +126,7 @@ def test_las_tiles_equal_the_tool_on_the_merged_las(tmp_path, client, las_scene,
     if "up" in args:
         options["orient"] = "up"
     dd.estimate_normals(paths, out, client=client, merge=str(out / ("m" + suffix)),
-                        memory_per_worker=MEMORY, **options)
+                        memory_per_worker=memory(client), **options)
     assert (out / ("m" + suffix)).read_bytes() == expected.read_bytes()
 
 
@@ -128,11 +136,11 @@ def test_curvature_pcd_and_per_file_outputs(tmp_path, client, scene):
     run_tool("pcl_ddg_curvature", merged, expected, "-method", "quadric", "-k", "20")
     out = tmp_path / "out"
     dd.principal_curvatures(paths, out, client=client, merge=str(tmp_path / "merged.pcd"),
-                            memory_per_worker=MEMORY, k=20)
+                            memory_per_worker=memory(client), k=20)
     assert (tmp_path / "merged.pcd").read_bytes() == expected.read_bytes()
     # Without --merge: one file per input, its points with the scene's neighbours (the merged
     # result's rows of that file).
-    summary = dd.estimate_normals(paths, out, client=client, memory_per_worker=MEMORY, k=16)
+    summary = dd.estimate_normals(paths, out, client=client, memory_per_worker=memory(client), k=16)
     run_tool("pcl_ddg_normals", merged, tmp_path / "tool.ply", "-k", "16", "-precision", "double")
     whole = pcl_ddg.read(tmp_path / "tool.ply").fields
     first = 0
@@ -201,7 +209,7 @@ def test_worker_killed_in_a_tile(tmp_path, scene, monkeypatch):
     thread.start()
     try:
         summary = dd.estimate_normals(paths, out, client=own, merge=str(out / "m.ply"),
-                                      memory_per_worker=MEMORY, k=16, retries=3)
+                                      memory_per_worker=memory(own), k=16, retries=3)
     finally:
         thread.join()
         cluster = own.cluster
@@ -216,8 +224,9 @@ def test_worker_killed_in_a_tile(tmp_path, scene, monkeypatch):
 def test_resume_does_only_the_missing_tiles(tmp_path, client, scene):
     paths, merged = scene
     out = tmp_path / "out"
+    limit = memory(client)
     first = dd.estimate_normals(paths, out, client=client, merge=str(out / "m.ply"),
-                                memory_per_worker=MEMORY, k=16)
+                                memory_per_worker=limit, k=16)
     state = out / dd.STATE_FOLDER / "normals" / "tiles"
     tiles = sorted(state.glob("tile_*.bin"))
     assert len(tiles) == first["tiles"] >= 4
@@ -228,8 +237,21 @@ def test_resume_does_only_the_missing_tiles(tmp_path, client, scene):
         t.unlink()
     half[0].write_bytes(half[0].read_bytes()[:-4])
     (out / "m.ply").unlink()
-    second = dd.estimate_normals(paths, out, client=client, merge=str(out / "m.ply"),
-                                 memory_per_worker=MEMORY, k=16)
+    # The workers grew by a rounding step since (as they do between runs): the limit would now
+    # leave no room for the first run's tiles above the step, but it holds them above what the
+    # workers hold, so the run keeps its plan.
+    step = 16 << 20
+
+    def grow():
+        resident = dd._resident_bytes()
+        sys.pcl_ddg_ballast = b"\x01" * (step - resident % step + (1 << 20))
+
+    client.run(grow)
+    try:
+        second = dd.estimate_normals(paths, out, client=client, merge=str(out / "m.ply"),
+                                     memory_per_worker=limit, k=16)
+    finally:
+        client.run(lambda: delattr(sys, "pcl_ddg_ballast"))
     assert second["tiles_run"] == len(half)
     assert second["tiles_skipped"] == len(tiles) - len(half)
     run_tool("pcl_ddg_normals", merged, tmp_path / "tool.ply", "-k", "16")
