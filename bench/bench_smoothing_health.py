@@ -22,8 +22,9 @@ import scipy.sparse as sp
 
 import pcl_ddg
 
-POLICIES = {  # pcl_ddg.smooth keyword: the library's WeightUpdate
-    "frozen (default)": {},
+POLICIES = {  # pcl_ddg.smooth keywords: the library's WeightUpdate and thickness limit
+    "default (frozen, thickness limit 0.5)": {},
+    "frozen, no limit": {"thickness_limit": 0.0},
     "update_mass": {"update_mass": True},
     "rebuild_weights": {"rebuild_weights": True},
 }

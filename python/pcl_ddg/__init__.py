@@ -240,6 +240,7 @@ def smooth(
     freeze_weights: bool = False,
     update_mass: bool = False,
     rebuild_weights: bool = False,
+    thickness_limit: float = 0.5,
     fix_boundary: bool = False,
     allow_unstable: bool = False,
     preserve: str = "none",
@@ -270,6 +271,11 @@ def smooth(
         by default (``freeze_weights``) L and M stay those of the input; ``update_mass`` lets M
         follow the surface (conformalized mean-curvature flow), ``rebuild_weights`` rebuilds both
         every iteration (mean-curvature flow, which pinches thin parts into slivers).
+    thickness_limit:
+        a vertex where the solid is r thick (the radius of the largest empty ball touching it
+        from inside) smooths for at most about ``thickness_limit * r**2`` in all, so that
+        handles, legs and horns a few edges thick do not collapse into slivers; 0: no limit.
+        Area-averaged explicit and implicit steps only.
     fix_boundary: boundary vertices keep their position.
     preserve: ``"none"``, ``"volume"`` (closed meshes) or ``"area"``: rescale after every step.
     solver: ``"auto"``, ``"cholmod"``, ``"ldlt"`` or ``"cg"`` (conjugate gradients).
@@ -292,6 +298,7 @@ def smooth(
         bool(freeze_weights),
         bool(update_mass),
         bool(rebuild_weights),
+        float(thickness_limit),
         bool(fix_boundary),
         bool(allow_unstable),
         preserve,

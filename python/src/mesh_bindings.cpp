@@ -192,8 +192,8 @@ void bindMeshes(py::module_& m) {
          std::optional<std::string> mass, std::optional<double> lambda_dt,
          std::optional<double> lambda_, std::optional<double> mu, int iterations,
          bool absolute_time, bool freeze_weights, bool update_mass, bool rebuild_weights,
-         bool fix_boundary, bool allow_unstable, const std::string& preserve,
-         const std::string& solver) {
+         double thickness_limit, bool fix_boundary, bool allow_unstable,
+         const std::string& preserve, const std::string& solver) {
         // pcl_ddg_smooth's options and defaults (tools/pcl_ddg_smooth.cpp).
         MeshSmoothingParameters p;
         const std::string scheme = choice("method", method, {"implicit", "explicit", "taubin"});
@@ -213,6 +213,9 @@ void bindMeshes(py::module_& m) {
               "freeze_weights, update_mass and rebuild_weights exclude each other");
         if (update_mass) p.weight_update = WeightUpdate::FrozenStiffness;
         if (rebuild_weights) p.weight_update = WeightUpdate::EveryIteration;
+        if (!(thickness_limit >= 0.0) || !std::isfinite(thickness_limit))
+          throw py::value_error("thickness_limit must be >= 0 (0: none)");
+        p.thickness_limit = thickness_limit;
         if (fix_boundary) p.boundary = BoundaryCondition::Fixed;
         const std::string keep = choice("preserve", preserve, {"none", "volume", "area"});
         p.shrinkage = keep == "volume" ? ShrinkageCorrection::PreserveVolume
@@ -249,8 +252,8 @@ void bindMeshes(py::module_& m) {
       py::arg("lambda_") = py::none(), py::arg("mu") = -0.53, py::arg("iterations") = 1,
       py::arg("absolute_time") = false, py::arg("freeze_weights") = false,
       py::arg("update_mass") = false, py::arg("rebuild_weights") = false,
-      py::arg("fix_boundary") = false, py::arg("allow_unstable") = false,
-      py::arg("preserve") = "none", py::arg("solver") = "auto",
+      py::arg("thickness_limit") = 0.5, py::arg("fix_boundary") = false,
+      py::arg("allow_unstable") = false, py::arg("preserve") = "none", py::arg("solver") = "auto",
       "smoothMeshPositions with pcl_ddg_smooth's options.");
 
   m.def(

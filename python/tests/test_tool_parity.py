@@ -56,6 +56,8 @@ def test_smooth_field_equals_pcl_ddg_curvature_smooth(tmp_path):
 @pytest.mark.parametrize("arguments", [[], ["-method", "explicit", "-iterations", "20"],
                                        ["-lambda_dt", "5", "-preserve", "volume",
                                         "-iterations", "3", "-update_mass"],
+                                       ["-lambda_dt", "5", "-thickness_limit", "0"],
+                                       ["-lambda_dt", "5", "-thickness_limit", "2"],
                                        ["-method", "taubin", "-lambda", "0.4", "-mu", "-0.45",
                                         "-iterations", "10"],
                                        ["-method", "explicit", "-weights", "cotan",
@@ -81,6 +83,8 @@ def test_smooth_equals_pcl_ddg_smooth(tmp_path, arguments):
             keywords["lambda_"] = float(value)
         elif flag == "-mu":
             keywords["mu"] = float(value)
+        elif flag == "-thickness_limit":
+            keywords["thickness_limit"] = float(value)
         elif flag in ("-weights", "-average"):
             keywords[flag[1:]] = value
     smoothed = pcl_ddg.smooth(mesh.points, mesh.faces, **keywords)

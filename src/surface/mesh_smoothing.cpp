@@ -8,10 +8,12 @@
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "laplacian_flow.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/surface/inner_ball.h"
 
 namespace pcl_ddg {
 namespace {
@@ -23,12 +25,6 @@ namespace {
 [[noreturn]] void failedAt(int iteration, const std::string& what) {
   throw pcl::ComputeFailedException("smoothing iteration " + std::to_string(iteration) + ": " +
                                     what);
-}
-
-bool isClosedAndOriented(const MeshTopology& topology) {
-  const TopologyCounts& counts = topology.counts();
-  return counts.boundary_edges == 0 && counts.nonmanifold_edges == 0 &&
-         counts.consistently_oriented && topology.numTriangles() > 0;
 }
 
 // Area-weighted centroid of the triangles: the point the shrinkage correction scales about.
@@ -81,6 +77,30 @@ Eigen::VectorXd averageOf(const Eigen::SparseMatrix<double>& l, const MeshTopolo
   return -Eigen::VectorXd(l.diagonal());
 }
 
+/** s_i = max(1, time / (limit r_i^2)), its logarithm smoothed by one implicit step of the
+ *  input's operator (see the header: a slowdown that changed faster than the flow smooths would
+ *  itself roughen a curved surface, and a single noise bump reads as thin). */
+Eigen::ArrayXd thinPartSlowdown(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
+                                const MeshSmoothingParameters& p) {
+  const double time = p.time_step * p.iterations;
+  const Eigen::ArrayXd radii = innerBallRadii(topology, positions).array();
+  // Capped where a radius rounds to nothing: such a vertex just stays (r = inf gives 1).
+  Eigen::MatrixXd log_slowdown =
+      (time / (p.thickness_limit * radii.square())).max(1.0).min(1e12).log().matrix();
+  if ((log_slowdown.array() == 0.0).all()) return Eigen::ArrayXd::Ones(positions.cols());
+  // For at most four times what the median vertex gets (its diffusion length doubled): longer
+  // would even out thin and thick parts once the time asked is far beyond the thick parts' own
+  // limit.
+  std::vector<double> sorted(log_slowdown.data(), log_slowdown.data() + log_slowdown.size());
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double median_time = time / std::exp(sorted[sorted.size() / 2]);
+  detail::LaplacianFlow heat(topology.numVertices(), {}, p.solver, p.implicit_solver);
+  heat.setOperator(laplacian(topology, positions, p.weights, LaplacianForm::Summed),
+                   lumpedMass(topology, positions, p.mass));
+  heat.implicitStep(log_slowdown, std::min(time, 4.0 * median_time));
+  return log_slowdown.array().max(0.0).exp();
+}
+
 }  // namespace
 
 double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& positions,
@@ -95,6 +115,12 @@ double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& 
     largest = std::max(largest, row / m[v]);
   }
   return largest > 0.0 ? 2.0 / largest : std::numeric_limits<double>::infinity();
+}
+
+bool isClosedAndOriented(const MeshTopology& topology) {
+  const TopologyCounts& counts = topology.counts();
+  return counts.boundary_edges == 0 && counts.nonmanifold_edges == 0 &&
+         counts.consistently_oriented && topology.numTriangles() > 0;
 }
 
 double enclosedVolume(const MeshTopology& topology, const PositionsRef& positions) {
@@ -133,6 +159,9 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   if (p.scheme == SmoothingScheme::Taubin && !(p.taubin_mu < -p.time_step)) {
     badArgument("Taubin's mu must be below -lambda (e.g. lambda 0.5, mu -0.53)");
   }
+  if (!(p.thickness_limit >= 0.0) || !std::isfinite(p.thickness_limit)) {
+    badArgument("the thickness limit must be >= 0 (0: none)");
+  }
   if (p.shrinkage != ShrinkageCorrection::None && p.boundary == BoundaryCondition::Fixed) {
     badArgument("a shrinkage correction rescales the whole mesh: it cannot keep a fixed boundary");
   }
@@ -146,15 +175,25 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   }
   detail::LaplacianFlow flow(n, std::move(fixed), p.solver, p.implicit_solver);
   flow.planSteps(p.iterations, p.weight_update == WeightUpdate::Frozen ? 1 : p.iterations);
+  MeshSmoothingReport r;
+  // Thin parts move more slowly (see the header): s_i multiplies vertex i's mass.
+  Eigen::ArrayXd slowdown = Eigen::ArrayXd::Ones(n);
+  if (p.thickness_limit > 0.0 && p.average == FlowAverage::Area &&
+      p.scheme != SmoothingScheme::Taubin) {
+    slowdown = thinPartSlowdown(topology, positions, p);
+    r.thin_vertices = static_cast<int>((slowdown > 1.0 / 0.9).count());
+    r.mean_time_fraction = slowdown.inverse().mean();
+  }
   Eigen::SparseMatrix<double> stiffness;
   const auto setOperator = [&](const Eigen::Matrix3Xd& at) {
     stiffness = laplacian(topology, at, p.weights, LaplacianForm::Summed);
-    flow.setOperator(stiffness, averageOf(stiffness, topology, at, p.mass, p.average));
+    flow.setOperator(
+        stiffness,
+        (averageOf(stiffness, topology, at, p.mass, p.average).array() * slowdown).matrix());
   };
 
   // The before and after measures are for the report, and the shrinkage corrections' targets.
   const bool closed = isClosedAndOriented(topology);
-  MeshSmoothingReport r;
   r.solver = flow.backend();
   r.area_before = surfaceArea(topology, positions);
   if (closed) r.volume_before = enclosedVolume(topology, positions);
@@ -176,7 +215,7 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
     // A degree average belongs to the stiffness: with it frozen, nothing follows the surface.
     if (iteration > 1 && p.weight_update == WeightUpdate::FrozenStiffness &&
         p.average == FlowAverage::Area)
-      flow.setMass(lumpedMass(topology, current, p.mass));
+      flow.setMass((lumpedMass(topology, current, p.mass).array() * slowdown).matrix());
     if (p.scheme == SmoothingScheme::Explicit) {
       flow.explicitStep(values, p.time_step);
     } else if (p.scheme == SmoothingScheme::Taubin) {

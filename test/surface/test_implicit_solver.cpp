@@ -26,6 +26,7 @@ MeshSmoothingParameters implicitStep(const MeshTopology& topology, const Eigen::
   MeshSmoothingParameters p;
   p.time_step = h2_units * squaredEdge(topology, x);
   p.implicit_solver = solver;
+  p.thickness_limit = 0.0;  // the flow itself: the steps are compared with backward Euler
   return p;
 }
 

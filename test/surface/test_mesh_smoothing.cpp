@@ -68,6 +68,7 @@ TEST(MeshSmoothing, ExplicitLargeStepBlowsUpWhileImplicitWithTheSameStepStaysBou
   p.time_step = 10.0 * limit;
   p.iterations = 8;
   p.weight_update = WeightUpdate::Frozen;
+  p.thickness_limit = 0.0;  // the flow itself (the limit would slow the noise's bumps)
 
   p.scheme = SmoothingScheme::Explicit;
   const double explicit_radius =
@@ -111,6 +112,12 @@ TEST(MeshSmoothing, AStepThatCollapsesTheSurfaceIsAnErrorNotASliverWarning) {
   const double h2 = squaredEdge(topology, sphere.points);
   MeshSmoothingParameters p;
   p.time_step = 1e9 * h2;
+  // With the default thickness limit no vertex smooths for more than 0.5 r^2 (r = 1, the
+  // sphere's inner ball): one implicit step of at most 0.5 on the sphere's coordinate functions
+  // (eigenvalue 2 / r^2) leaves a radius of about 1 / (1 + 2 * 0.5) = 0.5.
+  const Eigen::Matrix3Xd limited = smoothMeshPositions(topology, sphere.points, p);
+  EXPECT_GT(limited.colwise().norm().minCoeff(), 0.45);
+  p.thickness_limit = 0.0;  // the flow itself
   for (const ShrinkageCorrection correction :
        {ShrinkageCorrection::None, ShrinkageCorrection::PreserveVolume,
         ShrinkageCorrection::PreserveArea}) {
@@ -198,6 +205,9 @@ TEST(MeshSmoothing, VolumeAndAreaArePreservedWhenAsked) {
   MeshSmoothingParameters p;
   p.time_step = 1.0 * squaredEdge(topology, noisy);
   p.iterations = 5;
+  // The flow itself: noise bumps 0.7 h deep read as parts thinner than the limit allows for
+  // this time, and would be smoothed less.
+  p.thickness_limit = 0.0;
   const double volume = enclosedVolume(topology, noisy), area = surfaceArea(topology, noisy);
 
   MeshSmoothingReport plain;
@@ -283,6 +293,7 @@ TEST(MeshSmoothing, CowExplicitManySmallStepsAndImplicitOneLargeStepGiveComparab
   MeshSmoothingParameters small_steps;
   small_steps.scheme = SmoothingScheme::Explicit;
   small_steps.weight_update = WeightUpdate::Frozen;
+  small_steps.thickness_limit = 0.0;  // the flow itself
   small_steps.time_step = 0.001 * h2;
   small_steps.iterations = 1000;
   MeshSmoothingParameters one_step = small_steps;
@@ -308,6 +319,7 @@ TEST(MeshSmoothing, FrozenImplicitStepsAreTheBackwardEulerOperatorAndBothSolvers
   p.time_step = 0.5 * squaredEdge(topology, torus.points);
   p.iterations = 3;
   p.weight_update = WeightUpdate::Frozen;
+  p.thickness_limit = 0.0;  // the flow itself (ThinPartsSmoothForAtMost... tests the limit)
 
   const Eigen::Matrix3Xd reference =
       frozenBackwardEuler(topology, torus.points, p.time_step, p.iterations);
@@ -337,6 +349,7 @@ TEST(MeshSmoothing, FrozenStiffnessKeepsTheInputsStiffnessAndTakesEachStepsMass)
   p.iterations = 3;
   p.implicit_solver = ImplicitSolver::Cholesky;
   p.weight_update = WeightUpdate::FrozenStiffness;
+  p.thickness_limit = 0.0;  // the flow itself
   const Eigen::Matrix3Xd ours = smoothMeshPositions(t, s.points, p);
   p.weight_update = WeightUpdate::Frozen;
   const Eigen::Matrix3Xd frozen = smoothMeshPositions(t, s.points, p);
@@ -423,12 +436,14 @@ TEST(MeshSmoothing, NothingFreeToSolveForLeavesTheInputUnchanged) {
   }
 }
 
-TEST(MeshSmoothing, TheDefaultFrozenOperatorMakesFewerSliversOnTheCoarseCow) {
-  // Three implicit cotangent steps of 2 h^2 keeping the volume. Rebuilding the cotangent weights
-  // every step (mean-curvature flow) pinches triangles into slivers (a corner under 1 deg); letting
-  // the mass follow the surface (conformalized flow, Kazhdan et al. 2012) pinches the coarse cow's
-  // thin legs and horns into more of them than the default, which freezes the whole operator.
-  const auto slivers = [](const char* file, WeightUpdate update) {
+TEST(MeshSmoothing, TheDefaultKeepsTheCoarseCowsThinPartsHealthyUnderEveryWeightUpdate) {
+  // Three implicit cotangent steps of 2 h^2 keeping the volume. Without the thickness limit,
+  // rebuilding the cotangent weights every step (mean-curvature flow) pinches triangles into
+  // slivers (a corner under 1 deg); letting the mass follow the surface (conformalized flow,
+  // Kazhdan et al. 2012) pinches the coarse cow's thin legs and horns into more of them than
+  // freezing the whole operator. With the default limit (0.5 r^2) none of the three makes more
+  // than 0.1 % new slivers (the bound), and each still smooths the surface.
+  const auto slivers = [](const char* file, WeightUpdate update, double limit) {
     const pcl::PolygonMesh mesh = loadMesh(sharedData(file));
     const MeshTopology topology(mesh);
     const Eigen::Matrix3Xd x = vertexPositions(mesh.cloud);
@@ -437,20 +452,81 @@ TEST(MeshSmoothing, TheDefaultFrozenOperatorMakesFewerSliversOnTheCoarseCow) {
     p.iterations = 3;
     p.shrinkage = ShrinkageCorrection::PreserveVolume;
     p.weight_update = update;
+    p.thickness_limit = limit;
     MeshSmoothingReport report;
     smoothMeshPositions(topology, x, p, &report);
-    EXPECT_LT(report.area_after, report.area_before);  // all three smooth
+    EXPECT_LT(report.area_after, 0.995 * report.area_before) << file;  // all smooth
     return static_cast<double>(report.quality_after.slivers - report.quality_before.slivers) /
            static_cast<double>(topology.numTriangles());
   };
   EXPECT_EQ(MeshSmoothingParameters().weight_update, WeightUpdate::Frozen);
-  EXPECT_EQ(slivers("meshes/bunny.off", WeightUpdate::Frozen), 0.0);
-  EXPECT_GE(slivers("meshes/bunny.off", WeightUpdate::EveryIteration), 0.01);
-  const double frozen = slivers("meshes/cow.off", WeightUpdate::Frozen);
-  const double mass_follows = slivers("meshes/cow.off", WeightUpdate::FrozenStiffness);
-  const double rebuilt = slivers("meshes/cow.off", WeightUpdate::EveryIteration);
+  EXPECT_EQ(MeshSmoothingParameters().thickness_limit, 0.5);
+  EXPECT_EQ(slivers("meshes/bunny.off", WeightUpdate::Frozen, 0.0), 0.0);
+  EXPECT_GE(slivers("meshes/bunny.off", WeightUpdate::EveryIteration, 0.0), 0.01);
+  const double frozen = slivers("meshes/cow.off", WeightUpdate::Frozen, 0.0);
+  const double mass_follows = slivers("meshes/cow.off", WeightUpdate::FrozenStiffness, 0.0);
+  const double rebuilt = slivers("meshes/cow.off", WeightUpdate::EveryIteration, 0.0);
+  EXPECT_GT(frozen, 0.05);
   EXPECT_LT(frozen, 0.7 * mass_follows) << frozen << " " << mass_follows;
   EXPECT_LT(mass_follows, 0.7 * rebuilt) << mass_follows << " " << rebuilt;
+  for (const char* file : {"meshes/cow.off", "meshes/bunny.off"}) {
+    for (const WeightUpdate update :
+         {WeightUpdate::Frozen, WeightUpdate::FrozenStiffness, WeightUpdate::EveryIteration}) {
+      EXPECT_LE(slivers(file, update, 0.5), 0.001) << file << " " << static_cast<int>(update);
+    }
+  }
+}
+
+TEST(MeshSmoothing, ThinPartsSmoothForAtMostTheLimitTimesTheirRadiusSquared) {
+  // A thin torus (tube radius a about 1.3 h) beside a sphere of radius 3, one mesh of two
+  // components. Three implicit steps of 2 h^2 (6 h^2 = 3.4 a^2 in all) draw the tube towards its
+  // axis: its lowest mode around the tube decays by 1 + tau / a^2 per step, to about 0.1 a. With
+  // the limit (0.5 a^2 in all) it keeps about (1 + 0.5 / 3)^-3 = 0.63 a. The sphere (r = 3, far
+  // above the limit's reach) gets the whole time either way: its vertices move the same.
+  const SurfaceSample torus = makeTorus({48, 0.0, 1}, 1.0, 0.12);
+  const SurfaceSample sphere = makeIcosphere(3, 3.0);
+  const int torus_vertices = static_cast<int>(torus.points.cols());
+  Eigen::Matrix3Xd x(3, torus.points.cols() + sphere.points.cols());
+  x << torus.points, (sphere.points.colwise() + Eigen::Vector3d(6.0, 0.0, 0.0));
+  Eigen::Matrix3Xi triangles(3, torus.triangles.cols() + sphere.triangles.cols());
+  triangles << torus.triangles, (sphere.triangles.array() + torus_vertices).matrix();
+  const MeshTopology topology(static_cast<int>(x.cols()), triangles);
+  const double h2 = squaredEdge(topology, x);
+  const double a = 0.12;
+  ASSERT_LT(a * a, 2.0 * h2);
+
+  const auto tubeRadius = [&](const Eigen::Matrix3Xd& y) {  // mean distance to the ring's circle
+    const Eigen::ArrayXd ring = y.topRows<2>().leftCols(torus_vertices).colwise().norm().array();
+    const double major = ring.mean();
+    return ((ring - major).square() +
+            y.row(2).leftCols(torus_vertices).array().transpose().square())
+        .sqrt()
+        .mean();
+  };
+  MeshSmoothingParameters p;
+  p.time_step = 2.0 * h2;
+  p.iterations = 3;
+  MeshSmoothingReport report;
+  const Eigen::Matrix3Xd limited = smoothMeshPositions(topology, x, p, &report);
+  p.thickness_limit = 0.0;
+  MeshSmoothingReport unlimited_report;
+  const Eigen::Matrix3Xd unlimited = smoothMeshPositions(topology, x, p, &unlimited_report);
+  std::printf("tube radius %.4f: limited %.4f, unlimited %.4f; %d thin vertices\n", a,
+              tubeRadius(limited), tubeRadius(unlimited), report.thin_vertices);
+  EXPECT_GT(tubeRadius(limited), 0.55 * a);
+  EXPECT_LT(tubeRadius(unlimited), 0.2 * a);
+  EXPECT_EQ(report.thin_vertices, torus_vertices);
+  EXPECT_EQ(unlimited_report.thin_vertices, 0);
+  EXPECT_LT((limited.rightCols(sphere.points.cols()) - unlimited.rightCols(sphere.points.cols()))
+                .cwiseAbs()
+                .maxCoeff(),
+            1e-12);
+  EXPECT_GT((unlimited.rightCols(sphere.points.cols()) - x.rightCols(sphere.points.cols()))
+                .cwiseAbs()
+                .maxCoeff(),
+            0.1);  // and the sphere did move
+  EXPECT_GT(report.quality_after.min_angle_degrees, 1.0);
+  EXPECT_LT(unlimited_report.quality_after.min_angle_degrees, 1.0);
 }
 
 // One umbrella step by brute force: every vertex moves lambda of the way to the mean of its
@@ -630,6 +706,11 @@ TEST(MeshSmoothing, BadInputAndParametersAreRejectedAndTheInputIsNeverModified) 
   bad.scheme = SmoothingScheme::Taubin;
   bad.taubin_mu = -p.time_step;
   EXPECT_THROW(smoothMeshPositions(topology, sphere.points, bad), pcl::BadArgumentException);
+  for (const double limit : {-0.5, std::nan(""), HUGE_VAL}) {
+    bad = p;
+    bad.thickness_limit = limit;
+    EXPECT_THROW(smoothMeshPositions(topology, sphere.points, bad), pcl::BadArgumentException);
+  }
   bad = p;
   bad.shrinkage = ShrinkageCorrection::PreserveArea;
   bad.boundary = BoundaryCondition::Fixed;
@@ -646,6 +727,7 @@ TEST(MeshSmoothing, BadInputAndParametersAreRejectedAndTheInputIsNeverModified) 
   smoothing.setInputMesh(input);
   smoothing.setScheme(SmoothingScheme::Explicit);
   smoothing.setWeightUpdate(WeightUpdate::Frozen);
+  smoothing.setThicknessLimit(0.0);  // unstable steps, not slowed
   smoothing.setTimeStep(10.0);
   smoothing.setNumberOfIterations(1000);
   pcl::PolygonMesh output;

@@ -138,9 +138,11 @@ TEST_F(SmoothingTools, ExplicitStepsAboveTheStabilityBoundAreRefusedUnlessAllowe
 }
 
 TEST_F(SmoothingTools, AStepThatCollapsesTheScanFailsNamingLambdaDt) {
-  // 1e9 h^2 squeezes the cow to a point: exit 1, one line that names the remedy, no output.
-  const ToolRun run = runTool(PCL_DDG_SMOOTH_TOOL, sharedData("meshes/cow.off") + " " +
-                                                       path("out.ply") + " -lambda_dt 1e9");
+  // Without the thickness limit, 1e9 h^2 squeezes the cow to a point: exit 1, one line that
+  // names the remedy, no output.
+  const ToolRun run =
+      runTool(PCL_DDG_SMOOTH_TOOL, sharedData("meshes/cow.off") + " " + path("out.ply") +
+                                       " -lambda_dt 1e9 -thickness_limit 0");
   EXPECT_EQ(run.exit_code, 1) << run.err;
   EXPECT_NE(run.err.find("pcl_ddg_smooth: error: smoothing iteration 1: the surface collapsed"),
             std::string::npos)
@@ -149,9 +151,25 @@ TEST_F(SmoothingTools, AStepThatCollapsesTheScanFailsNamingLambdaDt) {
   EXPECT_FALSE(std::filesystem::exists(path("out.ply")));
   // With the volume preserved the remnant would be inflated back into a needle: refused too.
   EXPECT_EQ(runTool(PCL_DDG_SMOOTH_TOOL, sharedData("meshes/cow.off") + " " + path("out.ply") +
-                                             " -lambda_dt 1e9 -preserve volume")
+                                             " -lambda_dt 1e9 -preserve volume -thickness_limit 0")
                 .exit_code,
             1);
+  // With it (the default) no vertex smooths for more than half its thickness squared: the cow
+  // keeps its shape, and the run says how many vertices it slowed.
+  const ToolRun limited = runTool(PCL_DDG_SMOOTH_TOOL, sharedData("meshes/cow.off") + " " +
+                                                           path("out.ply") + " -lambda_dt 1e9");
+  EXPECT_EQ(limited.exit_code, 0) << limited.err;
+  EXPECT_NE(limited.err.find("pcl_ddg_smooth: -thickness_limit 0.5: "), std::string::npos)
+      << limited.err;
+  EXPECT_NE(limited.err.find(" vertices got under 0.9 of the time (the solid is under "),
+            std::string::npos)
+      << limited.err;
+  EXPECT_NE(limited.err.find("slivers (a corner < 1 deg) 0 -> 0"), std::string::npos)
+      << limited.err;
+  EXPECT_EQ(runTool(PCL_DDG_SMOOTH_TOOL,
+                    sharedData("meshes/cow.off") + " " + path("out.ply") + " -thickness_limit -1")
+                .exit_code,
+            2);
 }
 
 TEST_F(SmoothingTools, MeshQualityIsReportedAndAnOpenScanWarnsAboutItsShrinkingBoundary) {

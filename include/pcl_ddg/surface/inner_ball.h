@@ -1,0 +1,38 @@
+#pragma once
+/** \file
+ * How thick the solid behind each vertex is: the radius of the largest empty ball that touches
+ * the surface at the vertex from its inner side (the side opposite its normal).
+ *
+ * Shrinking balls (Ma, Bae, Choi and Ramanathan 2012, "3D medial axis point approximation using
+ * nearest neighbors and the normal field"): start from a ball of radius r = the bounding-box
+ * diagonal centred at c = p - r n (n the outward unit normal at p). While the vertex q nearest to c
+ * lies strictly inside the ball, replace it by the ball through p and q that is still tangent at p:
+ *
+ *     |p - r' n - q|^2 = r'^2   =>   r' = |p - q|^2 / (2 n . (p - q))
+ *
+ * (q inside the ball means n . (p - q) > |p - q|^2 / (2 r) > 0, so r' < r: the radius only
+ * shrinks). It stops when no vertex is inside. On a tube of radius a the result is a, on a sphere
+ * its radius, on a plate half its thickness; only vertices are tested, so on a coarse mesh it can
+ * exceed the true radius by the sagitta of an edge. A convex bump of height e on edges of length h
+ * stops it at about h^2 / (2 e): noise reads as thin only where it is as deep as the part is thin.
+ * A normal tilted by d radians lets the ball out between p and its nearest vertices unless
+ * r <= R / (1 + 2 d R / h): the estimate is a few per cent low where R is a few edges (the thin
+ * parts it is for), up to a fifth low on fine, gently curved surfaces.
+ *
+ * The outward side is the faces' orientation, turned over when a closed mesh encloses a negative
+ * volume (faces wound inward). Vertices without a valid normal (no non-degenerate triangle, or
+ * face normals that cancel) get +infinity, as does a vertex no other vertex constrains. Vertices
+ * of no triangle take no part. Coordinates are taken about the vertices' mean (scans sit far
+ * from the origin).
+ */
+#include <Eigen/Core>
+
+#include "pcl_ddg/mesh/mesh_topology.h"
+#include "pcl_ddg/mesh/positions_ref.h"
+
+namespace pcl_ddg {
+
+/** The inner-ball radius of every vertex (see above); deterministic for any thread count. */
+Eigen::VectorXd innerBallRadii(const MeshTopology& topology, const PositionsRef& positions);
+
+}  // namespace pcl_ddg

@@ -1,0 +1,106 @@
+// Inner-ball radii: the radius of a sphere, the tube of a torus, half a plate's thickness; nothing
+// on an open plane; the same far from the origin, with the faces wound inward, or with a vertex
+// doubled.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "analytic_surfaces.h"
+#include "estimator_support.h"
+#include "pcl_ddg/surface/inner_ball.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+TEST(InnerBall, ASpheresRadiusAndATorusTube) {
+  // Only vertices are tested, so a ball can bulge between them by an edge's sagitta (2 % here).
+  // A vertex normal tilted by d (radians) from the true one lets the ball out between p and its
+  // nearest vertices (at h) unless r <= R / (1 + 2 d R / h): the icospheres' area-weighted
+  // normals tilt by up to 2 deg (coarse) and 0.1 deg (fine), which takes up to 20 % off; on the
+  // torus, whose normals are exact by symmetry, a few per cent.
+  const SurfaceSample sphere = makeIcosphere(2, 2.0);
+  const Eigen::VectorXd on_sphere = innerBallRadii(topologyOf(sphere), sphere.points);
+  EXPECT_GT(on_sphere.minCoeff(), 2.0 * 0.8);
+  EXPECT_LT(on_sphere.maxCoeff(), 2.0 * 1.02);
+  const SurfaceSample fine_sphere = makeIcosphere(4, 2.0);
+  const Eigen::VectorXd on_fine_sphere =
+      innerBallRadii(topologyOf(fine_sphere), fine_sphere.points);
+  EXPECT_GT(on_fine_sphere.minCoeff(), 2.0 * 0.8);
+  EXPECT_LT(on_fine_sphere.maxCoeff(), 2.0 * 1.02);
+
+  const SurfaceSample torus = makeTorus({96, 0.0, 1}, 1.0, 0.25);
+  const Eigen::VectorXd on_torus = innerBallRadii(topologyOf(torus), torus.points);
+  EXPECT_GT(on_torus.minCoeff(), 0.25 * 0.97);
+  EXPECT_LT(on_torus.maxCoeff(), 0.25 * 1.02);
+}
+
+TEST(InnerBall, APlateIsHalfItsThicknessAPlaneUnbounded) {
+  // Two parallel sheets 0.2 apart, wound as a slab's faces (outward normals): inside, 0.1.
+  const SurfaceSample plane = makePlane({16, 0.0, 1});
+  const Eigen::VectorXd open = innerBallRadii(topologyOf(plane), plane.points);
+  EXPECT_TRUE(open.array().isInf().all());
+
+  const int n = static_cast<int>(plane.points.cols());
+  Eigen::Matrix3Xd x(3, 2 * n);
+  x << plane.points.colwise() + Eigen::Vector3d(0, 0, 0.1),
+      plane.points.colwise() - Eigen::Vector3d(0, 0, 0.1);
+  Eigen::Matrix3Xi triangles(3, 2 * plane.triangles.cols());
+  Eigen::Matrix3Xi lower = plane.triangles.array() + n;
+  lower.row(1).swap(lower.row(2));  // the lower sheet faces down
+  triangles << plane.triangles, lower;
+  const Eigen::VectorXd plate = innerBallRadii(MeshTopology(2 * n, triangles), x);
+  // Interior vertices only: at the sheets' open edges the ball may leave through the side.
+  int interior = 0;
+  for (int v = 0; v < 2 * n; ++v) {
+    if (x.col(v).head<2>().cwiseAbs().maxCoeff() > 0.8) continue;
+    EXPECT_NEAR(plate[v], 0.1, 1e-9) << v;
+    ++interior;
+  }
+  EXPECT_GT(interior, 100);
+}
+
+TEST(InnerBall, TheSameFarFromTheOriginWoundInwardOrWithADoubledVertex) {
+  const SurfaceSample torus = makeTorus({48, 0.0, 1}, 1.0, 0.3);
+  const MeshTopology topology = topologyOf(torus);
+  const Eigen::VectorXd radii = innerBallRadii(topology, torus.points);
+  ASSERT_TRUE(radii.allFinite());
+
+  SurfaceSample far = torus;
+  far.rotateAndShiftFar();
+  const Eigen::VectorXd far_radii = innerBallRadii(topology, far.points);
+  EXPECT_LT((far_radii - radii).cwiseAbs().maxCoeff(), 1e-6 * radii.maxCoeff());
+
+  Eigen::Matrix3Xi inward = torus.triangles;
+  inward.row(1).swap(inward.row(2));
+  const Eigen::VectorXd inward_radii =
+      innerBallRadii(MeshTopology(static_cast<int>(torus.points.cols()), inward), torus.points);
+  EXPECT_EQ(inward_radii, radii);
+
+  // A second copy of vertex 0 (as scans have), in no triangle, and one in a triangle: the ball
+  // at vertex 0 is not stopped by its own duplicate.
+  const int n = static_cast<int>(torus.points.cols());
+  Eigen::Matrix3Xd doubled(3, n + 1);
+  doubled << torus.points, torus.points.col(0);
+  Eigen::Matrix3Xi with_copy(3, torus.triangles.cols());
+  with_copy = torus.triangles;
+  for (Eigen::Index t = 0; t < with_copy.cols(); ++t) {
+    for (int c = 0; c < 3; ++c) {
+      if (with_copy(c, t) == 0 && t % 2 == 0) with_copy(c, t) = n;
+    }
+  }
+  const Eigen::VectorXd isolated_copy =
+      innerBallRadii(MeshTopology(n + 1, torus.triangles), doubled);
+  EXPECT_TRUE(std::isinf(isolated_copy[n]));
+  EXPECT_EQ(isolated_copy.head(n), radii);
+  const Eigen::VectorXd shared_copy = innerBallRadii(MeshTopology(n + 1, with_copy), doubled);
+  // Sharing vertex 0's triangles, the copy tilts both normals a little (0.3 * 0.75 on this
+  // coarse torus), but neither ball stops at the other (it would be 0).
+  EXPECT_GT(shared_copy[0], 0.3 * 0.7);
+  EXPECT_GT(shared_copy[n], 0.3 * 0.7);
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
