@@ -38,10 +38,10 @@ constexpr const char* kDescription =
     "-rebuild_weights rebuilds both every iteration (mean-curvature flow: thin parts pinch into\n"
     "slivers). -freeze_weights, the default, is accepted for old command lines.\n"
     "Thin parts (handles, legs, horns a few edges thick) would collapse into slivers under large\n"
-    "steps: by default a vertex whose solid is r thick (the radius of the largest empty ball\n"
-    "touching it from inside) smooths for at most -thickness_limit c (default 0.5) times r^2 in\n"
-    "all, the rest of the surface for the whole time; -thickness_limit 0 smooths everything for\n"
-    "the whole time. Area-averaged explicit and implicit steps only.";
+    "steps: by default a vertex whose inner ball (the largest empty ball touching it from inside,\n"
+    "half the local thickness) has radius r smooths for about -thickness_limit c (default 0.5)\n"
+    "times r^2 at most, the rest of the surface for the whole time; -thickness_limit 0 smooths\n"
+    "everything for the whole time. Area-averaged explicit and implicit steps only.";
 constexpr const char* kSyntax =
     "input.{ply,obj,off,stl,vtk} output.{ply,pcd,las}\n"
     "         [-method explicit|implicit|taubin (default implicit)]\n"
@@ -97,6 +97,11 @@ int run(int argc, char** argv) {
   p.implicit_solver = solver.method;
   p.solver = solver.backend;
   const bool taubin = p.scheme == SmoothingScheme::Taubin;
+  if (args.has("thickness_limit") && p.thickness_limit > 0.0 &&
+      (taubin || p.average == FlowAverage::Degree))
+    throw tools::UsageError(
+        "-thickness_limit is for area-averaged explicit and implicit steps (Taubin's filter "
+        "and degree-averaged steps have no time in length^2)");
   if (taubin && args.has("lambda_dt"))
     throw tools::UsageError("-method taubin takes -lambda and -mu, not -lambda_dt");
   if (!taubin && (args.has("lambda") || args.has("mu")))
@@ -166,10 +171,10 @@ int run(int argc, char** argv) {
           const double reach = std::sqrt(p.time_step * p.iterations / p.thickness_limit);
           std::cerr << kName << ": -thickness_limit " << p.thickness_limit << ": "
                     << report.thin_vertices << " of " << points
-                    << " vertices got under 0.9 of the time (the solid is under "
+                    << " vertices smoothed for < 90% of the time (inner radius < "
                     << reach / meanEdgeLength(*in.topology, in.positions)
-                    << " h thick there, or near); on average the vertices got "
-                    << report.mean_time_fraction << " of it\n";
+                    << " h, or next to such parts); mean time fraction "
+                    << report.mean_time_fraction << "\n";
         }
         if (report.volume_before != 0.0) {
           std::cerr << kName << ": volume " << report.volume_before << " -> " << report.volume_after

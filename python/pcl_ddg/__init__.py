@@ -240,7 +240,7 @@ def smooth(
     freeze_weights: bool = False,
     update_mass: bool = False,
     rebuild_weights: bool = False,
-    thickness_limit: float = 0.5,
+    thickness_limit: Optional[float] = None,
     fix_boundary: bool = False,
     allow_unstable: bool = False,
     preserve: str = "none",
@@ -272,10 +272,11 @@ def smooth(
         follow the surface (conformalized mean-curvature flow), ``rebuild_weights`` rebuilds both
         every iteration (mean-curvature flow, which pinches thin parts into slivers).
     thickness_limit:
-        a vertex where the solid is r thick (the radius of the largest empty ball touching it
-        from inside) smooths for at most about ``thickness_limit * r**2`` in all, so that
-        handles, legs and horns a few edges thick do not collapse into slivers; 0: no limit.
-        Area-averaged explicit and implicit steps only.
+        a vertex whose inner ball (the largest empty ball touching it from inside: half the
+        local thickness) has radius r smooths for at most about ``thickness_limit * r**2`` in
+        all, so that handles, legs and horns a few edges thick do not collapse into slivers.
+        Default (None) 0.5 for area-averaged explicit and implicit steps, where alone it
+        applies (ValueError elsewhere); 0: no limit.
     fix_boundary: boundary vertices keep their position.
     preserve: ``"none"``, ``"volume"`` (closed meshes) or ``"area"``: rescale after every step.
     solver: ``"auto"``, ``"cholmod"``, ``"ldlt"`` or ``"cg"`` (conjugate gradients).
@@ -298,7 +299,7 @@ def smooth(
         bool(freeze_weights),
         bool(update_mass),
         bool(rebuild_weights),
-        float(thickness_limit),
+        None if thickness_limit is None else float(thickness_limit),
         bool(fix_boundary),
         bool(allow_unstable),
         preserve,

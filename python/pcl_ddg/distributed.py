@@ -699,14 +699,17 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
             resident = max(client.run(_resident_bytes).values())
         except Exception:  # noqa: BLE001
             resident = WORKER_BASELINE_BYTES
-        points_per_tile = (memory - worker_baseline_bytes(resident)) // BYTES_PER_POINT
+        room = memory - worker_baseline_bytes(resident)
+        points_per_tile = room // BYTES_PER_POINT
         plan_path = os.path.join(state, "plan.json")
-        # A resumed run keeps its tiles while they still fit under the limit: the workers'
-        # resident memory drifts between runs, and a new tile size would discard finished tiles.
+        # A resumed run keeps its tile size while its tiles fit with one 16M step of drift in the
+        # workers' resident memory (it moves between runs, and a new tile size would discard the
+        # finished tiles); the room around a tile stays reserved.
         started_plan = _read_json(plan_path) if resume else None
-        if started_plan and 4096 <= started_plan.get("points_per_tile", 0) \
-                <= (memory - resident) // BYTES_PER_POINT:
-            points_per_tile = started_plan["points_per_tile"]
+        started_size = started_plan.get("points_per_tile", 0) \
+            if isinstance(started_plan, dict) else 0
+        if 4096 <= started_size and started_size * BYTES_PER_POINT <= room + (16 << 20):
+            points_per_tile = started_size
         if points_per_tile < 4096:
             raise ValueError(f"--memory-per-worker {memory_per_worker} leaves no room for a tile "
                              f"(the workers hold {resident >> 20}M before any point)")

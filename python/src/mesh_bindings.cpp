@@ -192,7 +192,7 @@ void bindMeshes(py::module_& m) {
          std::optional<std::string> mass, std::optional<double> lambda_dt,
          std::optional<double> lambda_, std::optional<double> mu, int iterations,
          bool absolute_time, bool freeze_weights, bool update_mass, bool rebuild_weights,
-         double thickness_limit, bool fix_boundary, bool allow_unstable,
+         std::optional<double> thickness_limit, bool fix_boundary, bool allow_unstable,
          const std::string& preserve, const std::string& solver) {
         // pcl_ddg_smooth's options and defaults (tools/pcl_ddg_smooth.cpp).
         MeshSmoothingParameters p;
@@ -213,9 +213,9 @@ void bindMeshes(py::module_& m) {
               "freeze_weights, update_mass and rebuild_weights exclude each other");
         if (update_mass) p.weight_update = WeightUpdate::FrozenStiffness;
         if (rebuild_weights) p.weight_update = WeightUpdate::EveryIteration;
-        if (!(thickness_limit >= 0.0) || !std::isfinite(thickness_limit))
+        p.thickness_limit = thickness_limit.value_or(p.thickness_limit);
+        if (!(p.thickness_limit >= 0.0) || !std::isfinite(p.thickness_limit))
           throw py::value_error("thickness_limit must be >= 0 (0: none)");
-        p.thickness_limit = thickness_limit;
         if (fix_boundary) p.boundary = BoundaryCondition::Fixed;
         const std::string keep = choice("preserve", preserve, {"none", "volume", "area"});
         p.shrinkage = keep == "volume" ? ShrinkageCorrection::PreserveVolume
@@ -225,6 +225,11 @@ void bindMeshes(py::module_& m) {
         p.implicit_solver = s.method;
         p.solver = s.backend;
         const bool taubin = p.scheme == SmoothingScheme::Taubin;
+        if (thickness_limit && *thickness_limit > 0.0 &&
+            (taubin || p.average == FlowAverage::Degree))
+          throw py::value_error(
+              "thickness_limit is for area-averaged explicit and implicit steps (Taubin's filter "
+              "and degree-averaged steps have no time in length^2)");
         if (taubin && lambda_dt)
           throw py::value_error("method='taubin' takes lambda_ and mu, not lambda_dt");
         if (!taubin && (lambda_ || mu))
@@ -252,7 +257,7 @@ void bindMeshes(py::module_& m) {
       py::arg("lambda_") = py::none(), py::arg("mu") = -0.53, py::arg("iterations") = 1,
       py::arg("absolute_time") = false, py::arg("freeze_weights") = false,
       py::arg("update_mass") = false, py::arg("rebuild_weights") = false,
-      py::arg("thickness_limit") = 0.5, py::arg("fix_boundary") = false,
+      py::arg("thickness_limit") = py::none(), py::arg("fix_boundary") = false,
       py::arg("allow_unstable") = false, py::arg("preserve") = "none", py::arg("solver") = "auto",
       "smoothMeshPositions with pcl_ddg_smooth's options.");
 

@@ -59,6 +59,8 @@ CASES = {
     "unknown solver": ("pcl_ddg.smooth(V, F, solver='magic')", "ValueError"),
     "negative thickness limit": ("pcl_ddg.smooth(V, F, thickness_limit=-0.5)", "ValueError"),
     "NaN thickness limit": ("pcl_ddg.smooth(V, F, thickness_limit=float('nan'))", "ValueError"),
+    "thickness limit with Taubin": ("pcl_ddg.smooth(V, F, method='taubin', thickness_limit=0.5)",
+                                    "ValueError"),
     "Taubin mu not below -lambda": ("pcl_ddg.smooth(V, F, method='taubin', mu=-0.1)",
                                     "ValueError"),
     "lambda_dt for Taubin": ("pcl_ddg.smooth(V, F, method='taubin', lambda_dt=0.5)",

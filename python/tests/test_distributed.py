@@ -3,6 +3,7 @@ a grid (written here, in a temporary folder) gives, merged, the bytes pcl_ddg_no
 pcl_ddg_curvature write for the merged cloud; batch mode equals the tool per file; a worker
 killed in the middle of a tile, a resumed run, bad inputs, and a worker's peak memory."""
 
+import json
 import os
 import signal
 import struct
@@ -20,9 +21,9 @@ from conftest import run_tool, shared_data
 distributed = pytest.importorskip("distributed")
 import pcl_ddg.distributed as dd  # noqa: E402
 
-# For a cluster of fresh workers (about 100M each before any point): tiles of about 30k points,
-# so that the 131k-point scan is cut into several.
-MEMORY = "140M"
+# For the command line's own cluster of fresh workers (about 100M each before any point, more on
+# some machines): room for tiles of up to about 160k points.
+MEMORY = "192M"
 
 
 def memory(client, points=30000):
@@ -237,16 +238,23 @@ def test_resume_does_only_the_missing_tiles(tmp_path, client, scene):
         t.unlink()
     half[0].write_bytes(half[0].read_bytes()[:-4])
     (out / "m.ply").unlink()
-    # The workers grew by a rounding step since (as they do between runs): the limit would now
-    # leave no room for the first run's tiles above the step, but it holds them above what the
-    # workers hold, so the run keeps its plan.
+    # The workers grew by one 16M step beyond what sized the first run's tiles (as they drift
+    # between runs): a fresh plan would find no room left for a tile, the resumed run keeps its
+    # tile size.
     step = 16 << 20
+    tile_bytes = json.loads((state.parent / "plan.json").read_text())["points_per_tile"] * \
+        dd.BYTES_PER_POINT
+    target = limit - tile_bytes - step + (1 << 20)  # one step above the first run's baseline
+    assert dd.worker_baseline_bytes(target) == limit - tile_bytes + step
+    if max(client.run(dd._resident_bytes).values()) >= limit - tile_bytes:
+        pytest.skip("the first run grew the workers by more than a step already")
 
     def grow():
-        resident = dd._resident_bytes()
-        sys.pcl_ddg_ballast = b"\x01" * (step - resident % step + (1 << 20))
+        sys.pcl_ddg_ballast = b"\x01" * max(0, target - dd._resident_bytes())
 
     client.run(grow)
+    grown = client.run(dd._resident_bytes).values()
+    assert all(target - (1 << 20) <= r < limit - tile_bytes for r in grown), (grown, target)
     try:
         second = dd.estimate_normals(paths, out, client=client, merge=str(out / "m.ply"),
                                      memory_per_worker=limit, k=16)

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "pcl_ddg/features/plane_fit.h"
+#include "point_moments.h"
 
 namespace pcl_ddg {
 
@@ -43,37 +44,11 @@ double medianResidual(const Eigen::Matrix3Xd& x, int count, const Plane& plane,
   return *middle;
 }
 
-/** Sums of points: their number, first and second moments (the six distinct ones). */
-struct Moments {
-  int count = 0;
-  double x = 0.0, y = 0.0, z = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0, zz = 0.0;
-
-  void add(const Eigen::Vector3d& p) {
-    ++count;
-    x += p.x();
-    y += p.y();
-    z += p.z();
-    xx += p.x() * p.x();
-    xy += p.x() * p.y();
-    xz += p.x() * p.z();
-    yy += p.y() * p.y();
-    yz += p.y() * p.z();
-    zz += p.z() * p.z();
-  }
-  Eigen::Vector3d centroid() const { return Eigen::Vector3d(x, y, z) / count; }
-  /** About the centroid, divided by the number of points (relative coordinates keep the
-   *  subtraction's cancellation small). */
-  Eigen::Matrix3d covariance() const {
-    const Eigen::Vector3d c = centroid();
-    Eigen::Matrix3d products;
-    products << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-    return products / count - c * c.transpose();
-  }
-};
+using detail::PointMoments;
 
 /** Moments of those of the first count columns of x within band of plane. */
-Moments within(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double band) {
-  Moments m;
+PointMoments within(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double band) {
+  PointMoments m;
   const double offset = plane.normal.dot(plane.centroid);
   for (int i = 0; i < count; ++i) {
     const double u = (plane.normal.dot(x.col(i)) - offset) / band;
@@ -156,19 +131,19 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   };
   thread_local std::vector<Scale> scales;
   scales.clear();
-  Moments nested;
+  PointMoments nested;
   Eigen::Vector3d anchor = Eigen::Vector3d::Zero();
   int next = std::min(kSmallestScale, count);
   for (int i = 0; i < count; ++i) {
     nested.add(x.col(i));
-    if (nested.count == std::min(kAnchorNeighbours, count)) anchor = nested.centroid();
-    if (nested.count != next && nested.count != count) continue;
-    if (nested.count == next) next = (next & (next - 1)) == 0 ? next * 3 / 2 : next * 4 / 3;
+    if (nested.count() == std::min(kAnchorNeighbours, count)) anchor = nested.centroid();
+    if (nested.count() != next && nested.count() != count) continue;
+    if (nested.count() == next) next = (next & (next - 1)) == 0 ? next * 3 / 2 : next * 4 / 3;
     const Eigen::Matrix3d covariance = nested.covariance();
     const PlaneNormal fit = fitPlaneNormal(covariance);
     if (fit.valid)
       scales.push_back(
-          {nested.count, {fit.normal, anchor}, fit.surface_variation * covariance.trace()});
+          {nested.count(), {fit.normal, anchor}, fit.surface_variation * covariance.trace()});
   }
 
   // 2. The scale (after Mitra and Nguyen 2003): the largest at which a plane explains the
@@ -235,8 +210,8 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   const double band = kBand * result.noise;
   result.surface_variation = std::numeric_limits<double>::quiet_NaN();
   for (int iteration = 0; iteration < kMaxRefinements; ++iteration) {
-    const Moments m = within(x, used, plane, band);
-    if (m.count < 3) break;
+    const PointMoments m = within(x, used, plane, band);
+    if (m.count() < 3) break;
     const Eigen::Matrix3d covariance = m.covariance();
     const PlaneNormal fit = fitPlaneNormal(covariance);
     if (!fit.valid) break;
@@ -246,21 +221,21 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
     plane = next_plane;
     result.surface_variation = fit.surface_variation;
     result.residual =
-        fit.surface_variation * covariance.trace() * m.count / std::max(m.count - 3, 1);
+        fit.surface_variation * covariance.trace() * m.count() / std::max(m.count() - 3, 1);
     if (converged) break;
   }
   if (std::isnan(result.surface_variation)) {  // no refit: the chosen plane's own spread
-    Moments all;
+    PointMoments all;
     for (int i = 0; i < used; ++i) all.add(x.col(i));
     const PlaneFit fit = fitPlane(all.centroid(), all.covariance());
     result.surface_variation = fit.surface_variation;
-    result.residual = fit.eigenvalues[0] * all.count / std::max(all.count - 3, 1);
+    result.residual = fit.eigenvalues[0] * all.count() / std::max(all.count() - 3, 1);
   }
-  const Moments inliers = within(x, used, plane, band);
+  const PointMoments inliers = within(x, used, plane, band);
   result.normal = plane.normal;
   result.centroid = plane.centroid;
-  result.scale = inliers.count;
-  result.confidence = static_cast<double>(inliers.count) / count;
+  result.scale = inliers.count();
+  result.confidence = static_cast<double>(inliers.count()) / count;
   result.valid = result.normal.allFinite() && std::isfinite(result.surface_variation);
   return result;
 }

@@ -6,46 +6,21 @@
 
 #include "pcl_ddg/features/plane_fit.h"
 #include "pcl_ddg/features/spatial_order.h"
+#include "point_moments.h"
 
 namespace pcl_ddg {
 
 namespace {
 
-/** Weighted sums of points about a reference point: weight, first moments and the six distinct
- *  second moments. */
-struct Moments {
-  double w = 0.0, x = 0.0, y = 0.0, z = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0,
-         zz = 0.0;
-
-  /** Adds other, taken about a reference d from this one's: x - ours = (x - theirs) + d. */
-  void addMoved(const Moments& o, const Eigen::Vector3d& d) {
-    w += o.w;
-    x += o.x + o.w * d.x();
-    y += o.y + o.w * d.y();
-    z += o.z + o.w * d.z();
-    xx += o.xx + 2.0 * o.x * d.x() + o.w * d.x() * d.x();
-    yy += o.yy + 2.0 * o.y * d.y() + o.w * d.y() * d.y();
-    zz += o.zz + 2.0 * o.z * d.z() + o.w * d.z() * d.z();
-    xy += o.xy + o.x * d.y() + o.y * d.x() + o.w * d.x() * d.y();
-    xz += o.xz + o.x * d.z() + o.z * d.x() + o.w * d.x() * d.z();
-    yz += o.yz + o.y * d.z() + o.z * d.y() + o.w * d.y() * d.z();
-  }
-  /** The covariance about the centroid, divided by the weight. */
-  Eigen::Matrix3d covariance() const {
-    const Eigen::Vector3d c(x / w, y / w, z / w);
-    Eigen::Matrix3d products;
-    products << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-    return products / w - c * c.transpose();
-  }
-};
+using detail::PointMoments;
 
 /** The moments about `at` of the nodes of a graph row, each as a point (previous == nullptr) or
  *  as its moments of the previous level. */
-Moments sumOverRow(const Eigen::Vector3d& at, const int* row, int width,
-                   const std::vector<Eigen::Vector3d>& nodes,
-                   const std::vector<Moments>* previous) {
-  static const Moments kPoint{1.0};
-  Moments sum;
+PointMoments sumOverRow(const Eigen::Vector3d& at, const int* row, int width,
+                        const std::vector<Eigen::Vector3d>& nodes,
+                        const std::vector<PointMoments>* previous) {
+  static const PointMoments kPoint{1.0};
+  PointMoments sum;
   for (int n = 0; n < width; ++n) {
     const int j = row[n];
     if (j >= 0) sum.addMoved(previous ? (*previous)[j] : kPoint, nodes[j] - at);
@@ -93,13 +68,13 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
   };
   std::stable_sort(visit.begin(), visit.end(), [&](int a, int b) { return key(a) < key(b); });
   std::vector<WidePlane> kept(queries.size());
-  std::vector<double> reference(queries.size());  // lambda0 of level kFirstWideLevel - 1
-  std::vector<char> stopped(queries.size(), 0);   // a level's residual was too large
-  std::vector<Moments> level_moments, previous;   // A_l and A_{l-1} of the nodes
+  std::vector<double> reference(queries.size());      // lambda0 of level kFirstWideLevel - 1
+  std::vector<char> stopped(queries.size(), 0);       // a level's residual was too large
+  std::vector<PointMoments> level_moments, previous;  // A_l and A_{l-1} of the nodes
   for (int level = 0; level < kWideLevels; ++level) {
     std::swap(previous, level_moments);
     level_moments.resize(at.size());
-    const std::vector<Moments>* below = level == 0 ? nullptr : &previous;
+    const std::vector<PointMoments>* below = level == 0 ? nullptr : &previous;
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (std::ptrdiff_t r = 0; r < static_cast<std::ptrdiff_t>(at.size()); ++r)
       level_moments[r] = sumOverRow(at[r], &rows[r * width], width, at, below);
@@ -110,13 +85,13 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
       if (stopped[v]) continue;
       const int q = visit[v];
       const int node = query_nodes[q];
-      const Moments m =
+      const PointMoments m =
           node >= 0
               ? level_moments[rank[node]]
               : sumOverRow(queries[q], &query_rows[static_cast<std::size_t>(q) * query_graph.width],
                            query_graph.width, at, below);
       const Eigen::Matrix3d covariance = m.covariance();
-      const PlaneNormal fit = m.w >= 3.0 ? fitPlaneNormal(covariance) : PlaneNormal{};
+      const PlaneNormal fit = m.weight >= 3.0 ? fitPlaneNormal(covariance) : PlaneNormal{};
       const double lambda0 = fit.surface_variation * covariance.trace();
       const bool wide = level >= kFirstWideLevel;
       if (!fit.valid || !(lambda0 <= (wide ? kWideGrowth * reference[v] : largest_reference[q]))) {

@@ -7,7 +7,6 @@
 
 #include "pcl_ddg/search/point_kd_tree.h"
 #include "pcl_ddg/surface/mesh_normals.h"
-#include "pcl_ddg/surface/mesh_smoothing.h"
 
 namespace pcl_ddg {
 
@@ -38,9 +37,25 @@ Eigen::VectorXd innerBallRadii(const MeshTopology& topology, const PositionsRef&
   const detail::PointKdTree tree(std::move(xyz), pcl::Indices(used.begin(), used.end()));
 
   const MeshNormals normals = computeMeshNormals(topology, positions);
-  // Outward: the faces' side, unless a closed mesh's faces are wound inward.
-  const double outward =
-      isClosedAndOriented(topology) && enclosedVolume(topology, positions) < 0.0 ? -1.0 : 1.0;
+  // Outward: the faces' side, turned over on each closed component that encloses a negative
+  // volume (faces wound inward).
+  const std::vector<int>& component = topology.vertexComponent();
+  const int components = *std::max_element(component.begin(), component.end()) + 1;
+  std::vector<double> six_volume(components, 0.0);
+  std::vector<char> open(components, 0);
+  const Eigen::Matrix3Xi& t = topology.triangles();
+  for (Eigen::Index f = 0; f < t.cols(); ++f) {
+    const Eigen::Vector3d a = positions.col(t(0, f)) - centre, b = positions.col(t(1, f)) - centre,
+                          c = positions.col(t(2, f)) - centre;
+    six_volume[component[t(0, f)]] += a.dot(b.cross(c));
+  }
+  for (const int v : used) open[component[v]] |= topology.isBoundary(v);
+  const bool oriented =
+      topology.counts().consistently_oriented && topology.counts().nonmanifold_edges == 0;
+  std::vector<double> outward(components, 1.0);
+  for (int k = 0; k < components; ++k) {
+    if (oriented && !open[k] && six_volume[k] < 0.0) outward[k] = -1.0;
+  }
 
   const int count = static_cast<int>(used.size());
 #pragma omp parallel
@@ -52,15 +67,17 @@ Eigen::VectorXd innerBallRadii(const MeshTopology& topology, const PositionsRef&
       const int v = used[i];
       if (!normals.valid[v]) continue;
       const Eigen::Vector3d p = positions.col(v) - centre;
-      const Eigen::Vector3d normal = outward * normals.normals.col(v);
+      const Eigen::Vector3d normal = outward[component[v]] * normals.normals.col(v);
       double r = diagonal;
-      // Each pass shrinks r strictly; 64 passes are far more than a surface needs (usually < 10).
+      // Each pass shrinks r strictly; 64 passes are far more than a surface needs (usually under
+      // 10). Were they spent, r would be an upper bound.
       for (int pass = 0; pass < 64; ++pass) {
         const Eigen::Vector3f c = (p - r * normal).cast<float>();
-        if (tree.nearestK(c.data(), 1, nearest, squared) < 1) break;
+        if (tree.nearestK(c.data(), 1, nearest, squared) < 1 || nearest[0] == v) break;
         const Eigen::Vector3d pq = p - (positions.col(nearest[0]) - centre);
-        // |c - q| with c = p - r n and q = p - pq; at r (duplicates of p) the ball is empty.
-        if (nearest[0] == v || (pq - r * normal).norm() >= r * (1.0 - 1e-9)) break;
+        // |c - q| with c = p - r n and q = p - pq: q on the sphere (p's exact doubles) or outside,
+        // the ball is empty.
+        if ((pq - r * normal).norm() >= r * (1.0 - 1e-9)) break;
         const double along = 2.0 * normal.dot(pq);
         const double shrunk = along > 0.0 ? pq.squaredNorm() / along : r;
         if (!(shrunk < r)) break;

@@ -27,6 +27,12 @@ namespace {
                                     what);
 }
 
+bool isClosedAndOriented(const MeshTopology& topology) {
+  const TopologyCounts& counts = topology.counts();
+  return counts.boundary_edges == 0 && counts.nonmanifold_edges == 0 &&
+         counts.consistently_oriented && topology.numTriangles() > 0;
+}
+
 // Area-weighted centroid of the triangles: the point the shrinkage correction scales about.
 Eigen::Vector3d surfaceCentroid(const MeshTopology& topology, const Eigen::Matrix3Xd& x) {
   Eigen::Vector3d weighted = Eigen::Vector3d::Zero();
@@ -117,12 +123,6 @@ double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& 
   return largest > 0.0 ? 2.0 / largest : std::numeric_limits<double>::infinity();
 }
 
-bool isClosedAndOriented(const MeshTopology& topology) {
-  const TopologyCounts& counts = topology.counts();
-  return counts.boundary_edges == 0 && counts.nonmanifold_edges == 0 &&
-         counts.consistently_oriented && topology.numTriangles() > 0;
-}
-
 double enclosedVolume(const MeshTopology& topology, const PositionsRef& positions) {
   // Tetrahedra to a point near the surface, so that scans far from the origin lose no digits.
   const Eigen::Vector3d origin = positions.rowwise().mean();
@@ -162,6 +162,7 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   if (!(p.thickness_limit >= 0.0) || !std::isfinite(p.thickness_limit)) {
     badArgument("the thickness limit must be >= 0 (0: none)");
   }
+  if (!std::isfinite(p.time_step * p.iterations)) badArgument("the total time is not finite");
   if (p.shrinkage != ShrinkageCorrection::None && p.boundary == BoundaryCondition::Fixed) {
     badArgument("a shrinkage correction rescales the whole mesh: it cannot keep a fixed boundary");
   }

@@ -77,6 +77,15 @@ TEST(InnerBall, TheSameFarFromTheOriginWoundInwardOrWithADoubledVertex) {
   const Eigen::VectorXd inward_radii =
       innerBallRadii(MeshTopology(static_cast<int>(torus.points.cols()), inward), torus.points);
   EXPECT_EQ(inward_radii, radii);
+  // Two far-apart copies, one wound inward: each component finds its own inside.
+  const int m = static_cast<int>(torus.points.cols());
+  Eigen::Matrix3Xd two(3, 2 * m);
+  two << torus.points, torus.points.colwise() + Eigen::Vector3d(10.0, 0.0, 0.0);
+  Eigen::Matrix3Xi both(3, 2 * torus.triangles.cols());
+  both << torus.triangles, (inward.array() + m).matrix();
+  const Eigen::VectorXd two_radii = innerBallRadii(MeshTopology(2 * m, both), two);
+  EXPECT_LT((two_radii.head(m) - radii).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_LT((two_radii.tail(m) - radii).cwiseAbs().maxCoeff(), 1e-9);
 
   // A second copy of vertex 0 (as scans have), in no triangle, and one in a triangle: the ball
   // at vertex 0 is not stopped by its own duplicate.
@@ -94,6 +103,13 @@ TEST(InnerBall, TheSameFarFromTheOriginWoundInwardOrWithADoubledVertex) {
       innerBallRadii(MeshTopology(n + 1, torus.triangles), doubled);
   EXPECT_TRUE(std::isinf(isolated_copy[n]));
   EXPECT_EQ(isolated_copy.head(n), radii);
+  // A near double a millionth inside, sharing vertex 0's triangles, stops vertex 0's ball at
+  // half that: a spot kept still.
+  Eigen::Matrix3Xd near_double = doubled;
+  near_double.col(n) -= 1e-6 * torus.normals.col(0);
+  const Eigen::VectorXd near = innerBallRadii(MeshTopology(n + 1, with_copy), near_double);
+  EXPECT_LT(near[0], 1e-6);
+  EXPECT_GT(near[n], 0.3 * 0.7);
   const Eigen::VectorXd shared_copy = innerBallRadii(MeshTopology(n + 1, with_copy), doubled);
   // Sharing vertex 0's triangles, the copy tilts both normals a little (0.3 * 0.75 on this
   // coarse torus), but neither ball stops at the other (it would be 0).

@@ -480,7 +480,8 @@ TEST(MeshSmoothing, TheDefaultKeepsTheCoarseCowsThinPartsHealthyUnderEveryWeight
 TEST(MeshSmoothing, ThinPartsSmoothForAtMostTheLimitTimesTheirRadiusSquared) {
   // A thin torus (tube radius a about 1.3 h) beside a sphere of radius 3, one mesh of two
   // components. Three implicit steps of 2 h^2 (6 h^2 = 3.4 a^2 in all) draw the tube towards its
-  // axis: its lowest mode around the tube decays by 1 + tau / a^2 per step, to about 0.1 a. With
+  // axis: its lowest mode around the tube decays by 1 + tau / a^2 per step, to 0.1 a or less (the
+  // coarse tube's discrete mode decays faster: 0.02 a measured). With
   // the limit (0.5 a^2 in all) it keeps about (1 + 0.5 / 3)^-3 = 0.63 a. The sphere (r = 3, far
   // above the limit's reach) gets the whole time either way: its vertices move the same.
   const SurfaceSample torus = makeTorus({48, 0.0, 1}, 1.0, 0.12);

@@ -161,15 +161,23 @@ TEST_F(SmoothingTools, AStepThatCollapsesTheScanFailsNamingLambdaDt) {
   EXPECT_EQ(limited.exit_code, 0) << limited.err;
   EXPECT_NE(limited.err.find("pcl_ddg_smooth: -thickness_limit 0.5: "), std::string::npos)
       << limited.err;
-  EXPECT_NE(limited.err.find(" vertices got under 0.9 of the time (the solid is under "),
+  EXPECT_NE(limited.err.find(" vertices smoothed for < 90% of the time (inner radius < "),
             std::string::npos)
       << limited.err;
   EXPECT_NE(limited.err.find("slivers (a corner < 1 deg) 0 -> 0"), std::string::npos)
       << limited.err;
-  EXPECT_EQ(runTool(PCL_DDG_SMOOTH_TOOL,
-                    sharedData("meshes/cow.off") + " " + path("out.ply") + " -thickness_limit -1")
-                .exit_code,
-            2);
+  std::filesystem::remove(path("out.ply"));
+  for (const char* options :
+       {" -thickness_limit -1", " -thickness_limit nan", " -method taubin -thickness_limit 0.5",
+        " -method explicit -weights umbrella -thickness_limit 1"}) {
+    const ToolRun bad = runTool(PCL_DDG_SMOOTH_TOOL,
+                                sharedData("meshes/cow.off") + " " + path("out.ply") + options);
+    EXPECT_EQ(bad.exit_code, 2) << options << "\n" << bad.err;
+    EXPECT_NE(bad.err.find("pcl_ddg_smooth: error: -thickness_limit "), std::string::npos)
+        << options << "\n"
+        << bad.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(path("out.ply")));
 }
 
 TEST_F(SmoothingTools, MeshQualityIsReportedAndAnOpenScanWarnsAboutItsShrinkingBoundary) {

@@ -19,11 +19,15 @@
  * r <= R / (1 + 2 d R / h): the estimate is a few per cent low where R is a few edges (the thin
  * parts it is for), up to a fifth low on fine, gently curved surfaces.
  *
- * The outward side is the faces' orientation, turned over when a closed mesh encloses a negative
- * volume (faces wound inward). Vertices without a valid normal (no non-degenerate triangle, or
- * face normals that cancel) get +infinity, as does a vertex no other vertex constrains. Vertices
- * of no triangle take no part. Coordinates are taken about the vertices' mean (scans sit far
- * from the origin).
+ * The outward side is the faces' orientation, turned over on each closed component that encloses
+ * a negative volume (faces wound inward; with inconsistent winding or non-manifold edges the
+ * faces' side is taken as it is). Exact doubles of p (scans repeat points) lie on every ball's
+ * sphere and never stop it; a vertex a hair inside p does (r about half their distance): such a
+ * degenerate spot is then kept nearly still, which on badly decimated meshes keeps their
+ * near-coincident vertices from forming slivers. Vertices without a valid normal (no
+ * non-degenerate triangle, or face normals that cancel) get +infinity, as does a vertex no other
+ * vertex constrains. Vertices of no triangle take no part. Coordinates are taken
+ * about the vertices' mean (scans sit far from the origin).
  */
 #include <Eigen/Core>
 

@@ -115,9 +115,10 @@ struct MeshSmoothingParameters {
   double taubin_mu = -0.53;  ///< Taubin's second factor, in time_step's units
   int iterations = 1;
   WeightUpdate weight_update = WeightUpdate::Frozen;
-  /** Thin parts: a vertex whose inner ball (inner_ball.h) has radius r smooths for at most about
-   *  thickness_limit * r^2 of time in all; see the header comment. 0: no limit. Only with
-   *  FlowAverage::Area and the explicit or implicit scheme (Taubin's filter does not shrink). */
+  /** Thin parts: a vertex whose inner ball (inner_ball.h; half the local thickness) has radius r
+   *  smooths for at most about thickness_limit * r^2 of time in all; see the header comment. 0: no
+   * limit. Only with FlowAverage::Area and the explicit or implicit scheme (Taubin's filter does
+   * not shrink). */
   double thickness_limit = 0.5;
   BoundaryCondition boundary = BoundaryCondition::Free;
   ShrinkageCorrection shrinkage = ShrinkageCorrection::None;
@@ -159,10 +160,6 @@ double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& 
                               LaplacianWeights weights = LaplacianWeights::Cotangent,
                               MassType mass = MassType::MixedVoronoi,
                               FlowAverage average = FlowAverage::Area);
-
-/** No boundary edge, no non-manifold edge, every edge traversed once each way: a mesh that
- *  encloses a volume. */
-bool isClosedAndOriented(const MeshTopology& topology);
 
 /** Volume enclosed by a closed, consistently oriented mesh (divergence theorem; positive for
  *  outward faces). */
