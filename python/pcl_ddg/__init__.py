@@ -390,22 +390,46 @@ def estimate_normals(
 
     PCL's point types are float: the points are rounded to float as the tools read them.
     """
-    normals, curvature, valid, _, _, _ = _pcl_ddg.estimate_normals(
-        _array(points, "points"),
-        method,
-        k,
-        radius,
-        max_nn,
-        min_nn,
-        neighbours,
-        None if faces is None else _faces(faces),
-        _vector(viewpoint, "viewpoint"),
-        orient,
-        _vector(up, "up"),
-        max_depth_jump,
-        int(threads),
+    normals, curvature, valid, _, _, _ = _fitted_normals(
+        points, method, k, radius, max_nn, min_nn, neighbours, faces, viewpoint, orient, up,
+        max_depth_jump, threads,
     )
     return Normals(normals, curvature, valid)
+
+
+def _fitted_normals(
+    points: ArrayLike,
+    method: str,
+    k: Optional[int],
+    radius: Optional[float],
+    max_nn: Optional[int],
+    min_nn: Optional[int],
+    neighbours: Optional[str],
+    faces: Optional[Faces],
+    viewpoint: Vector3,
+    orient: Optional[str],
+    up: Vector3,
+    max_depth_jump: Optional[float],
+    threads: int,
+) -> Tuple[np.ndarray, ...]:
+    """The binding's fit with the arguments checked and converted (estimate_normals' order)."""
+    return tuple(
+        _pcl_ddg.estimate_normals(
+            _array(points, "points"),
+            method,
+            k,
+            radius,
+            max_nn,
+            min_nn,
+            neighbours,
+            None if faces is None else _faces(faces),
+            _vector(viewpoint, "viewpoint"),
+            orient,
+            _vector(up, "up"),
+            max_depth_jump,
+            int(threads),
+        )
+    )
 
 
 class RobustNormals(NamedTuple):
@@ -432,20 +456,9 @@ def robust_normals(
     robust``; the method: ``docs/library.md``, fitted normals). k: the neighbourhood searched
     (default 96, or all points if fewer). Options as :func:`estimate_normals`.
     """
-    normals, curvature, valid, _, scale, confidence = _pcl_ddg.estimate_normals(
-        _array(points, "points"),
-        "robust",
-        k,
-        None,
-        None,
-        None,
-        neighbours,
-        None if faces is None else _faces(faces),
-        _vector(viewpoint, "viewpoint"),
-        orient,
-        _vector(up, "up"),
-        None,
-        int(threads),
+    normals, curvature, valid, _, scale, confidence = _fitted_normals(
+        points, "robust", k, None, None, None, neighbours, faces, viewpoint, orient, up, None,
+        threads,
     )
     return RobustNormals(normals, curvature, valid, scale, confidence)
 

@@ -7,6 +7,7 @@
 
 #include "pcl_ddg/search/point_kd_tree.h"
 #include "pcl_ddg/surface/mesh_normals.h"
+#include "pcl_ddg/surface/mesh_smoothing.h"
 
 namespace pcl_ddg {
 
@@ -40,21 +41,15 @@ Eigen::VectorXd innerBallRadii(const MeshTopology& topology, const PositionsRef&
   // Outward: the faces' side, turned over on each closed component that encloses a negative
   // volume (faces wound inward).
   const std::vector<int>& component = topology.vertexComponent();
-  const int components = *std::max_element(component.begin(), component.end()) + 1;
-  std::vector<double> six_volume(components, 0.0);
+  const std::vector<double> volumes = componentVolumes(topology, positions);
+  const int components = static_cast<int>(volumes.size());
   std::vector<char> open(components, 0);
-  const Eigen::Matrix3Xi& t = topology.triangles();
-  for (Eigen::Index f = 0; f < t.cols(); ++f) {
-    const Eigen::Vector3d a = positions.col(t(0, f)) - centre, b = positions.col(t(1, f)) - centre,
-                          c = positions.col(t(2, f)) - centre;
-    six_volume[component[t(0, f)]] += a.dot(b.cross(c));
-  }
   for (const int v : used) open[component[v]] |= topology.isBoundary(v);
   const bool oriented =
       topology.counts().consistently_oriented && topology.counts().nonmanifold_edges == 0;
   std::vector<double> outward(components, 1.0);
   for (int k = 0; k < components; ++k) {
-    if (oriented && !open[k] && six_volume[k] < 0.0) outward[k] = -1.0;
+    if (oriented && !open[k] && volumes[k] < 0.0) outward[k] = -1.0;
   }
 
   const int count = static_cast<int>(used.size());

@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "laplacian_flow.h"
@@ -87,7 +89,8 @@ Eigen::VectorXd averageOf(const Eigen::SparseMatrix<double>& l, const MeshTopolo
  *  input's operator (see the header: a slowdown that changed faster than the flow smooths would
  *  itself roughen a curved surface, and a single noise bump reads as thin). */
 Eigen::ArrayXd thinPartSlowdown(const MeshTopology& topology, const Eigen::Matrix3Xd& positions,
-                                const MeshSmoothingParameters& p) {
+                                const Eigen::SparseMatrix<double>& stiffness,
+                                const Eigen::VectorXd& mass, const MeshSmoothingParameters& p) {
   const double time = p.time_step * p.iterations;
   const Eigen::ArrayXd radii = innerBallRadii(topology, positions).array();
   // Capped where a radius rounds to nothing: such a vertex just stays (r = inf gives 1).
@@ -101,8 +104,7 @@ Eigen::ArrayXd thinPartSlowdown(const MeshTopology& topology, const Eigen::Matri
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
   const double median_time = time / std::exp(sorted[sorted.size() / 2]);
   detail::LaplacianFlow heat(topology.numVertices(), {}, p.solver, p.implicit_solver);
-  heat.setOperator(laplacian(topology, positions, p.weights, LaplacianForm::Summed),
-                   lumpedMass(topology, positions, p.mass));
+  heat.setOperator(stiffness, mass);
   heat.implicitStep(log_slowdown, std::min(time, 4.0 * median_time));
   return log_slowdown.array().max(0.0).exp();
 }
@@ -123,17 +125,25 @@ double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& 
   return largest > 0.0 ? 2.0 / largest : std::numeric_limits<double>::infinity();
 }
 
-double enclosedVolume(const MeshTopology& topology, const PositionsRef& positions) {
+std::vector<double> componentVolumes(const MeshTopology& topology, const PositionsRef& positions) {
+  const std::vector<int>& component = topology.vertexComponent();
+  std::vector<double> six_volume(
+      component.empty() ? 0 : *std::max_element(component.begin(), component.end()) + 1, 0.0);
   // Tetrahedra to a point near the surface, so that scans far from the origin lose no digits.
   const Eigen::Vector3d origin = positions.rowwise().mean();
   const Eigen::Matrix3Xi& t = topology.triangles();
-  double six_volume = 0.0;
   for (Eigen::Index f = 0; f < t.cols(); ++f) {
     const Eigen::Vector3d a = positions.col(t(0, f)) - origin, b = positions.col(t(1, f)) - origin,
                           c = positions.col(t(2, f)) - origin;
-    six_volume += a.dot(b.cross(c));
+    six_volume[component[t(0, f)]] += a.dot(b.cross(c));
   }
-  return six_volume / 6.0;
+  for (double& v : six_volume) v /= 6.0;
+  return six_volume;
+}
+
+double enclosedVolume(const MeshTopology& topology, const PositionsRef& positions) {
+  const std::vector<double> volumes = componentVolumes(topology, positions);
+  return std::accumulate(volumes.begin(), volumes.end(), 0.0);
 }
 
 double surfaceArea(const MeshTopology& topology, const PositionsRef& positions) {
@@ -177,21 +187,19 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
   detail::LaplacianFlow flow(n, std::move(fixed), p.solver, p.implicit_solver);
   flow.planSteps(p.iterations, p.weight_update == WeightUpdate::Frozen ? 1 : p.iterations);
   MeshSmoothingReport r;
+  // The input's operator: the flow's first (or only) one, and the slowdown's.
+  Eigen::SparseMatrix<double> stiffness =
+      laplacian(topology, positions, p.weights, LaplacianForm::Summed);
+  Eigen::VectorXd average = averageOf(stiffness, topology, positions, p.mass, p.average);
   // Thin parts move more slowly (see the header): s_i multiplies vertex i's mass.
   Eigen::ArrayXd slowdown = Eigen::ArrayXd::Ones(n);
   if (p.thickness_limit > 0.0 && p.average == FlowAverage::Area &&
       p.scheme != SmoothingScheme::Taubin) {
-    slowdown = thinPartSlowdown(topology, positions, p);
+    slowdown = thinPartSlowdown(topology, positions, stiffness, average, p);
     r.thin_vertices = static_cast<int>((slowdown > 1.0 / 0.9).count());
     r.mean_time_fraction = slowdown.inverse().mean();
   }
-  Eigen::SparseMatrix<double> stiffness;
-  const auto setOperator = [&](const Eigen::Matrix3Xd& at) {
-    stiffness = laplacian(topology, at, p.weights, LaplacianForm::Summed);
-    flow.setOperator(
-        stiffness,
-        (averageOf(stiffness, topology, at, p.mass, p.average).array() * slowdown).matrix());
-  };
+  flow.setOperator(std::move(stiffness), (average.array() * slowdown).matrix());
 
   // The before and after measures are for the report, and the shrinkage corrections' targets.
   const bool closed = isClosedAndOriented(topology);
@@ -209,10 +217,13 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
 
   Eigen::Matrix3Xd current = positions;
   Eigen::MatrixXd values = positions.transpose();  // one column per coordinate
-  setOperator(current);
   r.fixed_vertices = n - flow.numFree();
   for (int iteration = 1; iteration <= p.iterations; ++iteration) {
-    if (iteration > 1 && p.weight_update == WeightUpdate::EveryIteration) setOperator(current);
+    if (iteration > 1 && p.weight_update == WeightUpdate::EveryIteration) {
+      stiffness = laplacian(topology, current, p.weights, LaplacianForm::Summed);
+      average = averageOf(stiffness, topology, current, p.mass, p.average);
+      flow.setOperator(std::move(stiffness), (average.array() * slowdown).matrix());
+    }
     // A degree average belongs to the stiffness: with it frozen, nothing follows the surface.
     if (iteration > 1 && p.weight_update == WeightUpdate::FrozenStiffness &&
         p.average == FlowAverage::Area)

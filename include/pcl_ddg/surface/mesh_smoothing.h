@@ -73,6 +73,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
@@ -164,6 +165,10 @@ double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& 
 /** Volume enclosed by a closed, consistently oriented mesh (divergence theorem; positive for
  *  outward faces). */
 double enclosedVolume(const MeshTopology& topology, const PositionsRef& positions);
+
+/** The same per connected component (indexed as MeshTopology::vertexComponent): the volume each
+ *  encloses where it is closed; their sum is enclosedVolume. */
+std::vector<double> componentVolumes(const MeshTopology& topology, const PositionsRef& positions);
 
 /** Sum of the triangle areas. */
 double surfaceArea(const MeshTopology& topology, const PositionsRef& positions);
