@@ -17,7 +17,6 @@
 #include "pcl_ddg/features/robust_normal_estimation.h"
 #include "pcl_ddg/features/robust_plane_fit.h"
 #include "pcl_ddg/features/widening_planes.h"
-#include "test_data.h"
 
 namespace pcl_ddg {
 namespace test {
@@ -125,18 +124,17 @@ TEST(RobustPlaneFit, TooFewOrCollinearPointsHaveNoPlane) {
 }
 
 TEST(RobustNormals, OnANoiseFreeCubeEachPointGetsTheNormalOfItsOwnFaceUpToTheEdges) {
-  // n points per face: spacing s = 1 / sqrt(n) (0.018 for 3000). A plane fit averages the faces
+  // 3000 points per face: spacing s = 1 / sqrt(3000) = 0.018. A plane fit averages the faces
   // wherever its k neighbours reach across an edge (PCA at k = 18 within about 2.4 s of it);
-  // beyond 3 s even the smallest scale the robust fit considers (16) sees one face. Everything
-  // here is in spacings: under AddressSanitizer a coarser cube makes the same claims 2.5x faster.
-  const int per_face = kUnderAddressSanitizer ? 1200 : 3000;
-  const CubeSample cube = sampleCube(per_face, 11);
+  // beyond 3 s even the smallest scale the robust fit considers (16) sees one face.
+  const CubeSample cube = sampleCube(3000, 11);
   const RobustResult r = robust(cube.points);
+  const Eigen::Matrix3Xd normals = normalsOf(r.normals);
   const Normals plane = pca(cube.points, 18);
-  const double s = 1.0 / std::sqrt(static_cast<double>(per_face));
+  const double s = 1.0 / std::sqrt(3000.0);
   int near = 0, near_exact = 0, pca_near_exact = 0, far = 0, far_exact = 0;
   for (Eigen::Index i = 0; i < cube.points.cols(); ++i) {
-    const double error = degreesBetween(normalsOf(r.normals).col(i), cube.normals.col(i));
+    const double error = degreesBetween(normals.col(i), cube.normals.col(i));
     const double pca_error =
         degreesBetween(plane[i].getNormalVector3fMap().cast<double>(), cube.normals.col(i));
     if (cube.edge_distance[i] >= 3.0 * s) {
@@ -218,11 +216,12 @@ TEST(RobustNormals, ARigidMotionFarFromTheOriginMovesTheNormalsWithTheSurface) {
   // Float coordinates 2000 from the origin carry rounding noise of 1e-4 (s / 250): the same
   // normals to 0.1 deg but at the 1 % of points next to an edge, where that noise can tip the
   // choice between the faces.
+  const Eigen::Matrix3Xd normals = normalsOf(here.normals);
   int differ = 0;
   for (Eigen::Index i = 0; i < cube.points.cols(); ++i)
-    differ += degreesBetween(normalsOf(here.normals).col(i), turned_back.col(i)) > 0.1;
+    differ += degreesBetween(normals.col(i), turned_back.col(i)) > 0.1;
   EXPECT_LE(differ, cube.points.cols() / 100) << differ;
-  const AngleErrors a = angleErrors(normalsOf(here.normals), cube.normals, SignMode::Unsigned);
+  const AngleErrors a = angleErrors(normals, cube.normals, SignMode::Unsigned);
   const AngleErrors b = angleErrors(turned_back, cube.normals, SignMode::Unsigned);
   EXPECT_NEAR(a.mean, b.mean, 0.1 * a.mean + 0.01);
 }
