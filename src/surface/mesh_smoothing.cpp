@@ -127,15 +127,26 @@ double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& 
 
 std::vector<double> componentVolumes(const MeshTopology& topology, const PositionsRef& positions) {
   const std::vector<int>& component = topology.vertexComponent();
-  std::vector<double> six_volume(
-      component.empty() ? 0 : *std::max_element(component.begin(), component.end()) + 1, 0.0);
-  // Tetrahedra to a point near the surface, so that scans far from the origin lose no digits.
-  const Eigen::Vector3d origin = positions.rowwise().mean();
+  const int components =
+      component.empty() ? 0 : *std::max_element(component.begin(), component.end()) + 1;
+  // Tetrahedra to the mean of each component's vertices, so that scans far from the origin, and
+  // components far from each other, lose no digits.
+  std::vector<Eigen::Vector3d> origin(components, Eigen::Vector3d::Zero());
+  std::vector<int> members(components, 0);
+  for (Eigen::Index v = 0; v < positions.cols(); ++v) {
+    if (component[v] < 0) continue;  // a vertex of no triangle
+    origin[component[v]] += positions.col(v);
+    ++members[component[v]];
+  }
+  for (int k = 0; k < components; ++k) origin[k] /= members[k];
+  std::vector<double> six_volume(components, 0.0);
   const Eigen::Matrix3Xi& t = topology.triangles();
   for (Eigen::Index f = 0; f < t.cols(); ++f) {
-    const Eigen::Vector3d a = positions.col(t(0, f)) - origin, b = positions.col(t(1, f)) - origin,
-                          c = positions.col(t(2, f)) - origin;
-    six_volume[component[t(0, f)]] += a.dot(b.cross(c));
+    const int k = component[t(0, f)];
+    const Eigen::Vector3d a = positions.col(t(0, f)) - origin[k],
+                          b = positions.col(t(1, f)) - origin[k],
+                          c = positions.col(t(2, f)) - origin[k];
+    six_volume[k] += a.dot(b.cross(c));
   }
   for (double& v : six_volume) v /= 6.0;
   return six_volume;

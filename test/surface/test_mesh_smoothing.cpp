@@ -196,6 +196,21 @@ TEST(MeshSmoothing, VolumeAndAreaOfABoxAndASphereAreTheirClosedForms) {
   EXPECT_GT(volume, 0.995 * 4.0 / 3.0 * kPi * r * r * r);
   EXPECT_LT(area, 4.0 * kPi * r * r);
   EXPECT_GT(area, 0.995 * 4.0 * kPi * r * r);
+
+  // The box and the sphere as one mesh of two components, the sphere wound inward: each
+  // component's own volume, signed, and their sum.
+  Eigen::Matrix3Xd both(3, 8 + sphere.points.cols());
+  both << box, sphere.points;
+  Eigen::Matrix3Xi inward = sphere.triangles;
+  inward.row(1).swap(inward.row(2));
+  Eigen::Matrix3Xi all(3, faces.cols() + inward.cols());
+  all << faces, (inward.array() + 8).matrix();
+  const MeshTopology two(static_cast<int>(both.cols()), all);
+  const std::vector<double> volumes = componentVolumes(two, both);
+  ASSERT_EQ(volumes.size(), 2u);
+  EXPECT_NEAR(volumes[two.vertexComponent()[0]], a * b * c, 1e-9 * a * b * c);
+  EXPECT_NEAR(volumes[two.vertexComponent()[8]], -volume, 1e-6 * volume);
+  EXPECT_NEAR(enclosedVolume(two, both), a * b * c - volume, 1e-6 * volume);
 }
 
 TEST(MeshSmoothing, VolumeAndAreaArePreservedWhenAsked) {
