@@ -161,7 +161,7 @@ def ellipsoid(n, rng, axes=(1.0, 0.6, 0.3)):
     while found < n:
         u = normalized(rng.normal(size=(4 * n, 3)))
         stretch = np.linalg.norm(u / a, axis=1)  # area element / (a1 a2 a3)
-        keep = rng.uniform(0, stretch.max(), len(u)) < stretch
+        keep = rng.uniform(0, 1 / a.min(), len(u)) < stretch  # 1 / min(a): the largest stretch
         points.append(u[keep] * a)
         normals.append(normalized(u[keep] / a))
         found += keep.sum()
@@ -170,7 +170,7 @@ def ellipsoid(n, rng, axes=(1.0, 0.6, 0.3)):
 
 def pyramid(n, rng):
     """A square pyramid of height 1.2 on a unit base: edges sharper than the cube's at the base
-    (interior dihedral angle 67 deg; 98 deg between the sides), meeting at an apex."""
+    (interior dihedral angle 67 deg; 98.5 deg between the sides, whose edges meet at an apex)."""
     apex = (0, 0, 1.2)
     base = [(-0.5, -0.5, 0), (0.5, -0.5, 0), (0.5, 0.5, 0), (-0.5, 0.5, 0)]
     faces = [base[::-1]] + [[base[i], base[(i + 1) % 4], apex] for i in range(4)]
@@ -228,7 +228,8 @@ def main():
     parser.add_argument("--points", type=int, default=100000)
     parser.add_argument("--shapes", default=",".join(SHAPES))
     parser.add_argument("--held-out", action="store_true",
-                        help="the shapes never tuned on (%s) instead" % ", ".join(HELD_OUT))
+                        help="the shapes never tuned on (%s) instead of --shapes"
+                        % ", ".join(HELD_OUT))
     parser.add_argument("--quick", action="store_true", help="robust and PCA only (no quadric)")
     args = parser.parse_args()
     shapes = list(HELD_OUT) if args.held_out else args.shapes.split(",")

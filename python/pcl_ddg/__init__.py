@@ -411,24 +411,23 @@ def _fitted_normals(
     up: Vector3,
     max_depth_jump: Optional[float],
     threads: int,
-) -> Tuple[np.ndarray, ...]:
-    """The binding's fit with the arguments checked and converted (estimate_normals' order)."""
-    return tuple(
-        _pcl_ddg.estimate_normals(
-            _array(points, "points"),
-            method,
-            k,
-            radius,
-            max_nn,
-            min_nn,
-            neighbours,
-            None if faces is None else _faces(faces),
-            _vector(viewpoint, "viewpoint"),
-            orient,
-            _vector(up, "up"),
-            max_depth_jump,
-            int(threads),
-        )
+) -> Tuple[Any, ...]:
+    """The binding's fit with the arguments checked and converted (estimate_normals' order):
+    normals, curvature, valid, counts, and robust's scale and confidence (else None)."""
+    return _pcl_ddg.estimate_normals(
+        _array(points, "points"),
+        method,
+        k,
+        radius,
+        max_nn,
+        min_nn,
+        neighbours,
+        None if faces is None else _faces(faces),
+        _vector(viewpoint, "viewpoint"),
+        orient,
+        _vector(up, "up"),
+        max_depth_jump,
+        int(threads),
     )
 
 

@@ -126,6 +126,9 @@ double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& 
 }
 
 std::vector<double> componentVolumes(const MeshTopology& topology, const PositionsRef& positions) {
+  if (positions.cols() != topology.numVertices()) {
+    throw InvalidMeshException("positions do not match the mesh");
+  }
   const std::vector<int>& component = topology.vertexComponent();
   const int components =
       component.empty() ? 0 : *std::max_element(component.begin(), component.end()) + 1;

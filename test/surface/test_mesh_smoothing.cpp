@@ -211,6 +211,7 @@ TEST(MeshSmoothing, VolumeAndAreaOfABoxAndASphereAreTheirClosedForms) {
   EXPECT_NEAR(volumes[two.vertexComponent()[0]], a * b * c, 1e-9 * a * b * c);
   EXPECT_NEAR(volumes[two.vertexComponent()[8]], -volume, 1e-6 * volume);
   EXPECT_NEAR(enclosedVolume(two, both), a * b * c - volume, 1e-6 * volume);
+  EXPECT_THROW(componentVolumes(two, box), InvalidMeshException);
 }
 
 TEST(MeshSmoothing, VolumeAndAreaArePreservedWhenAsked) {

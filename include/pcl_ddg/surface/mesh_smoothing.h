@@ -167,7 +167,9 @@ double explicitStabilityLimit(const MeshTopology& topology, const PositionsRef& 
 double enclosedVolume(const MeshTopology& topology, const PositionsRef& positions);
 
 /** The same per connected component (indexed as MeshTopology::vertexComponent): the volume each
- *  encloses where it is closed; their sum is enclosedVolume. */
+ *  closed component encloses, its tetrahedra taken to its own vertices' mean (components far
+ *  apart lose no digits); their sum is enclosedVolume. An open component's entry depends on that
+ *  point and measures nothing. Throws InvalidMeshException if positions do not match the mesh. */
 std::vector<double> componentVolumes(const MeshTopology& topology, const PositionsRef& positions);
 
 /** Sum of the triangle areas. */
