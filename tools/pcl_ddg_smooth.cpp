@@ -85,9 +85,15 @@ int run(int argc, char** argv) {
         "-freeze_weights, -update_mass and -rebuild_weights exclude each other");
   if (args.has("update_mass")) p.weight_update = WeightUpdate::FrozenStiffness;
   if (args.has("rebuild_weights")) p.weight_update = WeightUpdate::EveryIteration;
-  p.thickness_limit = args.number("thickness_limit", p.thickness_limit);
-  if (!(p.thickness_limit >= 0.0) || !std::isfinite(p.thickness_limit))
-    throw tools::UsageError("-thickness_limit must be >= 0 (0: none)");
+  try {
+    chooseThicknessLimit(p,
+                         args.has("thickness_limit")
+                             ? std::optional<double>(args.number("thickness_limit", 0.0))
+                             : std::nullopt,
+                         "-thickness_limit");
+  } catch (const pcl::BadArgumentException& e) {
+    throw tools::UsageError(errorDescription(e));
+  }
   if (args.has("fix_boundary")) p.boundary = BoundaryCondition::Fixed;
   const std::string preserve = args.choice("preserve", {"none", "volume", "area"}, "none");
   p.shrinkage = preserve == "volume" ? ShrinkageCorrection::PreserveVolume
@@ -97,11 +103,6 @@ int run(int argc, char** argv) {
   p.implicit_solver = solver.method;
   p.solver = solver.backend;
   const bool taubin = p.scheme == SmoothingScheme::Taubin;
-  if (args.has("thickness_limit") && p.thickness_limit > 0.0 &&
-      (taubin || p.average == FlowAverage::Degree))
-    throw tools::UsageError(
-        "-thickness_limit is for area-averaged explicit and implicit steps (Taubin's filter "
-        "and degree-averaged steps have no time in length^2)");
   if (taubin && args.has("lambda_dt"))
     throw tools::UsageError("-method taubin takes -lambda and -mu, not -lambda_dt");
   if (!taubin && (args.has("lambda") || args.has("mu")))

@@ -213,9 +213,11 @@ void bindMeshes(py::module_& m) {
               "freeze_weights, update_mass and rebuild_weights exclude each other");
         if (update_mass) p.weight_update = WeightUpdate::FrozenStiffness;
         if (rebuild_weights) p.weight_update = WeightUpdate::EveryIteration;
-        p.thickness_limit = thickness_limit.value_or(p.thickness_limit);
-        if (!(p.thickness_limit >= 0.0) || !std::isfinite(p.thickness_limit))
-          throw py::value_error("thickness_limit must be >= 0 (0: none)");
+        try {
+          chooseThicknessLimit(p, thickness_limit, "thickness_limit");
+        } catch (const pcl::BadArgumentException& e) {
+          throw py::value_error(errorDescription(e));
+        }
         if (fix_boundary) p.boundary = BoundaryCondition::Fixed;
         const std::string keep = choice("preserve", preserve, {"none", "volume", "area"});
         p.shrinkage = keep == "volume" ? ShrinkageCorrection::PreserveVolume
@@ -225,11 +227,6 @@ void bindMeshes(py::module_& m) {
         p.implicit_solver = s.method;
         p.solver = s.backend;
         const bool taubin = p.scheme == SmoothingScheme::Taubin;
-        if (thickness_limit && *thickness_limit > 0.0 &&
-            (taubin || p.average == FlowAverage::Degree))
-          throw py::value_error(
-              "thickness_limit is for area-averaged explicit and implicit steps (Taubin's filter "
-              "and degree-averaged steps have no time in length^2)");
         if (taubin && lambda_dt)
           throw py::value_error("method='taubin' takes lambda_ and mu, not lambda_dt");
         if (!taubin && (lambda_ || mu))

@@ -28,6 +28,19 @@ void chooseOperator(MeshSmoothingParameters& p, const std::string& weights,
   p.average = by_degree ? FlowAverage::Degree : FlowAverage::Area;
 }
 
+void chooseThicknessLimit(MeshSmoothingParameters& p, std::optional<double> limit,
+                          const std::string& name) {
+  if (!limit) return;
+  if (!(*limit >= 0.0) || !std::isfinite(*limit))
+    throw pcl::BadArgumentException(name + " must be >= 0 (0: none)");
+  if (*limit > 0.0 && (p.scheme == SmoothingScheme::Taubin || p.average == FlowAverage::Degree))
+    throw pcl::BadArgumentException(
+        name +
+        " is for area-averaged explicit and implicit steps (Taubin's filter and degree-averaged "
+        "steps have no time in length^2)");
+  p.thickness_limit = *limit;
+}
+
 ResolvedSteps resolveSteps(const MeshTopology& topology, const PositionsRef& positions,
                            const RelativeSteps& steps, MeshSmoothingParameters& p) {
   const bool taubin = p.scheme == SmoothingScheme::Taubin;

@@ -32,6 +32,16 @@ namespace pcl_ddg {
 void chooseOperator(MeshSmoothingParameters& p, const std::string& weights,
                     const std::string& average, bool areas_asked);
 
+/**
+ * Sets p.thickness_limit to the caller's limit (none: the default, which applies only to
+ * area-averaged explicit and implicit steps). Throws pcl::BadArgumentException, naming the option
+ * as the caller spells it (name), for a negative or non-finite limit, or a positive one given with
+ * Taubin's filter or a degree average (their steps have no time in length^2). Call it after
+ * chooseOperator.
+ */
+void chooseThicknessLimit(MeshSmoothingParameters& p, std::optional<double> limit,
+                          const std::string& name);
+
 struct RelativeSteps {
   std::optional<double> step;   ///< lambda_dt (Taubin: lambda); none: the default
   double mu = -0.53;            ///< Taubin's second step
