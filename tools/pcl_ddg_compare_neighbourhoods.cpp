@@ -52,7 +52,7 @@ int run(int argc, char** argv) {
                            (organized ? "the pixel grid" : "mesh rings") + " and from a kd-tree");
         const NeighbourhoodComparison c = [&] {
           const tools::QuietPCLWarnings quiet;
-          return compareNeighbourhoods(in.points(), in.topology, options);
+          return compareNeighbourhoods(in.local(), in.topology, options);
         }();
         timer.done(in.points()->size());
         tools::warnAboutLocalFit(kName, c.topological);

@@ -138,14 +138,14 @@ int run(int argc, char** argv) {
           curvatures = {c.mean_curvature, c.gauss_curvature, c.k1, c.k2};
           setVertexField(in.mesh.cloud, "vertex_area", c.vertex_area, precision);
         } else {
-          const LocalFitOptions options =
-              tools::localFitArguments(args, in, LocalFitMethod::Quadric);
+          LocalFitOptions options = tools::localFitArguments(args, in, LocalFitMethod::Quadric);
+          tools::orientLasUp(kName, args, in.las && !in.topology, options);
           const std::int64_t left_out = tools::keepOnlyClasses(kName, args, in);
           const tools::SamplingCheck sampling = tools::checkSampling(kName, in, options);
           tools::Timer timer("Fitting quadrics");
           LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
-            return fitLocalSurfaces(in.points(), in.topology, options);
+            return fitLocalSurfaces(in.local(), in.topology, options);
           }();
           timer.done(in.points()->size());
           result.failed_points -= left_out;  // -classes: not fitted by request

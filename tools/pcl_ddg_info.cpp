@@ -1,9 +1,12 @@
 // pcl_ddg_info: what a mesh or cloud file holds, defects included. It never refuses a file it can
 // parse: out-of-range faces, non-finite vertices and the like are counted, not fatal.
+#include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <vector>
 
 #include "common/fit_steps.h"
 #include "common/tool_common.h"
@@ -46,15 +49,53 @@ std::string lasName(const pcl_ddg::LasExtraBytesDimension& d) {
   return name.substr(0, name.find('\0'));
 }
 
+// The shortest digits that read back as v (a header's doubles, exactly), in fixed notation over
+// the range coordinates take (an offset of 5000000, not 5e+06).
 std::string number(double v) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.17g", v);
-  return text;
+  char text[48];
+  const double a = std::abs(v);
+  const auto end = a >= 1e-5 && a < 1e15
+                       ? std::to_chars(text, text + sizeof text, v, std::chars_format::fixed).ptr
+                       : std::to_chars(text, text + sizeof text, v).ptr;
+  return std::string(text, end);
 }
 
-// What a LAS file holds beside its points: version, point format, scale and offset, VLRs, Extra
-// Bytes dimensions and the classification histogram; as text lines, or as a JSON object.
-std::string lasReport(const pcl_ddg::LasLayout& las, const pcl::PCLPointCloud2& cloud, bool json) {
+std::string jsonNumber(double v) {
+  return std::isfinite(v) ? number(v) : "null";
+}
+
+std::string triple(const Eigen::Vector3d& v) {
+  return number(v[0]) + " " + number(v[1]) + " " + number(v[2]);
+}
+
+// A header bound that differs from the records' by more than half the axis's scale: the two name
+// different steps of the integer grid (a writer that took the bound from the records' integers
+// differs by nothing).
+struct BoundMismatch {
+  char axis;
+  const char* side;  // "min" or "max"
+  double header, records;
+};
+
+std::vector<BoundMismatch> boundMismatches(const pcl_ddg::LasLayout& las,
+                                           const pcl_ddg::BoundingBox& records) {
+  std::vector<BoundMismatch> found;
+  for (int d = 0; d < 3; ++d) {
+    const char axis = static_cast<char>('x' + d);
+    const BoundMismatch sides[] = {{axis, "min", las.min[d], records.min[d]},
+                                   {axis, "max", las.max[d], records.max[d]}};
+    for (const BoundMismatch& m : sides) {
+      if (!(std::abs(m.header - m.records) <= std::abs(las.scale[d]) / 2)) found.push_back(m);
+    }
+  }
+  return found;
+}
+
+// What a LAS file holds beside its points: version, point format, scale and offset, the header's
+// bounds against the records' (records_box: their exact coordinates' box), VLRs, Extra Bytes
+// dimensions and the classification histogram; as text lines, or as a JSON object.
+std::string lasReport(const pcl_ddg::LasLayout& las, const pcl::PCLPointCloud2& cloud,
+                      const pcl_ddg::BoundingBox& records_box, bool json) {
   std::map<int, long long> histogram;
   if (pcl_ddg::hasVertexField(cloud, "classification")) {
     const Eigen::VectorXd c = pcl_ddg::vertexScalarField(cloud, "classification");
@@ -64,16 +105,33 @@ std::string lasReport(const pcl_ddg::LasLayout& las, const pcl::PCLPointCloud2& 
     return r.userId() + " " + std::to_string(r.record_id) + " (" + std::to_string(r.data.size()) +
            " bytes" + (r.descriptionText().empty() ? "" : ", " + r.descriptionText()) + ")";
   };
+  // No records: nothing to compare the header's bounds with.
+  const bool compared = cloud.width * cloud.height > 0;
+  const std::vector<BoundMismatch> mismatches =
+      compared ? boundMismatches(las, records_box) : std::vector<BoundMismatch>();
   std::ostringstream out;
   const std::string version =
       std::to_string(las.version_major) + "." + std::to_string(las.version_minor);
   if (json) {
+    const auto array = [](const Eigen::Vector3d& v) {
+      return "[" + jsonNumber(v[0]) + ", " + jsonNumber(v[1]) + ", " + jsonNumber(v[2]) + "]";
+    };
+    const char* agree = "null";
+    if (compared) agree = mismatches.empty() ? "true" : "false";
     out << "\"las\": {\"version\": " << jsonText(version)
         << ", \"point_format\": " << int(las.point_format)
-        << ", \"record_length\": " << las.record_length << ", \"scale\": [" << number(las.scale[0])
-        << ", " << number(las.scale[1]) << ", " << number(las.scale[2]) << "], \"offset\": ["
-        << number(las.offset[0]) << ", " << number(las.offset[1]) << ", " << number(las.offset[2])
-        << "], \"vlrs\": [";
+        << ", \"record_length\": " << las.record_length << ", \"scale\": " << array(las.scale)
+        << ", \"offset\": " << array(las.offset) << ", \"header_bounds_min\": " << array(las.min)
+        << ", \"header_bounds_max\": " << array(las.max) << ", \"header_bounds_agree\": " << agree
+        << ", \"header_bounds_mismatches\": [";
+    for (std::size_t k = 0; k < mismatches.size(); ++k) {
+      const BoundMismatch& m = mismatches[k];
+      out << (k ? ", " : "") << "{\"axis\": \"" << m.axis << "\", \"side\": \"" << m.side
+          << "\", \"header\": " << jsonNumber(m.header)
+          << ", \"records\": " << jsonNumber(m.records)
+          << ", \"difference\": " << jsonNumber(m.header - m.records) << "}";
+    }
+    out << "], \"vlrs\": [";
     for (std::size_t k = 0; k < las.vlrs.size(); ++k)
       out << (k ? ", " : "") << jsonText(record(las.vlrs[k]));
     out << "], \"evlrs\": [";
@@ -94,10 +152,19 @@ std::string lasReport(const pcl_ddg::LasLayout& las, const pcl::PCLPointCloud2& 
   }
   out << "LAS:               " << version << ", point format " << int(las.point_format) << " ("
       << las.record_length << "-byte records)\n"
-      << "scale:             " << number(las.scale[0]) << " " << number(las.scale[1]) << " "
-      << number(las.scale[2]) << "\n"
-      << "offset:            " << number(las.offset[0]) << " " << number(las.offset[1]) << " "
-      << number(las.offset[2]) << "\n";
+      << "scale:             " << triple(las.scale) << "\n"
+      << "offset:            " << triple(las.offset) << "\n"
+      << "header bounds:     [" << triple(las.min) << "] .. [" << triple(las.max) << "]\n";
+  if (!compared) {
+    out << "header vs records: no records to compare\n";
+  } else if (mismatches.empty()) {
+    out << "header vs records: agree (within half a scale step)\n";
+  }
+  for (const BoundMismatch& m : mismatches) {
+    out << "header vs records: " << m.axis << " " << m.side << " differs by "
+        << number(m.header - m.records) << " (header " << number(m.header) << ", records "
+        << number(m.records) << ")\n";
+  }
   for (const auto& r : las.vlrs) out << "VLR:               " << record(r) << "\n";
   for (const auto& r : las.evlrs) out << "EVLR:              " << record(r) << "\n";
   if (!las.extra_bytes.empty()) {
@@ -120,23 +187,25 @@ int run(int argc, char** argv) {
   const tools::ToolArguments args(argc, argv, {}, {"json"});
   return tools::forEachInput(args, kName, {}, [&](const std::string& path, const std::string&) {
     tools::Timer load_timer("Loading " + path);
-    const MeshFile file = readMeshFile(path);
+    // A file of no points is reported on (a LAS file's header), not refused.
+    const MeshFile file = readMeshFile(path, EmptyFilePolicy::Accept);
     const pcl::PolygonMesh& mesh = file.mesh;
     load_timer.done(static_cast<std::size_t>(file.positions.cols()));
 
     const bool json = args.has("json");
     if (args.has("input_dir") && !json) std::cout << "== " << path << "\n";
     if (mesh.polygons.empty()) {
-      const CloudReport report = makeCloudReport(mesh.cloud);
+      const CloudReport report = makeCloudReport(mesh.cloud, file.positions);
       if (file.las && json) {
         std::string text = report.toJson();  // one object: the LAS layout goes inside it
         text.pop_back();
-        std::cout << text << ", " << lasReport(*file.las, mesh.cloud, true) << "}\n";
+        std::cout << text << ", " << lasReport(*file.las, mesh.cloud, report.bounding_box, true)
+                  << "}\n";
       } else {
         std::cout << (json ? report.toJson() + "\n" : report.toText());
-        if (file.las) std::cout << lasReport(*file.las, mesh.cloud, false);
+        if (file.las) std::cout << lasReport(*file.las, mesh.cloud, report.bounding_box, false);
       }
-      tools::warnAboutQuantisation(kName, *tools::toXYZ(file.positions));
+      tools::warnAboutQuantisation(kName, *makeLocalCloud(file.positions).points);
       return;
     }
     const MeshTopology topology(mesh, OutOfRangeFacePolicy::Drop);

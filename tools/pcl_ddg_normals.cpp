@@ -203,6 +203,7 @@ int run(int argc, char** argv) {
                                 : orient == "up"      ? NormalOrientation::Up
                                 : orient == "mst"     ? NormalOrientation::SpanningTree
                                                       : NormalOrientation::MeshFaces;
+          tools::orientLasUp(kName, args, in.las && !in.topology, options);
           // An organized frame has one sensor: it decides the tree's signs (unless -up does).
           options.seed_facing_viewpoint =
               !args.has("up") && (args.has("viewpoint") || in.points()->height > 1);
@@ -213,7 +214,7 @@ int run(int argc, char** argv) {
                              (orient == "mst" ? ", oriented along a spanning tree)" : ")"));
           LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
-            return fitLocalSurfaces(in.points(), in.topology, options);
+            return fitLocalSurfaces(in.local(), in.topology, options);
           }();
           timer.done(in.points()->size());
           result.failed_points -= left_out;  // -classes: not fitted by request

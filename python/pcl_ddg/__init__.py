@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import json
 import os
+import warnings
 from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -92,6 +93,24 @@ def _faces(F: Faces) -> Any:
                 return array.astype(np.int64, copy=False).reshape(len(F), -1)
         return list(F)
     raise ValueError("F must be an (m, 3) integer array or a sequence of polygons")
+
+
+def _file_defaults(
+    points: Any, faces: Optional[Faces], viewpoint: Vector3, orient: Optional[str]
+) -> Tuple[Any, Optional[Faces], Vector3, Optional[str]]:
+    """A :class:`MeshFile` given as the points brings the tools' defaults for its file: its faces,
+    its organized grid, its VIEWPOINT, and for a LAS cloud ``orient="up"`` (aerial LiDAR has no
+    single viewpoint; as ``pcl_ddg_normals`` and PDAL's filters.normal). Arrays pass unchanged."""
+    if not isinstance(points, MeshFile):
+        return points, faces, viewpoint, orient
+    f = points
+    if faces is None:
+        faces = f.faces
+    if orient is None and viewpoint is None and f.las is not None and faces is None:
+        orient = "up"
+    if viewpoint is None and orient != "up":
+        viewpoint = f.viewpoint
+    return (f.grid if f.organized_shape is not None else f.points), faces, viewpoint, orient
 
 
 def _vector(value: Vector3, name: str) -> Optional[List[float]]:
@@ -373,7 +392,11 @@ def estimate_normals(
     (``"robust"``: its own scale up to k, not across sharp edges; :func:`robust_normals` also
     returns the scale and confidence) to each point's neighbours (``pcl_ddg_normals -method``).
 
-    points: (n, 3), or (h, w, 3) for an organized cloud (kept: the output has its grid).
+    points: (n, 3), or (h, w, 3) for an organized cloud (kept: the output has its grid), in any
+        real dtype; float64 coordinates are fitted as they are, wherever they lie (about their
+        local origin, as the tools: docs/library.md). Or what :func:`read` returned, which
+        brings its file's defaults: its faces, grid and VIEWPOINT, and for a LAS file
+        ``orient="up"``, as ``pcl_ddg_normals`` orients LAS files.
     k: neighbours (default 16, quadric 20, robust 96 or all points if fewer: the
         neighbourhood searched, beyond which robust widens only on noisy data; at least 3, at most the point count).
     radius: a radius search instead of k, keeping at most ``max_nn`` (default 64) nearest;
@@ -387,8 +410,6 @@ def estimate_normals(
         ``"up"`` (n . up >= 0; ``up`` default +z) or ``"mst"`` (consistent along a minimum
         spanning tree; the viewpoint or ``up`` decides every sign it can).
     threads: 0 for every core.
-
-    PCL's point types are float: the points are rounded to float as the tools read them.
     """
     normals, curvature, valid, _, _, _ = _fitted_normals(
         points, method, k, radius, max_nn, min_nn, neighbours, faces, viewpoint, orient, up,
@@ -414,6 +435,7 @@ def _fitted_normals(
 ) -> Tuple[Any, ...]:
     """The binding's fit with the arguments checked and converted (estimate_normals' order):
     normals, curvature, valid, counts, and robust's scale and confidence (else None)."""
+    points, faces, viewpoint, orient = _file_defaults(points, faces, viewpoint, orient)
     return _pcl_ddg.estimate_normals(
         _array(points, "points"),
         method,
@@ -489,6 +511,7 @@ def principal_curvatures(
     (``pcl_ddg_curvature -method quadric``; k default 20). Options as :func:`estimate_normals`.
     Mean curvature is ``(k1 + k2) / 2``, Gaussian ``k1 * k2``.
     """
+    points, faces, viewpoint, orient = _file_defaults(points, faces, viewpoint, orient)
     k1, k2, direction, normals, valid, _ = _pcl_ddg.principal_curvatures(
         _array(points, "points"),
         k,
@@ -699,14 +722,20 @@ def write(
     records, every other field becomes an Extra Bytes dimension (``"normals"`` as NormalX
     NormalY NormalZ). ``las``: the layout to keep (a LAS :func:`read`'s ``las``: version, point
     format, scale/offset, VLRs), so that unchanged records round-trip bit for bit; None: LAS 1.4
-    format 6 (7 with ``"rgb"``).
+    format 6 (7 with ``"rgb"``), scale and offset chosen from the points, and no VLR but the
+    fields' Extra Bytes: an input's CRS (its projection VLRs) and its other VLRs are not carried,
+    which a ``UserWarning`` says. To keep them, pass the input's layout::
+
+        cloud = pcl_ddg.read("survey.las")
+        pcl_ddg.write("out.las", cloud.points, fields=..., las=cloud.las)
     """
     points = _array(points, "points")
     if points.ndim == 3 and organized_shape is None:
         organized_shape = (points.shape[0], points.shape[1])
         points = points.reshape(-1, points.shape[-1])
+    path = _path(path)
     _pcl_ddg.write(
-        _path(path),
+        path,
         points,
         None if faces is None else _faces(faces),
         None if fields is None else dict(fields),
@@ -716,3 +745,10 @@ def write(
         None if organized_shape is None else (int(organized_shape[0]), int(organized_shape[1])),
         las,
     )
+    if las is None and path.lower().endswith(".las"):
+        warnings.warn(
+            f"{path}: written without las=, so it carries no CRS and no VLR of any input; pass "
+            "las=pcl_ddg.read(input).las to keep the input's projection, VLRs, scale and offset",
+            UserWarning,
+            stacklevel=2,
+        )

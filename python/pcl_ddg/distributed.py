@@ -14,6 +14,7 @@ the merged cloud.
         [--memory-per-worker 2G] [--retries 3] [--merge FILE] [--resume | --no-resume]
     python3 -m pcl_ddg.distributed curvature INPUT... OUTPUT_DIR [-k 20] ...
     python3 -m pcl_ddg.distributed batch 'scans/*.ply' OUTPUT_DIR -- normals -k 16
+        (meshes too: 'models/*.off' gives OUTPUT_DIR/<name>.ply)
 
 How it stays exact (docs/distributed.md has the details):
 
@@ -51,6 +52,11 @@ from . import _pcl_ddg
 __all__ = ["estimate_normals", "principal_curvatures", "batch", "main", "DistributedError"]
 
 CLOUD_EXTENSIONS = (".pcd", ".ply", ".las", ".laz")
+# What else the tools read (batch runs them on any such file), and what they write: a mesh format
+# they do not write gives a .ply output, the one format that keeps its faces (the tools' own
+# -input_dir rule).
+MESH_EXTENSIONS = (".obj", ".off", ".stl", ".vtk")
+OUTPUT_EXTENSIONS = (".ply", ".pcd", ".las")
 # What a worker process holds before any tile (the interpreter, NumPy, Dask, the module), and
 # what a gathered point costs at once (float points, indices, the kd-tree, the fit, the results
 # and their copies): the tile size follows from --memory-per-worker with these.
@@ -99,18 +105,21 @@ def parse_size(text: str) -> int:
     return int(value * units[unit])
 
 
-def expand_inputs(inputs: Sequence[str]) -> List[str]:
-    """Files, folders (their .pcd/.ply/.las files) and glob patterns, in order; a name that is
-    none of them is an error (FileNotFoundError)."""
+def expand_inputs(inputs: Sequence[str],
+                  extensions: Sequence[str] = CLOUD_EXTENSIONS) -> List[str]:
+    """Files, folders (their files of these extensions: by default .pcd/.ply/.las) and glob
+    patterns, in order; a name that is none of them is an error (FileNotFoundError)."""
     if isinstance(inputs, (str, os.PathLike)):
         inputs = [inputs]
     paths: List[str] = []
     for item in map(os.fspath, inputs):
         if os.path.isdir(item):
             found = sorted(os.path.join(item, n) for n in os.listdir(item)
-                           if n.lower().endswith(CLOUD_EXTENSIONS))
+                           if n.lower().endswith(tuple(extensions)))
             if not found:
-                raise FileNotFoundError(f"{item}: no .pcd, .ply or .las file in the folder")
+                named = [e for e in extensions if e != ".laz"]  # (listed to be refused)
+                raise FileNotFoundError(f"{item}: no {', '.join(named[:-1])} or {named[-1]} file "
+                                        "in the folder")
             paths += found
         elif os.path.exists(item):
             paths.append(item)
@@ -240,6 +249,9 @@ def check_output_folder(output_dir: str, paths: Sequence[str], merge: Optional[s
 
 @dataclass
 class Plan:
+    """Tiles of the merged cloud, cut in its local frame: lo, hi and the chunks' boxes bound the
+    points' floats relative to `origin` (the tools' local origin, local_cloud.h)."""
+    origin: Tuple[float, float, float]
     lo: Tuple[float, float, float]
     hi: Tuple[float, float, float]
     dims: Tuple[int, int, int]
@@ -265,14 +277,22 @@ class Plan:
 
 
 def _chunk_bounds(path: str, index: int, first: int, count: int) -> Tuple:
-    """A worker's pass over a byte range: the float bounds of its finite points."""
-    xyz = _pcl_ddg._read_xyz(path, first, count)
+    """A worker's pass over a byte range: the exact bounds of its finite points."""
+    xyz = _pcl_ddg._read_positions(path, first, count)
     finite = np.isfinite(xyz).all(axis=1)
     n = int(finite.sum())
     if n == 0:
         return index, first, count, None, 0
-    pts = xyz[finite].astype(np.float64)
+    pts = xyz[finite]
     return index, first, count, tuple(pts.min(axis=0)) + tuple(pts.max(axis=0)), n
+
+
+def _local_box(box: Sequence[float], origin: np.ndarray) -> Tuple[float, ...]:
+    """An exact box in the local frame, as its points' floats bound it (rounding to float is
+    monotonic, and the subtraction exact)."""
+    lo = (np.asarray(box[:3], np.float64) - origin).astype(np.float32).astype(np.float64)
+    hi = (np.asarray(box[3:], np.float64) - origin).astype(np.float32).astype(np.float64)
+    return tuple(lo) + tuple(hi)
 
 
 def _grid_dims(extent: np.ndarray, tiles: int) -> Tuple[int, int, int]:
@@ -295,9 +315,12 @@ def make_plan(client: Any, clouds: List[CloudInput], points_per_tile: int,
     finite = sum(r[4] for r in results)
     if not boxes:
         raise DistributedError("the inputs have no finite point")
-    b = np.array(boxes)
+    world = np.array(boxes)
+    origin = np.array(_pcl_ddg._local_origin(list(world[:, :3].min(axis=0)) +
+                                             list(world[:, 3:].max(axis=0))))
+    chunks = [(r[0], r[1], r[2], _local_box(r[3], origin)) for r in results if r[3] is not None]
+    b = np.array([c[3] for c in chunks])
     lo, hi = b[:, :3].min(axis=0), b[:, 3:].max(axis=0)
-    chunks = [(r[0], r[1], r[2], r[3]) for r in results if r[3] is not None]
     # Cut first across the axes along which the chunks are narrow (a file in scan or flight-line
     # order): a tile then reads few chunks beyond its own points.
     extent = np.maximum(hi - lo, 1e-300)
@@ -308,7 +331,8 @@ def make_plan(client: Any, clouds: List[CloudInput], points_per_tile: int,
     area = max(extent[0] * max(extent[1], extent[0] * 1e-3), 1e-300)
     k = options["k"]
     guess = 1.5 * math.sqrt(k / (math.pi * finite / area)) if options["radius"] == 0 else 0.0
-    plan = Plan(tuple(lo), tuple(hi), dims, chunks, [], finite, points_per_tile, guess)
+    plan = Plan(tuple(origin), tuple(lo), tuple(hi), dims, chunks, [], finite, points_per_tile,
+                guess)
     tiles = []
     for t in range(dims[0] * dims[1] * dims[2]):
         tlo, thi = plan.tile_box(t)
@@ -355,11 +379,11 @@ def _resident_bytes() -> int:
 
 
 def _gather(plan: Plan, paths: List[str], firsts: List[int], lo: np.ndarray, hi: np.ndarray,
-            tile: int) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+            tile: int) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The points inside [lo, hi] and (tile >= 0) every point of the tile, in the merged cloud's
-    order: (float32 points, global indices, own mask). Only the byte ranges whose bounds meet the
-    box are read."""
-    parts_xyz, parts_index, parts_own = [], [], []
+    order and its local frame: (float32 points, the same in float64, global indices, own mask).
+    Only the byte ranges whose bounds meet the box are read."""
+    parts_xyz, parts_exact, parts_index, parts_own = [], [], [], []
     lo64, hi64 = np.asarray(lo, np.float64), np.asarray(hi, np.float64)
     size = plan.cell_size()
     size = [float(v) if v > 0 else 1.0 for v in size]
@@ -367,24 +391,29 @@ def _gather(plan: Plan, paths: List[str], firsts: List[int], lo: np.ndarray, hi:
         if not _intersects(lo64, hi64, box):
             continue
         # In C++: a chunk's points inside the box, and the tile's own (its half-open cells).
-        xyz, at, own = _pcl_ddg._gather_chunk(paths[index], first, count, list(lo64), list(hi64),
-                                              list(plan.lo), size, list(plan.dims), tile)
+        xyz, exact, at, own = _pcl_ddg._gather_chunk(
+            paths[index], first, count, list(lo64), list(hi64), list(plan.lo), size,
+            list(plan.dims), tile, list(plan.origin))
         parts_xyz.append(xyz)
+        parts_exact.append(exact)
         parts_index.append(firsts[index] + first + at)
         parts_own.append(own)
     if not parts_xyz:
-        return np.zeros((0, 3), np.float32), np.zeros(0, np.int64), np.zeros(0, bool)
+        return (np.zeros((0, 3), np.float32), np.zeros((0, 3)), np.zeros(0, np.int64),
+                np.zeros(0, bool))
     # The chunks are visited in the merged order and each keeps its order: already sorted.
-    return (np.concatenate(parts_xyz), np.concatenate(parts_index).astype(np.int64),
-            np.concatenate(parts_own))
+    return (np.concatenate(parts_xyz), np.concatenate(parts_exact),
+            np.concatenate(parts_index).astype(np.int64), np.concatenate(parts_own))
 
 
-def _fit(xyz, own_positions, options, halo_lo, halo_hi, bounds, mode):
+def _fit(plan, xyz, exact, own_positions, options, halo_lo, halo_hi, mode):
     o = options
     return _pcl_ddg._fit_tile(
-        xyz, own_positions, o["method"], o["k"], o["radius"], o["max_nn"], list(o["viewpoint"]),
+        xyz, exact, list(plan.origin), own_positions, o["method"], o["k"], o["radius"],
+        o["max_nn"], list(o["viewpoint"]),
         o["orient"], None if o["up"] is None else list(o["up"]),
-        None if halo_lo is None else list(halo_lo) + list(halo_hi), bounds, mode, o["threads"])
+        None if halo_lo is None else list(halo_lo) + list(halo_hi), plan.bounds, mode,
+        o["threads"])
 
 
 def _read_json(path: str) -> Any:
@@ -438,7 +467,7 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
     radius = options["radius"]
     halo = radius * (1.0 + 1e-5) if radius > 0 else plan.halo_guess
     growths = 0
-    xyz, index, own = _gather(plan, paths, firsts, core_lo - halo, core_hi + halo, tile)
+    xyz, exact, index, own = _gather(plan, paths, firsts, core_lo - halo, core_hi + halo, tile)
     largest = len(xyz)
     results_index = [np.zeros(0, np.int64)]
     results = [np.zeros((0, floats), np.float32)]
@@ -447,12 +476,13 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
         for round_ in range(3):
             own_at = np.flatnonzero(own)
             if radius > 0:
-                rec, ok, look, _, f1, f2 = _fit(xyz, own_at, options, None, None, bounds, "all")
+                rec, ok, look, _, f1, f2 = _fit(plan, xyz, exact, own_at, options, None, None,
+                                                "all")
                 far = np.zeros(0, np.int64)
                 break
             lo, hi = core_lo - halo, core_hi + halo
             # Fitted at once (the certified points); thrown away when the halo must widen.
-            rec, ok, look, reach, f1, f2 = _fit(xyz, own_at, options, lo, hi, bounds,
+            rec, ok, look, reach, f1, f2 = _fit(plan, xyz, exact, own_at, options, lo, hi,
                                                 "certified")
             needed = np.maximum(0.0, halo + look - reach)
             p99 = np.sort(needed)[len(needed) - 1 - len(needed) // 100]
@@ -460,9 +490,9 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
                 halo = 1.05 * p99 if np.isfinite(p99) else 2 * halo + float(
                     np.linalg.norm(core_hi - core_lo))
                 growths += 1
-                del xyz, index, own, rec
-                xyz, index, own = _gather(plan, paths, firsts, core_lo - halo, core_hi + halo,
-                                          tile)
+                del xyz, exact, index, own, rec
+                xyz, exact, index, own = _gather(plan, paths, firsts, core_lo - halo,
+                                                 core_hi + halo, tile)
                 largest = max(largest, len(xyz))
                 continue
             far = own_at[~ok]
@@ -482,11 +512,12 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
             a_hi = np.where(finite_look[:, None], fq + far_look[:, None], b[None, 3:]).max(axis=0)
             a_lo, a_hi = np.maximum(a_lo, b[:3] - 1.0), np.minimum(a_hi, b[3:] + 1.0)
             far_index = index[far]
-            del xyz, own
-            xyz2, index2, _ = _gather(plan, paths, firsts, a_lo, a_hi, -1)
+            del xyz, exact, own
+            xyz2, exact2, index2, _ = _gather(plan, paths, firsts, a_lo, a_hi, -1)
             largest = max(largest, len(xyz2))
             positions = np.searchsorted(index2, far_index)
-            rec2, _, _, _, f1, f2 = _fit(xyz2, positions, options, None, None, bounds, "all")
+            rec2, _, _, _, f1, f2 = _fit(plan, xyz2, exact2, positions, options, None, None,
+                                         "all")
             failed += f1
             fallback += f2
             far_count = len(far)
@@ -658,6 +689,15 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
     total = sum(c.points for c in clouds)
     if options["radius"] == 0 and options["k"] > total:
         raise ValueError(f"-k {options['k']} is more than the {total} points of the input")
+    # Aerial LiDAR has no single viewpoint: LAS inputs are oriented up unless told otherwise, as
+    # the tools orient them (fit_steps.h, orientLasUp).
+    las_up = orient is None and viewpoint is None and all(
+        c.path.lower().endswith(".las") for c in clouds)
+    if las_up:
+        options["orient"] = "up"
+        if progress:
+            stream.write("pcl_ddg.distributed: LAS inputs: normals oriented up (n . z >= 0, as "
+                         "PDAL's filters.normal; viewpoint= or orient= chooses otherwise)\n")
     if options["viewpoint"] is None:
         options["viewpoint"] = list(clouds[0].viewpoint)
     if merge is None:
@@ -717,7 +757,7 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
         plan = make_plan(client, clouds, points_per_tile, options)
         seconds_plan = time.perf_counter() - started
         described = json.loads(json.dumps({
-            "lo": plan.lo, "hi": plan.hi, "dims": plan.dims, "tiles": plan.tiles,
+            "origin": plan.origin, "lo": plan.lo, "hi": plan.hi, "dims": plan.dims, "tiles": plan.tiles,
             "points_per_tile": plan.points_per_tile, "halo_guess": plan.halo_guess}))
         same_plan = _read_json(plan_path) == described
         if not same_plan:  # tiles of another plan are not this one's
@@ -796,6 +836,7 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
     computed = sum(r["points"] for r in tiles)
     return {
         "points": total, "finite_points": plan.finite_points, "tiles": len(plan.tiles),
+        "orientation": options["orient"] + (" (a LAS input's default)" if las_up else ""),
         "tiles_run": len(tiles), "tiles_skipped": skipped,
         "retries": max(0, len(attempts) - len(tiles)), "seconds": seconds,
         "points_per_second": computed / seconds if seconds > 0 else 0.0,
@@ -888,21 +929,34 @@ def run_file(tool: str, arguments: List[str], source: str, output: str, check: s
             "peak_bytes": _peak_bytes()}
 
 
+def _batch_output_name(path: str) -> str:
+    """The name of batch's output for an input: the input's, or <stem>.ply for a format the tools
+    do not write (.obj .off .stl .vtk)."""
+    name = os.path.basename(path)
+    stem, extension = os.path.splitext(name)
+    return name if extension.lower() in OUTPUT_EXTENSIONS else stem + ".ply"
+
+
 def batch(inputs, output_dir, tool: str, arguments: Sequence[str] = (), client=None, *,
           retries: int = 3, resume: bool = True, scheduler: Optional[str] = None,
           workers: Optional[int] = None, progress: bool = False, stream=None,
           connect_timeout: float = 5.0) -> Dict[str, Any]:
     """Runs the tool (``normals``, ``curvature``, ... or ``pcl_ddg_smooth``) on every input file
-    independently, one task each: OUTPUT_DIR/<input's name> equals the tool run on that file."""
+    (a cloud or a mesh; a folder gives all of its files the tools read) independently, one task
+    each: OUTPUT_DIR/<input's name> equals the tool run on that file, written as .ply for a mesh
+    format the tools do not write (a.off gives a.ply)."""
     stream = stream or sys.stderr
     start = time.perf_counter()
     executable = find_tool(tool)
-    paths = expand_inputs(inputs)
+    paths = expand_inputs(inputs, CLOUD_EXTENSIONS + MESH_EXTENSIONS)
     output_dir = os.fspath(output_dir)
     check_output_folder(output_dir, paths, None)
-    names = [os.path.basename(p) for p in paths]
-    if len(set(names)) != len(names):
-        raise ValueError("two inputs have the same file name")
+    names = [_batch_output_name(p) for p in paths]
+    written_by: Dict[str, str] = {}
+    for p, n in zip(paths, names):
+        if n in written_by:
+            raise ValueError(f"{written_by[n]} and {p} would both write {n}")
+        written_by[n] = p
     state = os.path.join(output_dir, STATE_FOLDER, "batch")
     os.makedirs(state, exist_ok=True)
     jobs = []

@@ -1,6 +1,7 @@
 // Point cloud functions: fitted normals and curvatures (pca, quadric) with kd-tree, mesh-ring or
-// pixel-grid neighbourhoods, orientation, and the neighbourhood comparison. The points become PCL's
-// float points by the cast the tools make (double -> float), so results equal the tools'.
+// pixel-grid neighbourhoods, orientation, and the neighbourhood comparison. The points are placed
+// about their local origin as the tools place a file's (local_cloud.h), so results equal the
+// tools'.
 #include <pcl/exceptions.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -24,7 +25,7 @@ namespace {
 using Cloud = pcl::PointCloud<pcl::PointXYZ>;
 
 template <typename T>
-bool readPoints(const py::array& array, Cloud& cloud) {
+bool readPoints(const py::array& array, Eigen::Matrix3Xd& positions, std::size_t width) {
   const py::dtype dtype = py::dtype::of<T>();
   if (dtype.kind() != array.dtype().kind() || dtype.itemsize() != array.dtype().itemsize())
     return false;
@@ -32,21 +33,19 @@ bool readPoints(const py::array& array, Cloud& cloud) {
   const int nd = static_cast<int>(array.ndim());
   const py::ssize_t s_row = array.strides(nd == 3 ? 1 : 0), s_coord = array.strides(nd - 1);
   const py::ssize_t s_grid = nd == 3 ? array.strides(0) : 0;
-  const std::size_t width = cloud.width;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
     const char* row = base + static_cast<py::ssize_t>(i / width) * s_grid +
                       static_cast<py::ssize_t>(i % width) * s_row;
-    for (int d = 0; d < 3; ++d) {
-      // Through double, as the tools read a file (exact for every type but 64-bit integers).
-      cloud[i].data[d] =
-          static_cast<float>(static_cast<double>(*reinterpret_cast<const T*>(row + d * s_coord)));
-    }
+    // In double, as the tools read a file (exact for every type but 64-bit integers).
+    for (int d = 0; d < 3; ++d)
+      positions(d, i) = static_cast<double>(*reinterpret_cast<const T*>(row + d * s_coord));
   }
   return true;
 }
 
-// (n, 3) or organized (h, w, 3) points as PCL's float points, is_dense when all are finite.
-Cloud::Ptr cloudOf(const py::array& points) {
+// (n, 3) or organized (h, w, 3) points about their local origin, as the tools place a file's
+// (local_cloud.h): float64 coordinates are fitted as they are, wherever they lie.
+LocalCloud cloudOf(const py::array& points) {
   const int nd = static_cast<int>(points.ndim());
   if ((nd != 2 && nd != 3) || points.shape(nd - 1) != 3)
     throw py::value_error("points must have shape (n, 3) or (h, w, 3)");
@@ -56,29 +55,26 @@ Cloud::Ptr cloudOf(const py::array& points) {
                           std::string(py::str(points.dtype())));
   if (points.size() / 3 > std::numeric_limits<int>::max())
     throw py::value_error("points has more rows than the library indexes");
-  auto cloud = std::make_shared<Cloud>();
-  const auto height = nd == 3 ? static_cast<std::uint32_t>(points.shape(0)) : 1u;
   const auto width = static_cast<std::uint32_t>(nd == 3 ? points.shape(1) : points.shape(0));
-  cloud->resize(static_cast<std::size_t>(width) * height);
-  cloud->width = width;
-  cloud->height = height;
-  if (cloud->empty()) throw py::value_error("points is empty");
+  Eigen::Matrix3Xd positions(3, points.size() / 3);
+  if (positions.cols() == 0) throw py::value_error("points is empty");
   py::array source = points;
   if (points.dtype().byteorder() == '>')
     source = py::array_t<double, py::array::forcecast>::ensure(points);
-  if (!(readPoints<double>(source, *cloud) || readPoints<float>(source, *cloud) ||
-        readPoints<std::int64_t>(source, *cloud) || readPoints<std::int32_t>(source, *cloud) ||
-        readPoints<std::uint64_t>(source, *cloud) || readPoints<std::uint32_t>(source, *cloud) ||
-        readPoints<std::int16_t>(source, *cloud) || readPoints<std::uint16_t>(source, *cloud) ||
-        readPoints<std::int8_t>(source, *cloud) || readPoints<std::uint8_t>(source, *cloud))) {
+  if (!(readPoints<double>(source, positions, width) ||
+        readPoints<float>(source, positions, width) ||
+        readPoints<std::int64_t>(source, positions, width) ||
+        readPoints<std::int32_t>(source, positions, width) ||
+        readPoints<std::uint64_t>(source, positions, width) ||
+        readPoints<std::uint32_t>(source, positions, width) ||
+        readPoints<std::int16_t>(source, positions, width) ||
+        readPoints<std::uint16_t>(source, positions, width) ||
+        readPoints<std::int8_t>(source, positions, width) ||
+        readPoints<std::uint8_t>(source, positions, width))) {
     const auto converted = py::array_t<double, py::array::forcecast>::ensure(points);
-    readPoints<double>(converted, *cloud);
+    readPoints<double>(converted, positions, width);
   }
-  bool dense = true;
-  for (const pcl::PointXYZ& p : *cloud)
-    dense = dense && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-  cloud->is_dense = dense;
-  return cloud;
+  return makeLocalCloud(positions, nd == 3 ? width : 0);
 }
 
 std::optional<Eigen::Vector3d> vectorOf(const std::optional<std::vector<double>>& v,
@@ -133,7 +129,7 @@ struct FitArguments {
 };
 
 // The options of pcl_ddg_normals' in-memory path (localFitArguments), checked the same way.
-LocalFitOptions fitOptions(const FitArguments& a, Cloud& cloud,
+LocalFitOptions fitOptions(const FitArguments& a, const Cloud& cloud,
                            std::shared_ptr<const MeshTopology>& topology) {
   LocalFitOptions options;
   const std::string method = choice("method", a.method, {"pca", "quadric", "robust"});
@@ -205,7 +201,6 @@ LocalFitOptions fitOptions(const FitArguments& a, Cloud& cloud,
                                               : NormalOrientation::MeshFaces;
   // As the tool: the viewpoint is the sensor's (a PCD's VIEWPOINT), the origin by default.
   options.viewpoint = vectorOf(a.viewpoint, "viewpoint").value_or(Eigen::Vector3d::Zero());
-  cloud.sensor_origin_.head<3>() = options.viewpoint->cast<float>();
   options.up = directionOf(a.up);
   options.seed_facing_viewpoint = !a.up && (a.viewpoint || cloud.height > 1);
   options.threads = a.threads;
@@ -224,11 +219,12 @@ py::dict fitCounts(const LocalFitResult& result) {
 
 void bindClouds(py::module_& m) {
   const auto fit = [](const py::array& points, const FitArguments& arguments, bool curvatures) {
-    Cloud::Ptr cloud = cloudOf(points);
+    const LocalCloud local = cloudOf(points);
+    const Cloud::ConstPtr& cloud = local.points;
     std::shared_ptr<const MeshTopology> topology;
     const LocalFitOptions options = fitOptions(arguments, *cloud, topology);
     const LocalFitResult result =
-        compute([&] { return fitLocalSurfaces(cloud, topology, options); });
+        compute([&] { return fitLocalSurfaces(local, topology, options); });
     py::array_t<double> normals = normalsArray(*cloud, result.normals);
     py::array_t<bool> valid(shapeOf(*cloud, 0));
     bool* ok = valid.mutable_data();
@@ -382,7 +378,7 @@ void bindClouds(py::module_& m) {
         if (F.is_none() && V.ndim() != 3)
           throw py::value_error(
               "compare_neighbourhoods needs faces, or an organized (h, w, 3) cloud");
-        Cloud::Ptr cloud = cloudOf(V);
+        const LocalCloud local = cloudOf(V);
         std::shared_ptr<const MeshTopology> topology;
         FitArguments a;
         a.method = method;
@@ -391,9 +387,9 @@ void bindClouds(py::module_& m) {
         a.max_nn = max_nn;
         a.faces = F;
         a.threads = threads;
-        const LocalFitOptions options = fitOptions(a, *cloud, topology);
+        const LocalFitOptions options = fitOptions(a, *local.points, topology);
         NeighbourhoodComparison c =
-            compute([&] { return compareNeighbourhoods(cloud, topology, options); });
+            compute([&] { return compareNeighbourhoods(local, topology, options); });
         const NeighbourhoodComparison::Summary& s = c.summary;
         py::dict summary;
         summary["compared"] = s.compared;

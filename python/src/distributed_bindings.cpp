@@ -64,33 +64,35 @@ py::dict cloudLayout(const std::string& path) {
   return d;
 }
 
-// Points [first, first + count) of a binary PCD/PLY file as PCL's float points (the tools' toXYZ:
-// exact coordinates, then float); NaN rows stay.
-py::array_t<float> readXYZ(const std::string& path, std::int64_t first, std::int64_t count) {
-  py::array_t<float> out(
+// Points [first, first + count) of a cloud file, exact (double; NaN rows stay): a chunk's bounds
+// for the plan and the local origin.
+py::array_t<double> readPositions(const std::string& path, std::int64_t first, std::int64_t count) {
+  py::array_t<double> out(
       {static_cast<py::ssize_t>(std::max<std::int64_t>(count, 0)), py::ssize_t{3}});
-  float* data = out.mutable_data();
+  double* data = out.mutable_data();
   {
     py::gil_scoped_release release;
     CloudPieceReader pieces(path);
     const Eigen::Matrix3Xd positions = pieces.read(first, count).positions;
-    for (Eigen::Index i = 0; i < positions.cols(); ++i)
-      for (int d = 0; d < 3; ++d) data[3 * i + d] = static_cast<float>(positions(d, i));
+    std::copy(positions.data(), positions.data() + positions.size(), data);
   }
   return out;
 }
 
-// A chunk's points that a tile gathers: those inside the closed box [lo, hi] and (tile >= 0) the
-// tile's own (their grid cell, half-open: floor((x - origin) / size), clamped to the grid). Returns
-// (float32 points, their positions in the chunk, own mask), in the chunk's order.
+// A chunk's points that a tile gathers, relative to the run's local origin (local_cloud.h): those
+// whose floats lie inside the closed box [lo, hi] and (tile >= 0) the tile's own (their grid cell,
+// half-open: floor((x - origin) / size), clamped to the grid). Returns (float32 points, the same
+// in double, their positions in the chunk, own mask), in the chunk's order.
 py::tuple gatherChunk(const std::string& path, std::int64_t first, std::int64_t count,
                       const std::vector<double>& lo, const std::vector<double>& hi,
                       const std::vector<double>& origin, const std::vector<double>& size,
-                      const std::vector<std::int64_t>& dims, std::int64_t tile) {
+                      const std::vector<std::int64_t>& dims, std::int64_t tile,
+                      const std::vector<double>& local_origin) {
   if (lo.size() != 3 || hi.size() != 3 || origin.size() != 3 || size.size() != 3 ||
-      dims.size() != 3)
-    throw py::value_error("lo, hi, origin, size and dims are x, y, z");
+      dims.size() != 3 || local_origin.size() != 3)
+    throw py::value_error("lo, hi, origin, size, dims and local_origin are x, y, z");
   std::vector<float> kept;
+  std::vector<double> kept_exact;
   std::vector<std::int64_t> at;
   std::vector<std::uint8_t> own;
   {
@@ -99,10 +101,13 @@ py::tuple gatherChunk(const std::string& path, std::int64_t first, std::int64_t 
     const Eigen::Matrix3Xd positions = pieces.read(first, count).positions;
     for (Eigen::Index i = 0; i < positions.cols(); ++i) {
       float f[3];
-      double v[3];
+      double v[3], exact[3];
       bool finite = true, inside = true;
       for (int d = 0; d < 3; ++d) {
-        f[d] = static_cast<float>(positions(d, i));
+        exact[d] = positions(d, i) - local_origin[d];
+        if (std::isfinite(exact[d]) && std::abs(exact[d]) > std::numeric_limits<float>::max())
+          throw FileFormatException(path + ": a point lies beyond float's range from the others");
+        f[d] = static_cast<float>(exact[d]);
         v[d] = static_cast<double>(f[d]);
         finite = finite && std::isfinite(v[d]);
         inside = inside && v[d] >= lo[d] && v[d] <= hi[d];
@@ -119,14 +124,17 @@ py::tuple gatherChunk(const std::string& path, std::int64_t first, std::int64_t 
       }
       if (!inside && !mine) continue;
       kept.insert(kept.end(), f, f + 3);
+      kept_exact.insert(kept_exact.end(), exact, exact + 3);
       at.push_back(i);
       own.push_back(mine ? 1 : 0);
     }
   }
   py::array_t<float> points({static_cast<py::ssize_t>(at.size()), py::ssize_t{3}});
   if (!kept.empty()) std::memcpy(points.mutable_data(), kept.data(), kept.size() * sizeof(float));
+  py::array_t<double> exact({static_cast<py::ssize_t>(at.size()), py::ssize_t{3}});
+  std::copy(kept_exact.begin(), kept_exact.end(), exact.mutable_data());
   std::vector<std::uint8_t> own_copy = own;
-  return py::make_tuple(points, vectorArray(std::move(at)), maskArray(own_copy));
+  return py::make_tuple(points, exact, vectorArray(std::move(at)), maskArray(own_copy));
 }
 
 Eigen::AlignedBox3d boxOf(const std::vector<double>& b) {
@@ -182,6 +190,8 @@ class LookingKdTree : public KdTreeSearch<pcl::PointXYZ> {
  * unchecked), failed, fallback).
  */
 py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::forcecast>& xyz,
+                  const py::array_t<double, py::array::c_style | py::array::forcecast>& exact,
+                  const std::vector<double>& local_origin,
                   const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& own,
                   const std::string& method, int k, double radius, unsigned int max_nn,
                   const std::vector<double>& viewpoint, const std::string& orient,
@@ -191,6 +201,9 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
                   unsigned int threads) {
   const bool certify = choice("mode", mode, {"certified", "all"}) == "certified";
   if (xyz.ndim() != 2 || xyz.shape(1) != 3) throw py::value_error("points must be (m, 3)");
+  if (exact.ndim() != 2 || exact.shape(0) != xyz.shape(0) || exact.shape(1) != 3)
+    throw py::value_error("exact must be the points in double, (m, 3)");
+  if (local_origin.size() != 3) throw py::value_error("local_origin must be x, y, z");
   const auto m = static_cast<std::size_t>(xyz.shape(0));
   const auto n_own = static_cast<std::size_t>(own.size());
   LocalFitOptions options;
@@ -236,6 +249,10 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
       (*cloud)[i].y = p[3 * i + 1];
       (*cloud)[i].z = p[3 * i + 2];
     }
+    LocalCloud local(cloud);
+    local.positions = std::make_shared<const Eigen::Matrix3Xd>(
+        Eigen::Map<const Eigen::Matrix3Xd>(exact.data(), 3, static_cast<Eigen::Index>(m)));
+    local.origin = Eigen::Vector3d(local_origin[0], local_origin[1], local_origin[2]);
     for (std::size_t j = 0; j < n_own; ++j) {
       if (own_at[j] < 0 || static_cast<std::size_t>(own_at[j]) >= m)
         throw pcl::BadArgumentException("own position outside the gathered points");
@@ -246,7 +263,7 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
       options.kd_tree_search = search;
     }
     auto indices = std::make_shared<pcl::Indices>(own_at, own_at + n_own);
-    if (n_own > 0) fit = fitLocalSurfaces(cloud, nullptr, options, indices);
+    if (n_own > 0) fit = fitLocalSurfaces(local, nullptr, options, indices);
     // tiled_local_fit.cpp's rule: the k-th neighbour among the gathered points (never nearer than
     // the true one), widened by the rounding margin, within the reach.
     for (std::size_t j = 0; j < n_own; ++j) {
@@ -456,17 +473,32 @@ void bindDistributed(py::module_& m) {
   m.def("_cloud_layout", &cloudLayout, py::arg("path"),
         "How a binary PCD/PLY cloud lies on disk (header only): points, header_bytes, "
         "point_bytes, width, height, viewpoint, orientation, fields.");
-  m.def("_read_xyz", &readXYZ, py::arg("path"), py::arg("first"), py::arg("count"),
-        "Points [first, first + count) of a binary PCD/PLY file as float32 (n, 3), read by "
-        "their byte range and converted as the tools convert them.");
+  m.def("_read_positions", &readPositions, py::arg("path"), py::arg("first"), py::arg("count"),
+        "Points [first, first + count) of a cloud file as float64 (n, 3), read by their byte "
+        "range, exact (LAS: X * scale + offset).");
+  m.def(
+      "_local_origin",
+      [](const std::vector<double>& bounds) {
+        if (bounds.size() != 6)
+          throw py::value_error("bounds are (xmin, ymin, zmin, xmax, ymax, zmax)");
+        Eigen::AlignedBox3d box(Eigen::Vector3d(bounds[0], bounds[1], bounds[2]),
+                                Eigen::Vector3d(bounds[3], bounds[4], bounds[5]));
+        const Eigen::Vector3d o = localOrigin(box);
+        return std::vector<double>{o.x(), o.y(), o.z()};
+      },
+      py::arg("bounds"),
+      "The local origin of points within these bounds (local_cloud.h): what the tools centre "
+      "a cloud on before its floats are searched.");
   m.def("_gather_chunk", &gatherChunk, py::arg("path"), py::arg("first"), py::arg("count"),
         py::arg("lo"), py::arg("hi"), py::arg("origin"), py::arg("size"), py::arg("dims"),
-        py::arg("tile"),
-        "A chunk's points inside the box [lo, hi] and the tile's own (grid cells of the given "
-        "origin, size and dims): (float32 points, positions in the chunk, own mask).");
-  m.def("_fit_tile", &fitTile, py::arg("points"), py::arg("own"), py::arg("method"), py::arg("k"),
-        py::arg("radius"), py::arg("max_nn"), py::arg("viewpoint"), py::arg("orient"),
-        py::arg("up"), py::arg("halo_box"), py::arg("bounds"), py::arg("mode"), py::arg("threads"),
+        py::arg("tile"), py::arg("local_origin"),
+        "A chunk's points relative to local_origin inside the box [lo, hi] and the tile's own "
+        "(grid cells of the given origin, size and dims): (float32 points, float64 points, "
+        "positions in the chunk, own mask).");
+  m.def("_fit_tile", &fitTile, py::arg("points"), py::arg("exact"), py::arg("local_origin"),
+        py::arg("own"), py::arg("method"), py::arg("k"), py::arg("radius"), py::arg("max_nn"),
+        py::arg("viewpoint"), py::arg("orient"), py::arg("up"), py::arg("halo_box"),
+        py::arg("bounds"), py::arg("mode"), py::arg("threads"),
         "Fits a tile's own points among its gathered points (merged-cloud order); mode "
         "'certified': the fits of the points whose k-th neighbour is nearer than the halo's edge "
         "count, 'all': every own point's.");

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import pcl_ddg
-from conftest import icosphere
+from conftest import icosphere, shared_data
 
 
 def sphere_cloud(n=20000, radius=2.0, seed=0):
@@ -98,3 +98,57 @@ def test_compare_neighbourhoods_on_a_mesh():
     assert c.angle_difference.shape == (V.shape[0],)
     assert c.summary["compared"] == V.shape[0]
     assert np.all((c.overlap >= 0) & (c.overlap <= 1))
+
+
+def _survey_scene(seed: int = 5) -> np.ndarray:
+    """A sphere of radius 20 beside a jittered 60 x 60 height field, on a 2^-16 grid so that
+    moving it by a survey's offset is exact in float64."""
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(4000, 3))
+    sphere = np.array([150.0, 0.0, 0.0]) + 20.0 * d / np.linalg.norm(d, axis=1)[:, None]
+    u, v = np.meshgrid(np.arange(60.0) - 30.0, np.arange(60.0) - 30.0)
+    x = u.ravel() + rng.uniform(-0.3, 0.3, u.size)
+    y = v.ravel() + rng.uniform(-0.3, 0.3, v.size)
+    field = np.stack([x, y, 2.0 * np.sin(x / 7.0) * np.cos(y / 5.0)], axis=1)
+    return np.round(np.concatenate([sphere, field]) * 65536.0) / 65536.0
+
+
+@pytest.mark.parametrize("method", ["pca", "quadric", "robust"])
+def test_float64_points_far_away_give_the_normals_at_the_origin(method):
+    # Fitted about their local origin in double (as the tools fit a file): 5e6 away, the float32
+    # points would step by 0.5 and the height field's normals be off by tens of degrees.
+    near = _survey_scene()
+    far = near + np.array([5e5, 5e6, 200.0])
+    assert np.array_equal(far - np.array([5e5, 5e6, 200.0]), near)
+    a = pcl_ddg.estimate_normals(near, method=method, orient="up").normals
+    b = pcl_ddg.estimate_normals(far, method=method, orient="up").normals
+    # atan2 of the cross and dot products: exact near 0, where arccos of a float dot is not.
+    angle = np.arctan2(np.linalg.norm(np.cross(a, b), axis=1), np.abs(np.sum(a * b, axis=1)))
+    # Two frames' float searches may order a near tie of distances either way: a few points.
+    assert np.count_nonzero(angle > 1e-6) <= len(near) // 500, np.sort(angle)[-10:]
+    rounded = pcl_ddg.estimate_normals(far.astype(np.float32), method=method, orient="up").normals
+    off = np.arctan2(np.linalg.norm(np.cross(a, rounded), axis=1),
+                     np.abs(np.sum(a * rounded, axis=1)))
+    assert np.degrees(off.max()) > 5.0  # float32 input keeps its floats: they are its truth
+
+
+def test_principal_curvatures_far_away_equal_those_at_the_origin():
+    near = _survey_scene()
+    a = pcl_ddg.principal_curvatures(near, orient="up")
+    b = pcl_ddg.principal_curvatures(near + np.array([5e5, 5e6, 200.0]), orient="up")
+    same = np.isclose(a.k1, b.k1, rtol=1e-9, atol=1e-12) & np.isclose(a.k2, b.k2, rtol=1e-9,
+                                                                        atol=1e-12)
+    assert np.count_nonzero(~same) <= len(near) // 500
+
+
+def test_a_las_file_read_is_oriented_up_by_default():
+    las = shared_data() / "las" / "autzen_trim.las"
+    f = pcl_ddg.read(las)
+    normals = pcl_ddg.estimate_normals(f).normals
+    assert np.nanmin(normals[:, 2]) >= 0.0
+    assert np.array_equal(normals, pcl_ddg.estimate_normals(f.points, orient="up").normals,
+                          equal_nan=True)
+    # A viewpoint given chooses otherwise, as the tool's -viewpoint does.
+    below = f.points.mean(axis=0) - np.array([0.0, 0.0, 1e4])
+    down = pcl_ddg.estimate_normals(f, viewpoint=below).normals
+    assert np.nanmean(down[:, 2] < 0) > 0.9

@@ -1,7 +1,8 @@
 """pcl_ddg.distributed on a LocalCluster of 2 worker processes: a shared scan split into 4 files by
 a grid (written here, in a temporary folder) gives, merged, the bytes pcl_ddg_normals /
-pcl_ddg_curvature write for the merged cloud; batch mode equals the tool per file; a worker
-killed in the middle of a tile, a resumed run, bad inputs, and a worker's peak memory."""
+pcl_ddg_curvature write for the merged cloud; batch mode equals the tool per file (clouds, and
+OFF, OBJ and STL meshes, whose outputs are PLY); a worker killed in the middle of a tile, a resumed
+run, bad inputs, and a worker's peak memory."""
 
 import json
 import os
@@ -16,7 +17,7 @@ import numpy as np
 import pytest
 
 import pcl_ddg
-from conftest import run_tool, shared_data
+from conftest import icosphere, run_tool, shared_data
 
 distributed = pytest.importorskip("distributed")
 import pcl_ddg.distributed as dd  # noqa: E402
@@ -131,6 +132,35 @@ def test_las_tiles_equal_the_tool_on_the_merged_las(tmp_path, client, las_scene,
     assert (out / ("m" + suffix)).read_bytes() == expected.read_bytes()
 
 
+def test_survey_coordinates_in_tiles_equal_the_tool_and_the_cloud_at_the_origin(tmp_path, client):
+    # A double PLY 5e6 from the origin (a sphere beside a height field on a 2^-16 grid): the tiles
+    # are searched and fitted about the run's local origin, as the tool fits the file, and give
+    # the normals of the same points at the origin (but where two frames' floats order a near
+    # tie of distances differently).
+    rng = np.random.default_rng(3)
+    d = rng.normal(size=(20000, 3))
+    sphere = np.array([150.0, 0.0, 0.0]) + 20.0 * d / np.linalg.norm(d, axis=1)[:, None]
+    u, v = np.meshgrid(np.arange(100.0) - 50.0, np.arange(100.0) - 50.0)
+    x, y = u.ravel() + rng.uniform(-0.3, 0.3, u.size), v.ravel() + rng.uniform(-0.3, 0.3, v.size)
+    near = np.concatenate([sphere, np.stack([x, y, np.sin(x / 7.0) * np.cos(y / 5.0)], 1)])
+    near = np.round(near * 65536.0) / 65536.0
+    far = near + np.array([5e5, 5e6, 200.0])
+    pcl_ddg.write(tmp_path / "far.ply", far)
+    run_tool("pcl_ddg_normals", tmp_path / "far.ply", tmp_path / "tool.ply", "-k", "16",
+             "-orient", "up")
+    summary = dd.estimate_normals([tmp_path / "far.ply"], tmp_path / "out", client=client, k=16,
+                                  orient="up", memory_per_worker=memory(client, 8000))
+    assert summary["tiles"] >= 4
+    assert (tmp_path / "out" / "far.ply").read_bytes() == (tmp_path / "tool.ply").read_bytes()
+    fields = pcl_ddg.read(tmp_path / "out" / "far.ply").fields
+    tiles = np.stack([fields["nx"], fields["ny"], fields["nz"]], axis=1).astype(np.float64)
+    reference = pcl_ddg.estimate_normals(near, k=16, orient="up").normals
+    # atan2 of the cross and dot products: exact near 0, where arccos of a float dot is not.
+    angle = np.arctan2(np.linalg.norm(np.cross(tiles, reference), axis=1),
+                       np.abs(np.sum(tiles * reference, axis=1)))
+    assert np.count_nonzero(angle > 1e-6) <= len(near) // 500, np.sort(angle)[-10:]
+
+
 def test_curvature_pcd_and_per_file_outputs(tmp_path, client, scene):
     paths, merged = scene
     expected = tmp_path / "tool.pcd"
@@ -180,6 +210,60 @@ def test_batch_equals_the_tool_per_file(tmp_path, client, scene):
     again = dd.batch(str(paths[0].parent / "part[01].ply"), out, "normals",
                      ["-method", "quadric", "-k", "20"], client=client)
     assert again["files_run"] == 0 and again["files_skipped"] == 2
+
+
+def write_meshes(folder, V, F):
+    """The same triangle mesh as OFF, OBJ and ASCII STL (sphere_off.off, ...), written here from
+    the formats' texts."""
+    folder.mkdir()
+    rows = ["{!r} {!r} {!r}\n".format(*v) for v in V]
+    texts = {
+        "off": f"OFF\n{len(V)} {len(F)} 0\n" + "".join(rows) +
+               "".join(f"3 {a} {b} {c}\n" for a, b, c in F),
+        "obj": "".join("v " + r for r in rows) +
+               "".join(f"f {a + 1} {b + 1} {c + 1}\n" for a, b, c in F),
+        "stl": "solid sphere\n" + "".join(
+            "facet normal 0 0 0\nouter loop\n" + "".join("vertex " + rows[i] for i in face) +
+            "endloop\nendfacet\n" for face in F) + "endsolid sphere\n",
+    }
+    paths = []
+    for extension, text in texts.items():
+        paths.append(folder / f"sphere_{extension}.{extension}")
+        paths[-1].write_text(text)
+    return paths
+
+
+def test_batch_over_meshes_writes_ply_with_the_tools_normals(tmp_path, client):
+    """Meshes with default options: each output is <name>.ply, byte for byte the tool's output
+    for that file, and its normals are the sphere's (outward radial, to the faces' resolution)."""
+    centre = np.array([3.0, -1.0, 0.5])
+    V, F = icosphere(3, radius=2.0)
+    inputs = write_meshes(tmp_path / "meshes", V + centre, F)
+    out = tmp_path / "out"
+    summary = dd.batch(str(tmp_path / "meshes" / "sphere_*"), out, "normals", client=client)
+    assert summary["files_run"] == 3
+    expected = [out / f"sphere_{e}.ply" for e in ("obj", "off", "stl")]  # sorted by name
+    assert summary["outputs"] == [str(p) for p in expected]
+    for path in inputs:
+        written = out / (path.stem + ".ply")
+        assert written.exists(), written
+        tool_output = tmp_path / ("tool_" + path.stem + ".ply")
+        run_tool("pcl_ddg_normals", path, tool_output)
+        assert written.read_bytes() == tool_output.read_bytes(), path.name
+        m = pcl_ddg.read(written)
+        assert m.faces is not None and len(m.faces) == len(F)
+        n = np.stack([m.fields["nx"], m.fields["ny"], m.fields["nz"]], axis=1)
+        radial = m.points - centre
+        radial /= np.linalg.norm(radial, axis=1, keepdims=True)
+        assert np.all(np.einsum("ij,ij->i", n, radial) > 0.999), path.name
+    # A folder gives its meshes too; two that would write the same .ply are refused before any
+    # task runs, naming both.
+    twice = tmp_path / "twice"
+    twice.mkdir()
+    for path in inputs[:2]:
+        (twice / ("same" + path.suffix)).write_bytes(path.read_bytes())
+    with pytest.raises(ValueError, match=r"same\.obj and .*same\.off would both write same\.ply"):
+        dd.batch(str(twice), tmp_path / "out2", "normals", client=client)
 
 
 def test_worker_killed_in_a_tile(tmp_path, scene, monkeypatch):

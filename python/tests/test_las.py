@@ -1,8 +1,10 @@
 """LAS through the module: exact coordinates and fields against an independent reader written
-here from the ASPRS LAS 1.4 R15 tables, read -> write round trips of the records, the LAZ and
-truncated-file refusals, and normals equal to pcl_ddg_normals' on the same file."""
+here from the ASPRS LAS 1.4 R15 tables, read -> write round trips of the records, the warning of
+a new file that carries no VLR of its input, the LAZ, truncated-file and no-point refusals, and
+normals equal to pcl_ddg_normals' on the same file."""
 
 import struct
+import warnings
 
 import numpy as np
 import pytest
@@ -174,7 +176,7 @@ def test_read_write_read_keeps_records_and_vlrs(name, tmp_path):
 
 def test_new_file_and_normals_as_extra_bytes(tmp_path):
     m = pcl_ddg.read(las_path("test1_4.las"))
-    n = pcl_ddg.estimate_normals(m.points, k=16)
+    n = pcl_ddg.estimate_normals(m, k=16)  # a LAS file: oriented up, as the tool orients it
     out = tmp_path / "normals.las"
     fields = dict(m.fields, normals=n.normals, curvature=n.curvature)
     pcl_ddg.write(out, m.points, fields=fields, las=m.las)
@@ -191,11 +193,41 @@ def test_new_file_and_normals_as_extra_bytes(tmp_path):
 
     # Without a layout: LAS 1.4 format 6, exact enough coordinates, the fields kept.
     fresh = tmp_path / "fresh.las"
-    pcl_ddg.write(fresh, m.points, fields={"intensity": m.fields["intensity"]})
+    with pytest.warns(UserWarning, match="no CRS"):
+        pcl_ddg.write(fresh, m.points, fields={"intensity": m.fields["intensity"]})
     f = pcl_ddg.read(fresh)
     assert f.las.version == (1, 4) and f.las.point_format == 6
     np.testing.assert_array_equal(f.fields["intensity"], m.fields["intensity"])
     np.testing.assert_allclose(f.points, m.points, rtol=0, atol=np.max(f.las.scale))
+
+
+def test_a_new_las_file_warns_that_it_carries_no_vlr_of_the_input(tmp_path):
+    m = pcl_ddg.read(las_path("autzen_trim.las"))
+    assert any(r[0] == "LASF_Projection" for r in m.las.vlrs)  # its CRS
+    fresh = tmp_path / "fresh.las"
+    with pytest.warns(UserWarning) as caught:
+        pcl_ddg.write(fresh, m.points)
+    assert len(caught) == 1
+    message = str(caught[0].message)
+    assert str(fresh) in message and "CRS" in message and "VLR" in message, message
+    assert "las=pcl_ddg.read(input).las" in message, message
+    assert caught[0].filename == __file__  # points at the caller's line
+    assert pcl_ddg.read(fresh).las.vlrs == []  # what the warning says: no VLR of the input
+    # With the input's layout every VLR is kept, and nothing is said; other formats say nothing.
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pcl_ddg.write(tmp_path / "kept.las", m.points, fields=m.fields, las=m.las)
+        pcl_ddg.write(tmp_path / "cloud.ply", m.points)
+    assert pcl_ddg.read(tmp_path / "kept.las").las.vlrs == m.las.vlrs
+    assert "las=" in pcl_ddg.write.__doc__ and "CRS" in pcl_ddg.write.__doc__
+
+
+def test_a_file_of_no_points_is_refused_naming_it():
+    path = las_path("no-points.las")
+    with pytest.raises(OSError) as error:
+        pcl_ddg.read(path)
+    message = str(error.value)
+    assert "no-points.las" in message and "no points" in message, message
 
 
 def test_normals_equal_the_tool(tmp_path):
@@ -205,7 +237,7 @@ def test_normals_equal_the_tool(tmp_path):
     tool = pcl_ddg.read(out)
     m = pcl_ddg.read(path)
     np.testing.assert_array_equal(tool.points, m.points)
-    n = pcl_ddg.estimate_normals(m.points, k=16)
+    n = pcl_ddg.estimate_normals(m, k=16)  # a LAS file: oriented up, as the tool orients it
     got = np.stack([tool.fields["normal_x"], tool.fields["normal_y"], tool.fields["normal_z"]], 1)
     assert [d[1][4:13] for d in tool.las.extra_bytes[:3]] == [b"NormalX\0\0", b"NormalY\0\0",
                                                               b"NormalZ\0\0"]

@@ -15,11 +15,17 @@ namespace {
 
 constexpr int kSpanningTreeNeighbours = 10;
 
+// The viewpoint in the cloud's local frame (unset: the world's origin, as PCL's default).
+Eigen::Vector3d localViewpoint(const LocalCloud& cloud, const LocalFitOptions& options) {
+  return options.viewpoint.value_or(Eigen::Vector3d::Zero()) - cloud.origin;
+}
+
 template <typename Estimator>
-void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+void configure(Estimator& estimator, const LocalCloud& cloud,
                const std::shared_ptr<const MeshTopology>& topology, const LocalFitOptions& options,
                const pcl::IndicesPtr& indices) {
-  estimator.setInputCloud(cloud);
+  estimator.setInputCloud(cloud.points);
+  estimator.setInputPositions(cloud.positions);
   if (indices) estimator.setIndices(indices);
   if (options.neighbourhood == NeighbourhoodKind::MeshRings) {
     estimator.setSearchMethod(std::make_shared<MeshRingSearch<pcl::PointXYZ>>(topology));
@@ -39,7 +45,7 @@ void configure(Estimator& estimator, const pcl::PointCloud<pcl::PointXYZ>::Const
     estimator.setKSearch(options.k);
   }
   // The orientation by default, and the spanning tree's seeds' or the faces' fallback.
-  const Eigen::Vector3f v = options.viewpoint.value_or(Eigen::Vector3d::Zero()).cast<float>();
+  const Eigen::Vector3f v = localViewpoint(cloud, options).cast<float>();
   estimator.setViewPoint(v.x(), v.y(), v.z());
   if (options.up) estimator.setUpDirection(options.up->x(), options.up->y(), options.up->z());
   if (options.orientation == NormalOrientation::Up) {
@@ -72,15 +78,16 @@ int gridWindowRadius(int k) {
   return radius;
 }
 
-LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+LocalFitResult fitLocalSurfaces(const LocalCloud& local,
                                 const std::shared_ptr<const MeshTopology>& topology,
                                 const LocalFitOptions& options) {
-  return fitLocalSurfaces(cloud, topology, options, nullptr);
+  return fitLocalSurfaces(local, topology, options, nullptr);
 }
 
-LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+LocalFitResult fitLocalSurfaces(const LocalCloud& local,
                                 const std::shared_ptr<const MeshTopology>& topology,
                                 const LocalFitOptions& options, const pcl::IndicesPtr& indices) {
+  const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud = local.points;
   if (options.neighbourhood == NeighbourhoodKind::MeshRings && !topology) {
     throw pcl::BadArgumentException("mesh-ring neighbourhoods need a mesh (faces)");
   }
@@ -95,7 +102,9 @@ LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
     grid.window_radius = gridWindowRadius(options.k);
     grid.max_depth_jump = options.max_depth_jump;
     grid.threads = options.threads;
-    grid.viewpoint = options.viewpoint;
+    grid.positions = local.positions;
+    // Unset: the cloud's sensor origin (already in its local frame).
+    if (options.viewpoint) grid.viewpoint = localViewpoint(local, options);
     OrganizedNormalResult normals = computeOrganizedPCANormals(cloud, grid);
     result.normals = std::move(normals.normals);
     result.failed_points = normals.failed_points;
@@ -113,13 +122,13 @@ LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
   }
   if (options.method == LocalFitMethod::PCA) {
     PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
-    configure(estimator, cloud, topology, options, indices);
+    configure(estimator, local, topology, options, indices);
     estimator.compute(result.normals);
     result.failed_points = estimator.getFailedPoints();
     result.orientation = estimator.getOrientationReport();
   } else if (options.method == LocalFitMethod::Robust) {
     RobustNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
-    configure(estimator, cloud, topology, options, indices);
+    configure(estimator, local, topology, options, indices);
     estimator.compute(result.normals);
     result.failed_points = estimator.getFailedPoints();
     result.orientation = estimator.getOrientationReport();
@@ -127,7 +136,7 @@ LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
     result.confidences = estimator.getConfidences();
   } else {
     QuadricNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
-    configure(estimator, cloud, topology, options, indices);
+    configure(estimator, local, topology, options, indices);
     estimator.computeWithCurvatures(result.normals, result.curvatures);
     result.failed_points = estimator.getFailedPoints();
     result.fallback_points = estimator.getFallbackPoints();

@@ -68,18 +68,19 @@ Eigen::VectorXd jaccardOverlaps(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
 
 }  // namespace
 
-NeighbourhoodComparison compareNeighbourhoods(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+NeighbourhoodComparison compareNeighbourhoods(const LocalCloud& local,
                                               const std::shared_ptr<const MeshTopology>& topology,
                                               LocalFitOptions options) {
+  const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud = local.points;
   if (!topology && !(cloud && cloud->height > 1)) {
     throw pcl::BadArgumentException(
         "comparing neighbourhoods needs a mesh (faces) or an organized cloud (a pixel grid)");
   }
   NeighbourhoodComparison c;
   options.neighbourhood = topology ? NeighbourhoodKind::MeshRings : NeighbourhoodKind::Grid;
-  c.topological = fitLocalSurfaces(cloud, topology, options);
+  c.topological = fitLocalSurfaces(local, topology, options);
   options.neighbourhood = NeighbourhoodKind::KdTree;
-  c.kd_tree = fitLocalSurfaces(cloud, topology, options);
+  c.kd_tree = fitLocalSurfaces(local, topology, options);
 
   const auto n = static_cast<Eigen::Index>(cloud->size());
   c.angle_difference.resize(n);

@@ -84,6 +84,14 @@ OrganizedNormalResult computeOrganizedPCANormals(
   }
   auto search = std::make_shared<OrganizedGridSearch<pcl::PointXYZ>>(options.max_depth_jump);
   search->setInputCloud(cloud);  // throws unless organized
+  const Eigen::Matrix3Xd* positions = options.positions.get();
+  if (positions && positions->cols() != static_cast<Eigen::Index>(cloud->size()))
+    throw pcl::BadArgumentException("the positions must have a column per pixel");
+  // In double: the exact coordinates when given, else the floats.
+  const auto position = [&](int pixel) -> Eigen::Vector3d {
+    if (positions) return positions->col(pixel);
+    return (*cloud)[pixel].getVector3fMap().cast<double>();
+  };
   const Image image{static_cast<int>(cloud->width), static_cast<int>(cloud->height)};
   const int w = options.window_radius;
   const Eigen::Vector3d origin = cloud->sensor_origin_.head<3>().cast<double>();
@@ -112,7 +120,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
   std::int64_t failed = 0, window_points = 0, jump_points = 0;
 #pragma omp parallel reduction(+ : failed, window_points, jump_points) num_threads(threads)
   {
-    detail::WindowSums sums(*cloud, finite, w);
+    detail::WindowSums sums(*cloud, positions, finite, w);
     RowPlanes row;
     WindowColumns columns(bits, image.height);
     pcl::Indices neighbours;
@@ -139,7 +147,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
           const int j = __builtin_ctzll(check), x = x0 + j, pixel = image.index(x, y);
           if (!finite[pixel]) continue;
           int count = 0;
-          const Eigen::Vector3d query = (*cloud)[pixel].getVector3fMap().cast<double>();
+          const Eigen::Vector3d query = position(pixel);
           if (w <= kMaskRadius) {
             columns.moveTo(x0, y);
             const WindowMasks masks = floodWindow(columns, j, flood_shape);
@@ -148,7 +156,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
               const int bit = __builtin_ctzll(reached);
               const int neighbour =
                   image.index(x - kMaskRadius + bit % 8, y - kMaskRadius + bit / 8);
-              points.col(count++) = (*cloud)[neighbour].getVector3fMap().cast<double>() - query;
+              points.col(count++) = position(neighbour) - query;
             }
           } else {
             const int x_begin = std::max(0, x - w), y_begin = std::max(0, y - w);
@@ -159,7 +167,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
               continue;
             count = search->windowSearch(pixel, w, neighbours, distances);
             for (int i = 0; i < count; ++i) {
-              points.col(i) = (*cloud)[neighbours[i]].getVector3fMap().cast<double>() - query;
+              points.col(i) = position(neighbours[i]) - query;
             }
           }
           row.setFromPoints(j, points, count);
@@ -179,10 +187,8 @@ OrganizedNormalResult computeOrganizedPCANormals(
             ++failed;
             continue;
           }
-          const pcl::PointXYZ& p = (*cloud)[pixel];
           const double nx = row.normal_x[j], ny = row.normal_y[j], nz = row.normal_z[j];
-          const double towards =
-              nx * (viewpoint.x() - p.x) + ny * (viewpoint.y() - p.y) + nz * (viewpoint.z() - p.z);
+          const double towards = Eigen::Vector3d(nx, ny, nz).dot(viewpoint - position(pixel));
           const double sign = towards < 0.0 ? -1.0 : 1.0;
           out.normal_x = static_cast<float>(sign * nx);
           out.normal_y = static_cast<float>(sign * ny);

@@ -42,8 +42,10 @@ PCL_DDG_WIDE_LANES void sumTerms(int terms, const double* in, int step, int coun
 }  // namespace
 
 WindowSums::WindowSums(const pcl::PointCloud<pcl::PointXYZ>& cloud,
-                       const std::vector<std::uint8_t>& finite, int radius)
+                       const Eigen::Matrix3Xd* positions, const std::vector<std::uint8_t>& finite,
+                       int radius)
     : cloud_(cloud),
+      positions_(positions),
       finite_(finite),
       width_(static_cast<int>(cloud.width)),
       height_(static_cast<int>(cloud.height)),
@@ -63,7 +65,7 @@ void WindowSums::startTile(int x0, int y0, int x1, int y1) {
     for (int u = rx0; u < rx1; ++u) {
       const std::size_t pixel = static_cast<std::size_t>(v) * width_ + u;
       if (!finite_[pixel]) continue;
-      centre_ += cloud_[pixel].getVector3fMap().cast<double>();
+      centre_ += position(pixel);
       ++points;
     }
   }
@@ -81,7 +83,7 @@ void WindowSums::sumAcross(int v) {
       for (int c = 0; c < kChannels; ++c) value[c * stride] = 0.0;
       continue;
     }
-    const Eigen::Vector3d d = cloud_[pixel].getVector3fMap().cast<double>() - centre_;
+    const Eigen::Vector3d d = position(pixel) - centre_;
     value[kCount * stride] = 1.0;
     value[kX * stride] = d.x(), value[kY * stride] = d.y(), value[kZ * stride] = d.z();
     value[kXX * stride] = d.x() * d.x(), value[kXY * stride] = d.x() * d.y();

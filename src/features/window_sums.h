@@ -22,9 +22,10 @@ class WindowSums {
   enum Channel { kCount, kX, kY, kZ, kXX, kXY, kXZ, kYY, kYZ, kZZ, kChannels };
   static constexpr int kTileWidth = 64;
 
-  /** finite[i]: whether point i has finite coordinates (the others count as absent). */
-  WindowSums(const pcl::PointCloud<pcl::PointXYZ>& cloud, const std::vector<std::uint8_t>& finite,
-             int radius);
+  /** finite[i]: whether point i has finite coordinates (the others count as absent); positions:
+   *  the cloud's coordinates in double (null: its floats). */
+  WindowSums(const pcl::PointCloud<pcl::PointXYZ>& cloud, const Eigen::Matrix3Xd* positions,
+             const std::vector<std::uint8_t>& finite, int radius);
 
   /** Starts the tile of columns [x0, x1) and rows [y0, y1), x1 - x0 <= kTileWidth. */
   void startTile(int x0, int y0, int x1, int y1);
@@ -37,7 +38,13 @@ class WindowSums {
  private:
   void sumAcross(int v);  // region row v into its ring slot
 
+  Eigen::Vector3d position(std::size_t pixel) const {
+    return positions_ ? Eigen::Vector3d(positions_->col(static_cast<Eigen::Index>(pixel)))
+                      : Eigen::Vector3d(cloud_[pixel].getVector3fMap().cast<double>());
+  }
+
   const pcl::PointCloud<pcl::PointXYZ>& cloud_;
+  const Eigen::Matrix3Xd* positions_;
   const std::vector<std::uint8_t>& finite_;
   int width_, height_, radius_;
   int x0_ = 0, tile_width_ = 0, next_row_ = 0;

@@ -478,10 +478,12 @@ LasLayout parseLayout(std::string_view data, HeaderFacts& facts) {
   if (facts.header_size > size)
     fail("header size " + std::to_string(facts.header_size) + " is past the end of the file (" +
          std::to_string(size) + " bytes)");
-  if (facts.point_offset < facts.header_size || facts.point_offset > size)
+  if (facts.point_offset < facts.header_size)
+    fail("offset to the points " + std::to_string(facts.point_offset) + " is inside the header (" +
+         std::to_string(facts.header_size) + " bytes)");
+  if (facts.point_offset > size)
     fail("offset to the points " + std::to_string(facts.point_offset) +
-         " is outside the file (header " + std::to_string(facts.header_size) + ", file " +
-         std::to_string(size) + " bytes)");
+         " is past the end of the file (" + std::to_string(size) + " bytes)");
   if (layout.point_format > 10)
     fail("unknown point data record format " + std::to_string(layout.point_format) +
          " (0 to 10 are defined)");

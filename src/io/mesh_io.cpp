@@ -69,7 +69,7 @@ std::string fileExtension(const std::string& path) {
   return ext;
 }
 
-MeshFile readMeshFile(const std::string& path) {
+MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty) {
   const std::string ext = fileExtension(path);
   try {
     if (ext == "laz") {  // before anything is read: no LAZ decoder is at hand
@@ -81,7 +81,8 @@ MeshFile readMeshFile(const std::string& path) {
     const std::string_view data = bytes.view();
     if (ext == "las") {
       detail::LasCloud las = detail::parseLAS(data);
-      if (las.positions.cols() == 0) throw FileFormatException("file has no vertices");
+      if (las.positions.cols() == 0 && empty == EmptyFilePolicy::Refuse)
+        throw FileFormatException("no points (the header counts none)");
       MeshFile file;
       file.mesh = std::move(las.mesh);
       file.positions = std::move(las.positions);

@@ -6,25 +6,30 @@
 #include <vector>
 
 #include "json_number.h"
+#include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 
 namespace pcl_ddg {
 
-CloudReport makeCloudReport(const pcl::PCLPointCloud2& cloud) {
+CloudReport makeCloudReport(const pcl::PCLPointCloud2& cloud, const PositionsRef& positions) {
+  if (positions.cols() != static_cast<Eigen::Index>(cloud.width) * cloud.height)
+    throw InvalidMeshException("makeCloudReport: " + std::to_string(positions.cols()) +
+                               " positions for a cloud of " + std::to_string(cloud.width) + " x " +
+                               std::to_string(cloud.height) + " points");
   CloudReport r;
   r.width = cloud.width;
   r.height = cloud.height;
-  const Eigen::Matrix3Xd p = vertexPositions(cloud, NonFinitePolicy::Keep);
-  r.points = p.cols();
-  r.nan_points = findNonFiniteVertices(p).count;
+  r.points = positions.cols();
+  r.nan_points = findNonFiniteVertices(positions).count;
   std::vector<std::array<double, 3>> finite;
-  finite.reserve(static_cast<std::size_t>(p.cols()));
-  for (Eigen::Index i = 0; i < p.cols(); ++i) {
-    if (p.col(i).allFinite()) finite.push_back({p(0, i), p(1, i), p(2, i)});
+  finite.reserve(static_cast<std::size_t>(positions.cols()));
+  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
+    const auto p = positions.col(i);
+    if (p.allFinite()) finite.push_back({p[0], p[1], p[2]});
   }
   std::sort(finite.begin(), finite.end());
   r.duplicate_points = finite.end() - std::unique(finite.begin(), finite.end());
-  r.bounding_box = boundingBox(p);
+  r.bounding_box = boundingBox(positions);
   return r;
 }
 
@@ -40,10 +45,9 @@ std::string CloudReport::toJson() const {
 
 namespace {
 
-// Every digit: UTM coordinates differ in the last places a default stream would drop.
-std::string box(const Eigen::Vector3d& corner) {
-  return "[" + detail::shortestNumber(corner.x()) + " " + detail::shortestNumber(corner.y()) + " " +
-         detail::shortestNumber(corner.z()) + "]";
+std::string box(const BoundingBox& b) {
+  if (!b.min.allFinite()) return "none (no finite point)";
+  return detail::textArray(b.min) + " .. " + detail::textArray(b.max);
 }
 
 }  // namespace
@@ -55,7 +59,7 @@ std::string CloudReport::toText() const {
       << (organized() ? " (organized)" : " (unorganized)") << "\n"
       << "NaN points:        " << nan_points << "\n"
       << "duplicate points:  " << duplicate_points << "\n"
-      << "bounding box:      " << box(bounding_box.min) << " .. " << box(bounding_box.max) << "\n";
+      << "bounding box:      " << box(bounding_box) << "\n";
   return out.str();
 }
 

@@ -118,8 +118,8 @@ std::string MeshReport::toText() const {
       << "orientable:            " << (orientable ? "yes" : "no")
       << (consistently_oriented ? ", consistently oriented" : ", NOT consistently oriented") << "\n"
       << "mean edge length:      " << mean_edge_length << "\n"
-      << "bounding box:          [" << bounding_box.min.transpose() << "] .. ["
-      << bounding_box.max.transpose() << "]\n";
+      << "bounding box:          " << detail::textArray(bounding_box.min) << " .. "
+      << detail::textArray(bounding_box.max) << "\n";
   return out.str();
 }
 

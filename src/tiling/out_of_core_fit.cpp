@@ -24,21 +24,17 @@ namespace {
   throw FileFormatException(what + ": " + std::strerror(errno));
 }
 
-// What the tools hand PCL: float coordinates from the exact ones (as toXYZ in memory does).
-pcl::PointXYZ floatPoint(const Eigen::Matrix3Xd& positions, Eigen::Index i) {
-  pcl::PointXYZ p;
-  p.getVector3fMap() = positions.col(i).cast<float>();
-  return p;
+// What the search looks in: the float of the point relative to the local origin (as
+// makeLocalCloud makes it in memory).
+Eigen::Vector3f floatPoint(const Eigen::Vector3d& relative) {
+  return relative.cast<float>();
 }
 
-Eigen::Vector3d position(const pcl::PointXYZ& p) {
-  return p.getVector3fMap().cast<double>();
-}
-
-// One record per finite point in its tile's file: the point's index in the input, and x, y, z.
+// One record per finite point in its tile's file: the point's index in the input, and x, y, z
+// relative to the local origin, in double (exact: the fits read them).
 struct TileRecord {
   std::int64_t index;
-  float xyz[3];
+  double xyz[3];
 };
 
 class TileFiles {
@@ -46,9 +42,9 @@ class TileFiles {
   TileFiles(std::string folder, std::size_t tiles, std::size_t buffer_records)
       : folder_(std::move(folder)), buffers_(tiles), buffer_records_(buffer_records) {}
 
-  void add(int tile, std::int64_t index, const pcl::PointXYZ& p) {
+  void add(int tile, std::int64_t index, const Eigen::Vector3d& p) {
     auto& buffer = buffers_[tile];
-    buffer.push_back({index, {p.x, p.y, p.z}});
+    buffer.push_back({index, {p.x(), p.y(), p.z()}});
     if (buffer.size() >= buffer_records_) flush(tile);
   }
   void flushAll() {
@@ -206,6 +202,7 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
   report.points = layout.points;
   report.sensor_pose = layout.sensor_pose;
   if (!options.viewpoint) options.viewpoint = layout.sensor_pose.origin;
+  if (layout.points == 0) throw FileFormatException(input + ": no points (the header counts none)");
   if (options.radius == 0.0 && options.k > layout.points)
     throw pcl::BadArgumentException("k is more than the " + std::to_string(layout.points) +
                                     " points of the input");
@@ -225,22 +222,30 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
     }
   };
 
-  // 1. Bounds of the finite points (as PCL's float points, which is what is fitted).
-  Eigen::AlignedBox3d bounds;
-  forEachPiece([&](std::int64_t first, CloudPiece& piece) {
-    const Eigen::Matrix3Xd& positions = piece.positions;
-    for (Eigen::Index i = 0; i < positions.cols(); ++i) {
-      if (positions.col(i).allFinite() &&
-          positions.col(i).cwiseAbs().maxCoeff() > std::numeric_limits<float>::max())
-        throw FileFormatException(input + ": point " + std::to_string(first + i) +
-                                  " is beyond float's range (PCL's point types are float)");
-      const pcl::PointXYZ p = floatPoint(positions, i);
-      if (p.getVector3fMap().allFinite())
-        bounds.extend(position(p));
+  // 1. Bounds of the finite points, for the local origin (local_cloud.h: the rule the cloud in
+  // memory follows) and the plan, which is cut from the points' floats relative to it (rounding
+  // is monotonic: their bounds are the rounded bounds).
+  Eigen::AlignedBox3d world_bounds;
+  forEachPiece([&](std::int64_t, CloudPiece& piece) {
+    for (Eigen::Index i = 0; i < piece.positions.cols(); ++i) {
+      if (piece.positions.col(i).allFinite())
+        world_bounds.extend(piece.positions.col(i));
       else
         ++report.failed_points;
     }
   });
+  const Eigen::Vector3d origin = localOrigin(world_bounds);
+  Eigen::AlignedBox3d bounds;
+  if (!world_bounds.isEmpty()) {
+    const Eigen::Vector3d low = world_bounds.min() - origin, high = world_bounds.max() - origin;
+    if (std::max(low.cwiseAbs().maxCoeff(), high.cwiseAbs().maxCoeff()) >
+        std::numeric_limits<float>::max())
+      throw FileFormatException(input +
+                                ": the points span more than float's range (PCL's "
+                                "point types are float)");
+    bounds.extend(floatPoint(low).cast<double>());
+    bounds.extend(floatPoint(high).cast<double>());
+  }
 
   const std::string folder = limits.scratch_folder.empty()
                                  ? std::filesystem::path(output).parent_path().string()
@@ -253,8 +258,8 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
     PointHistogram histogram(bounds, 128);
     forEachPiece([&](std::int64_t, CloudPiece& piece) {
       for (Eigen::Index i = 0; i < piece.positions.cols(); ++i) {
-        const pcl::PointXYZ p = floatPoint(piece.positions, i);
-        if (p.getVector3fMap().allFinite()) histogram.add(position(p));
+        const Eigen::Vector3f p = floatPoint(piece.positions.col(i) - origin);
+        if (p.allFinite()) histogram.add(p.cast<double>());
       }
     });
     const TilePlan plan = planTiles(histogram, report.points_per_tile);
@@ -266,8 +271,9 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
     TileFiles tiles(scratch.path(), plan.tiles.size(), buffer_records);
     forEachPiece([&](std::int64_t first, CloudPiece& piece) {
       for (Eigen::Index i = 0; i < piece.positions.cols(); ++i) {
-        const pcl::PointXYZ p = floatPoint(piece.positions, i);
-        if (p.getVector3fMap().allFinite()) tiles.add(plan.tileOf(position(p)), first + i, p);
+        const Eigen::Vector3d relative = piece.positions.col(i) - origin;
+        const Eigen::Vector3f p = floatPoint(relative);
+        if (p.allFinite()) tiles.add(plan.tileOf(p.cast<double>()), first + i, relative);
       }
     });
     tiles.flushAll();
@@ -277,14 +283,15 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
       TilePoints points;
       points.points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
       points.own = std::make_shared<pcl::Indices>();
-      std::vector<std::pair<std::int64_t, pcl::PointXYZ>> gathered;
+      points.origin = origin;
+      std::vector<std::pair<std::int64_t, Eigen::Vector3d>> gathered;
       std::vector<char> own_flags;
       for (int t = 0; t < static_cast<int>(plan.tiles.size()); ++t) {
         if (t != tile && !plan.tiles[t].box.intersects(region)) continue;
         for (const TileRecord& r : tiles.read(t)) {
-          const pcl::PointXYZ p(r.xyz[0], r.xyz[1], r.xyz[2]);
-          if (t != tile && !region.contains(position(p))) continue;
-          gathered.emplace_back(r.index, p);
+          const Eigen::Vector3d relative(r.xyz[0], r.xyz[1], r.xyz[2]);
+          if (t != tile && !region.contains(floatPoint(relative).cast<double>())) continue;
+          gathered.emplace_back(r.index, relative);
           own_flags.push_back(t == tile);
         }
       }
@@ -294,10 +301,13 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
       std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
         return gathered[a].first < gathered[b].first;
       });
-      points.points->reserve(order.size());
-      for (const std::size_t i : order) {
-        if (own_flags[i]) points.own->push_back(static_cast<pcl::index_t>(points.points->size()));
-        points.points->push_back(gathered[i].second);
+      points.points->resize(order.size());
+      points.positions = std::make_shared<Eigen::Matrix3Xd>(3, order.size());
+      for (std::size_t j = 0; j < order.size(); ++j) {
+        const std::size_t i = order[j];
+        if (own_flags[i]) points.own->push_back(static_cast<pcl::index_t>(j));
+        (*points.points)[j].getVector3fMap() = floatPoint(gathered[i].second);
+        points.positions->col(static_cast<Eigen::Index>(j)) = gathered[i].second;
         points.global_index.push_back(gathered[i].first);
       }
       return points;

@@ -80,8 +80,11 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
   const auto fit = [&](TilePoints& points) {
     local.largest_gather = std::max<std::int64_t>(local.largest_gather,
                                                   static_cast<std::int64_t>(points.points->size()));
-    if (!points.own->empty())
-      consume(points, fitLocalSurfaces(points.points, nullptr, options, points.own));
+    if (points.own->empty()) return;
+    LocalCloud cloud(points.points);
+    cloud.positions = points.positions;
+    cloud.origin = points.origin;
+    consume(points, fitLocalSurfaces(cloud, nullptr, options, points.own));
   };
   // k nearest: the halo the tile before needed (neighbouring tiles have alike densities).
   double guess = 0.0;
@@ -145,9 +148,9 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
   if (report) *report = local;
 }
 
-LocalFitResult fitLocalSurfacesTiled(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
-                                     const LocalFitOptions& options, const TilingOptions& tiling,
-                                     TilingReport* report) {
+LocalFitResult fitLocalSurfacesTiled(const LocalCloud& local, const LocalFitOptions& options,
+                                     const TilingOptions& tiling, TilingReport* report) {
+  const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud = local.points;
   if (!cloud || cloud->empty()) throw pcl::BadArgumentException("the cloud is empty");
   if (options.method == LocalFitMethod::Robust)  // its scales and confidences have no tile path
     throw pcl::BadArgumentException("tiled fits are PCA or quadric; robust needs the whole cloud");
@@ -190,6 +193,7 @@ LocalFitResult fitLocalSurfacesTiled(const pcl::PointCloud<pcl::PointXYZ>::Const
     TilePoints points;
     points.points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
     points.own = std::make_shared<pcl::Indices>();
+    points.origin = local.origin;
     for (std::size_t i = 0; i < n; ++i) {
       if (cell[i] < 0) continue;
       const bool own = tile >= 0 && plan.tile_of_cell[cell[i]] == tile;
@@ -197,6 +201,12 @@ LocalFitResult fitLocalSurfacesTiled(const pcl::PointCloud<pcl::PointXYZ>::Const
       if (own) points.own->push_back(static_cast<pcl::index_t>(points.points->size()));
       points.points->push_back((*cloud)[i]);
       points.global_index.push_back(static_cast<std::int64_t>(i));
+    }
+    if (local.positions) {
+      points.positions = std::make_shared<Eigen::Matrix3Xd>(3, points.global_index.size());
+      for (std::size_t j = 0; j < points.global_index.size(); ++j)
+        points.positions->col(static_cast<Eigen::Index>(j)) =
+            local.positions->col(points.global_index[j]);
     }
     return points;
   };

@@ -58,7 +58,7 @@ void expectSumsEqualTwoPass(const pcl::PointCloud<pcl::PointXYZ>& cloud, int rad
   SCOPED_TRACE(radius);
   std::vector<std::uint8_t> finite(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) finite[i] = pcl::isXYZFinite(cloud[i]);
-  WindowSums sums(cloud, finite, radius);
+  WindowSums sums(cloud, nullptr, finite, radius);
   const int width = static_cast<int>(cloud.width), height = static_cast<int>(cloud.height);
   constexpr int kTileHeight = 37;  // divides neither 480 nor the 64-pixel tile width
   int compared = 0;

@@ -561,9 +561,11 @@ const Lie kLies[] = {
     {"legacy_count_too_large", "las/autzen_trim.las",
      [](std::string& b) { setAt<std::uint32_t>(b, 107, 0xffffffffu); }, "lying count"},
     {"point_offset_beyond_file", "las/autzen_trim.las",
-     [](std::string& b) { setAt<std::uint32_t>(b, 96, 1u << 30); }, "offset to the points"},
+     [](std::string& b) { setAt<std::uint32_t>(b, 96, 1u << 30); },
+     "offset to the points 1073741824 is past the end of the file"},
     {"point_offset_inside_header", "las/autzen_trim.las",
-     [](std::string& b) { setAt<std::uint32_t>(b, 96, 100); }, "offset to the points"},
+     [](std::string& b) { setAt<std::uint32_t>(b, 96, 100); },
+     "offset to the points 100 is inside the header (227 bytes)"},
     {"vlr_length_past_points", "las/autzen_trim.las",
      [](std::string& b) { setAt<std::uint16_t>(b, 227 + 20, 60000); }, "VLR 0"},
     {"vlr_count_past_points", "las/autzen_trim.las",
@@ -637,6 +639,36 @@ TEST_P(HostileLasHeader, IsRefusedWithOneLine) {
 
 INSTANTIATE_TEST_SUITE_P(Lies, HostileLasHeader, ::testing::ValuesIn(kLies),
                          [](const auto& info) { return std::string(info.param.name); });
+
+// no-points.las (PDAL's): a valid LAS 1.2 file whose header counts no point. Refused where points
+// are needed, naming the file; read as its header when asked to.
+TEST(LasIO, AFileOfNoPointsIsReadAsItsHeaderOnRequest) {
+  const std::string path = sharedData("las/no-points.las");
+  try {
+    readMeshFile(path);
+    FAIL() << "a file of no points was read";
+  } catch (const FileFormatException& e) {
+    const std::string text = errorDescription(e);
+    EXPECT_NE(text.find("no points"), std::string::npos) << text;
+    EXPECT_EQ(text.rfind(path, 0), 0u) << "names the file: " << text;
+  }
+  const MeshFile file = readMeshFile(path, EmptyFilePolicy::Accept);
+  EXPECT_EQ(file.positions.cols(), 0);
+  EXPECT_EQ(file.mesh.cloud.width * file.mesh.cloud.height, 0u);
+  ASSERT_TRUE(file.las);
+  const std::string bytes = readBytes(path);
+  const SpecHeader h = specHeader(bytes);
+  ASSERT_EQ(h.points, 0u);
+  EXPECT_EQ(file.las->point_format, h.format);
+  EXPECT_EQ(file.las->record_length, h.record_length);
+  EXPECT_EQ(file.las->vlrs.size(), h.vlr_count);
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_EQ(file.las->scale[d], h.scale[d]);
+    EXPECT_EQ(file.las->offset[d], h.offset[d]);
+    EXPECT_EQ(file.las->max[d], at<double>(bytes, 179 + 16 * d));
+    EXPECT_EQ(file.las->min[d], at<double>(bytes, 187 + 16 * d));
+  }
+}
 
 // A real file whose header claims one record more than it holds: refused, as PDAL refuses it
 // ("number of points too large for file size"), with the count of whole records.

@@ -1,13 +1,18 @@
 // The tools on LAS files: the same normals as from the same points in a PCD F 8 file, every field
-// and VLR kept, -classes, batch mode, pcl_ddg_info's LAS report, and LAZ refused.
+// and VLR kept, -classes, batch mode, pcl_ddg_info's LAS report, a file of no points, and LAZ
+// refused.
 #include <gtest/gtest.h>
 
+#include <boost/property_tree/json_parser.hpp>
+#include <boost/property_tree/ptree.hpp>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 
+#include "data_catalogue.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -164,6 +169,108 @@ TEST(LasTools, InfoReportsTheLasLayout) {
   EXPECT_NE(json.out.find("\"point_format\": 3"), std::string::npos) << json.out;
   EXPECT_NE(json.out.find("\"Colors\""), std::string::npos) << json.out;
   EXPECT_EQ(std::count(json.out.begin(), json.out.end(), '\n'), 1) << "one JSON object";
+}
+
+template <typename T>
+T at(const std::string& bytes, std::size_t offset) {
+  T v;
+  std::memcpy(&v, bytes.data() + offset, sizeof(T));
+  return v;
+}
+
+boost::property_tree::ptree infoJson(const std::string& path) {
+  const ToolRun run = runTool(PCL_DDG_INFO_TOOL, path + " -json");
+  EXPECT_EQ(run.exit_code, 0) << path << ": " << run.err;
+  std::istringstream in(run.out);
+  boost::property_tree::ptree tree;
+  boost::property_tree::read_json(in, tree);
+  return tree;
+}
+
+Eigen::Vector3d vector3(const boost::property_tree::ptree& array) {
+  Eigen::Vector3d v;
+  int d = 0;
+  for (const auto& item : array) v[d++] = item.second.get_value<double>();
+  EXPECT_EQ(d, 3);
+  return v;
+}
+
+// The box of the records' X * scale + offset and the header's bounds, read from the file's bytes
+// at the specification's offsets (LAS 1.4 R15, table 3): pcl_ddg_info reports both, and says the
+// two agree exactly when no bound differs from the records' by more than half a scale step.
+TEST(LasTools, InfoComparesTheHeaderBoundsWithTheRecords) {
+  for (const SharedCloud& entry : sharedLasFiles()) {
+    SCOPED_TRACE(entry.path);
+    const std::string path = sharedData(entry.path);
+    const std::string b = readBytes(path);
+    const std::uint32_t offset = at<std::uint32_t>(b, 96);
+    const std::uint16_t length = at<std::uint16_t>(b, 105);
+    const std::uint64_t count = b[25] >= 4 ? at<std::uint64_t>(b, 247) : at<std::uint32_t>(b, 107);
+    Eigen::Vector3d scale, shift, header_min, header_max;
+    for (int d = 0; d < 3; ++d) {
+      scale[d] = at<double>(b, 131 + 8 * d);
+      shift[d] = at<double>(b, 155 + 8 * d);
+      header_max[d] = at<double>(b, 179 + 16 * d);
+      header_min[d] = at<double>(b, 187 + 16 * d);
+    }
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+    for (std::uint64_t i = 0; i < count; ++i) {
+      for (int d = 0; d < 3; ++d) {
+        const double v = at<std::int32_t>(b, offset + i * length + 4 * d) * scale[d] + shift[d];
+        lo[d] = std::min(lo[d], v);
+        hi[d] = std::max(hi[d], v);
+      }
+    }
+    bool agree = true;
+    for (int d = 0; d < 3; ++d) {
+      agree = agree && std::abs(header_min[d] - lo[d]) <= scale[d] / 2 &&
+              std::abs(header_max[d] - hi[d]) <= scale[d] / 2;
+    }
+    const auto j = infoJson(path);
+    EXPECT_EQ(vector3(j.get_child("bounding_box_min")), lo);
+    EXPECT_EQ(vector3(j.get_child("bounding_box_max")), hi);
+    EXPECT_EQ(vector3(j.get_child("las.scale")), scale);
+    EXPECT_EQ(vector3(j.get_child("las.offset")), shift);
+    EXPECT_EQ(vector3(j.get_child("las.header_bounds_min")), header_min);
+    EXPECT_EQ(vector3(j.get_child("las.header_bounds_max")), header_max);
+    EXPECT_EQ(j.get<std::string>("las.header_bounds_agree"), agree ? "true" : "false");
+  }
+}
+
+// no-points.las (PDAL's): a valid LAS 1.2 file whose header counts no point.
+TEST(LasTools, AFileOfNoPointsIsReportedButNotFitted) {
+  const std::string path = sharedData("las/no-points.las");
+  const std::string b = readBytes(path);
+  const ToolRun info = runTool(PCL_DDG_INFO_TOOL, path);
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find("points:            0\n"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("LAS:               1.2, point format 3"), std::string::npos) << info.out;
+  EXPECT_NE(info.out.find("header vs records: no records to compare"), std::string::npos);
+  EXPECT_NE(info.out.find("VLR:               LASF_Projection 34735"), std::string::npos);
+  const auto j = infoJson(path);
+  EXPECT_EQ(j.get<int>("points"), 0);
+  Eigen::Vector3d scale, shift;
+  for (int d = 0; d < 3; ++d) {
+    scale[d] = at<double>(b, 131 + 8 * d);
+    shift[d] = at<double>(b, 155 + 8 * d);
+  }
+  EXPECT_EQ(vector3(j.get_child("las.scale")), scale);
+  EXPECT_EQ(vector3(j.get_child("las.offset")), shift);
+  EXPECT_EQ(j.get<std::string>("las.header_bounds_agree"), "null");
+  EXPECT_EQ(j.get_child("las.vlrs").size(), at<std::uint32_t>(b, 100));
+
+  const std::string folder = scratchFolder("las_tools_no_points");
+  for (const char* tool : {PCL_DDG_NORMALS_TOOL, PCL_DDG_CURVATURE_TOOL}) {
+    SCOPED_TRACE(tool);
+    const ToolRun run = runTool(tool, path + " " + folder + "/out.las");
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+    const std::string name = std::filesystem::path(tool).filename().string();
+    EXPECT_NE(run.err.find(name + ": error: "), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find(path), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find("no points"), std::string::npos) << run.err;
+    EXPECT_FALSE(std::filesystem::exists(folder + "/out.las"));
+  }
 }
 
 TEST(LasTools, LazIsRefusedWithOneLine) {

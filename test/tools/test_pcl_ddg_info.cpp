@@ -1,11 +1,16 @@
-// pcl_ddg_info -json on every shared mesh against the catalogue, exit codes and error lines.
+// pcl_ddg_info -json on every shared mesh against the catalogue, clouds reported on their exact
+// coordinates (LAS header and bounds included), exit codes and error lines.
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <array>
 #include <boost/property_tree/json_parser.hpp>
 #include <boost/property_tree/ptree.hpp>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <sstream>
+#include <vector>
 
 #include "data_catalogue.h"
 #include "test_data.h"
@@ -57,6 +62,146 @@ TEST(PclDdgInfo, ReportsCloudLayout) {
   const auto room = json(sharedData("clouds/tutorials_room_scan1.pcd"));
   // "about half the points are exact duplicates"
   EXPECT_NEAR(room.get<double>("duplicate_points") / room.get<double>("points"), 0.5, 0.05);
+}
+
+Eigen::Vector3d vector3(const boost::property_tree::ptree& array) {
+  Eigen::Vector3d v;
+  int d = 0;
+  for (const auto& item : array) v[d++] = item.second.get_value<double>();
+  EXPECT_EQ(d, 3);
+  return v;
+}
+
+template <typename T>
+void put(std::string& bytes, std::size_t offset, T value) {
+  std::memcpy(&bytes[offset], &value, sizeof(T));
+}
+
+using Record = std::array<std::int32_t, 3>;
+
+// A LAS 1.2 file of point format 0 written from the specification's byte offsets (LAS 1.4 R15,
+// table 3): the header's scale, offset and bounds as given, one 20-byte record per X Y Z.
+std::string lasFile(const Eigen::Vector3d& scale, const Eigen::Vector3d& offset,
+                    const Eigen::Vector3d& header_min, const Eigen::Vector3d& header_max,
+                    const std::vector<Record>& records) {
+  std::string bytes(227 + 20 * records.size(), '\0');
+  bytes.replace(0, 4, "LASF");
+  bytes[24] = 1;
+  bytes[25] = 2;
+  put<std::uint16_t>(bytes, 94, 227);  // header size
+  put<std::uint32_t>(bytes, 96, 227);  // offset to the points
+  put<std::uint16_t>(bytes, 105, 20);  // record length
+  put<std::uint32_t>(bytes, 107, static_cast<std::uint32_t>(records.size()));
+  for (int d = 0; d < 3; ++d) {
+    put(bytes, 131 + 8 * d, scale[d]);
+    put(bytes, 155 + 8 * d, offset[d]);
+    put(bytes, 179 + 16 * d, header_max[d]);
+    put(bytes, 187 + 16 * d, header_min[d]);
+  }
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    for (int d = 0; d < 3; ++d) put(bytes, 227 + 20 * i + 4 * d, records[i][d]);
+  }
+  return bytes;
+}
+
+// Survey coordinates (scale 1 mm, offset 500 km / 5000 km): float32 steps there are 1/32 and 1/2
+// of a metre, so points a millimetre apart are one float, and a float box is off by up to a
+// quarter of a metre.
+const Eigen::Vector3d kScale(0.001, 0.001, 0.01), kOffset(500000.0, 5000000.0, 200.0);
+const std::vector<Record> kRecords = {
+    {123456, 7, 0}, {123457, 7, 0}, {123456, 7, 0}, {-2000, 999999, 12345}};
+
+Eigen::Vector3d coordinates(const Record& r) {  // X * scale + offset, in double
+  return Eigen::Vector3d(r[0] * kScale[0] + kOffset[0], r[1] * kScale[1] + kOffset[1],
+                         r[2] * kScale[2] + kOffset[2]);
+}
+
+// The box of kRecords' coordinates: lo, hi.
+void recordsBox(Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+  lo = hi = coordinates(kRecords[0]);
+  for (const Record& r : kRecords) {
+    lo = lo.cwiseMin(coordinates(r));
+    hi = hi.cwiseMax(coordinates(r));
+  }
+}
+
+TEST(PclDdgInfo, LasBoxDuplicatesAndHeaderAreTheFilesExactValues) {
+  Eigen::Vector3d lo, hi;
+  recordsBox(lo, hi);
+  const std::string dir = scratchFolder("info_las_exact");
+  writeText(dir + "/agree.las", lasFile(kScale, kOffset, lo, hi, kRecords));
+  const auto j = json(dir + "/agree.las");
+  EXPECT_EQ(j.get<int>("points"), 4);
+  EXPECT_EQ(j.get<int>("duplicate_points"), 1) << "records 0 and 2; record 1 is 1 mm away";
+  EXPECT_EQ(vector3(j.get_child("bounding_box_min")), lo);
+  EXPECT_EQ(vector3(j.get_child("bounding_box_max")), hi);
+  EXPECT_EQ(vector3(j.get_child("las.scale")), kScale);
+  EXPECT_EQ(vector3(j.get_child("las.offset")), kOffset);
+  EXPECT_EQ(vector3(j.get_child("las.header_bounds_min")), lo);
+  EXPECT_EQ(vector3(j.get_child("las.header_bounds_max")), hi);
+  EXPECT_EQ(j.get<std::string>("las.header_bounds_agree"), "true");
+  EXPECT_TRUE(j.get_child("las.header_bounds_mismatches").empty());
+  const ToolRun text = runInfo(dir + "/agree.las");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("duplicate points:  1\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("scale:             0.001 0.001 0.01\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("offset:            500000 5000000 200\n"), std::string::npos);
+  EXPECT_NE(text.out.find("header vs records: agree"), std::string::npos) << text.out;
+}
+
+TEST(PclDdgInfo, LasHeaderBoundsThatDisagreeWithTheRecordsAreNamed) {
+  Eigen::Vector3d lo, hi;
+  recordsBox(lo, hi);
+  // x min 0.6 of a step above the records', y max 2.5 m above; z min 0.4 of a step below, which
+  // still names the records' step.
+  const Eigen::Vector3d header_min(lo.x() + 0.0006, lo.y(), lo.z() - 0.004);
+  const Eigen::Vector3d header_max(hi.x(), hi.y() + 2.5, hi.z());
+  const std::string dir = scratchFolder("info_las_bounds");
+  writeText(dir + "/lying.las", lasFile(kScale, kOffset, header_min, header_max, kRecords));
+  const auto j = json(dir + "/lying.las");
+  EXPECT_EQ(vector3(j.get_child("las.header_bounds_min")), header_min);
+  EXPECT_EQ(vector3(j.get_child("las.header_bounds_max")), header_max);
+  EXPECT_EQ(j.get<std::string>("las.header_bounds_agree"), "false");
+  struct Expected {
+    std::string axis, side;
+    double header, records;
+  };
+  const std::vector<Expected> expected = {{"x", "min", header_min.x(), lo.x()},
+                                          {"y", "max", header_max.y(), hi.y()}};
+  std::vector<Expected> found;
+  for (const auto& item : j.get_child("las.header_bounds_mismatches")) {
+    const auto& m = item.second;
+    found.push_back({m.get<std::string>("axis"), m.get<std::string>("side"),
+                     m.get<double>("header"), m.get<double>("records")});
+    EXPECT_EQ(m.get<double>("difference"), found.back().header - found.back().records);
+  }
+  ASSERT_EQ(found.size(), expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k) {
+    EXPECT_EQ(found[k].axis, expected[k].axis);
+    EXPECT_EQ(found[k].side, expected[k].side);
+    EXPECT_EQ(found[k].header, expected[k].header);
+    EXPECT_EQ(found[k].records, expected[k].records);
+  }
+  const ToolRun text = runInfo(dir + "/lying.las");
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("header vs records: x min differs by"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("header vs records: y max differs by"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("header vs records: z"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("agree"), std::string::npos) << text.out;
+}
+
+TEST(PclDdgInfo, DoubleCloudBoxAndDuplicatesAreTheFilesExactValues) {
+  // Three points at UTM-sized coordinates a millimetre apart in x (one float32 there), two of
+  // them identical.
+  const std::string dir = scratchFolder("info_double_cloud");
+  writeText(dir + "/utm.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+            "property double z\nend_header\n500000.001 4000000.002 10\n"
+            "500000.002 4000000.002 10\n500000.001 4000000.002 10\n");
+  const auto j = json(dir + "/utm.ply");
+  EXPECT_EQ(j.get<int>("duplicate_points"), 1);
+  EXPECT_EQ(vector3(j.get_child("bounding_box_min")), Eigen::Vector3d(500000.001, 4000000.002, 10));
+  EXPECT_EQ(vector3(j.get_child("bounding_box_max")), Eigen::Vector3d(500000.002, 4000000.002, 10));
 }
 
 TEST(PclDdgInfo, CountsDefectsInsteadOfRefusing) {

@@ -47,11 +47,12 @@ namespace test {
 namespace {
 
 // An input as the tools read it: readMeshFile's exact coordinates, the topology of a mesh, the
-// same points as PCL's float points (an organized cloud keeps its grid and its sensor).
+// same points about their local origin (an organized cloud keeps its grid and its sensor).
 struct Input {
   MeshFile file;
   std::shared_ptr<const MeshTopology> topology;  ///< null for a cloud
-  pcl::PointCloud<pcl::PointXYZ>::Ptr points;
+  LocalCloud local;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr points;  ///< local's float points
   double h = 0.0;  ///< mean edge length of a mesh: the unit of -radius 2.5h and -lambda_dt
 
   const Eigen::Matrix3Xd& positions() const { return file.positions; }
@@ -61,19 +62,16 @@ Input readInput(const std::string& path) {
   Input in;
   in.file = readMeshFile(path);
   const Eigen::Matrix3Xd& x = in.file.positions;
-  in.points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  in.points->resize(x.cols());
-  for (Eigen::Index i = 0; i < x.cols(); ++i)
-    (*in.points)[i].getVector3fMap() = x.col(i).cast<float>();
-  in.points->is_dense = x.allFinite();
-  if (!in.file.mesh.polygons.empty()) {
+  const bool mesh = !in.file.mesh.polygons.empty();
+  in.local =
+      makeLocalCloud(x, !mesh && in.file.mesh.cloud.height > 1 ? in.file.mesh.cloud.width : 0);
+  in.points = std::const_pointer_cast<pcl::PointCloud<pcl::PointXYZ>>(in.local.points);
+  if (mesh) {
     in.topology = std::make_shared<const MeshTopology>(in.file.mesh);
     in.h = meanEdgeLength(*in.topology, x);
-  } else if (in.file.mesh.cloud.height > 1) {
-    in.points->width = in.file.mesh.cloud.width;
-    in.points->height = in.file.mesh.cloud.height;
   }
-  in.points->sensor_origin_.head<3>() = in.file.sensor_pose.origin.cast<float>();
+  in.points->sensor_origin_.head<3>() =
+      (in.file.sensor_pose.origin - in.local.origin).cast<float>();
   in.points->sensor_orientation_ = in.file.sensor_pose.orientation.cast<float>();
   return in;
 }
@@ -244,7 +242,7 @@ LocalFitOptions withRadius(LocalFitOptions options, double radius, unsigned int 
 
 // Normals (float, as PCL's estimators give them) and PCL's curvature field.
 Fields fittedNormals(const Input& in, const LocalFitOptions& options) {
-  const LocalFitResult r = fitLocalSurfaces(in.points, in.topology, options);
+  const LocalFitResult r = fitLocalSurfaces(in.local, in.topology, options);
   Fields f{{"nx", "ny", "nz", "curvature"}, Eigen::MatrixXd(4, r.normals.size())};
   for (std::size_t i = 0; i < r.normals.size(); ++i) {
     const pcl::Normal& n = r.normals[i];
@@ -334,7 +332,7 @@ Fields cotanCurvatures(const Input& in, MassType mass) {
 // H = (k1 + k2) / 2 and K = k1 k2 from the quadric's principal curvatures, with its k1 direction
 // and normal.
 Fields quadricCurvatures(const Input& in, const LocalFitOptions& options) {
-  const LocalFitResult r = fitLocalSurfaces(in.points, in.topology, options);
+  const LocalFitResult r = fitLocalSurfaces(in.local, in.topology, options);
   const auto n = static_cast<Eigen::Index>(r.curvatures.size());
   Eigen::VectorXd k1(n), k2(n);
   Fields f{{"k1_direction_x", "k1_direction_y", "k1_direction_z", "nx", "ny", "nz"},
@@ -596,7 +594,7 @@ TEST_F(ToolOptions, SmoothOrganizedEqualsTheLibraryForEveryOption) {
 // angle_difference, overlap, and the colours of -color (default angle_difference, clamped at 30
 // degrees; overlap as it is), on the sequential map over the whole range.
 Fields comparison(const Input& in, LocalFitOptions options, const std::string& color) {
-  const NeighbourhoodComparison c = compareNeighbourhoods(in.points, in.topology, options);
+  const NeighbourhoodComparison c = compareNeighbourhoods(in.local, in.topology, options);
   const Eigen::VectorXd coloured =
       color == "overlap" ? c.overlap : Eigen::VectorXd(c.angle_difference.cwiseMin(30.0));
   Fields f{{"angle_difference", "overlap", "red", "green", "blue"},

@@ -583,7 +583,7 @@ TEST_F(Viewer, RobustNormalsAreTheLibrarys) {
   options.k = 40;
   options.viewpoint = model->sensorPose().origin;
   const LocalFitResult library =
-      fitLocalSurfaces(tools::toXYZ(model->inputPositions()), nullptr, options);
+      fitLocalSurfaces(makeLocalCloud(model->inputPositions()), nullptr, options);
   EXPECT_EQ(*window.frame().normals, tools::normalsOf(library.normals));
 }
 

@@ -318,6 +318,16 @@ std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args, T
   return left_out;
 }
 
+void orientLasUp(const char* tool_name, const ToolArguments& args, bool las_input,
+                 LocalFitOptions& options) {
+  if (!las_input || args.has("viewpoint") || args.has("orient")) return;
+  options.orientation = NormalOrientation::Up;
+  std::fprintf(stderr,
+               "%s: a LAS file: normals oriented up (n . z >= 0, as PDAL's filters.normal; "
+               "-viewpoint or -orient chooses otherwise)\n",
+               tool_name);
+}
+
 std::uint64_t memoryArgument(const ToolArguments& args) {
   try {
     return parseByteSize(*args.value("memory"));
@@ -373,7 +383,9 @@ int fitEachInputOutOfCore(const char* tool_name, const ToolArguments& args,
   memoryArgument(args);  // checked before any file is read
   return forEachInput(args, tool_name, {"ply", "pcd", "las"},
                       [&](const std::string& input, const std::string& output) {
-                        fitOutOfCore(tool_name, args, input, output, options,
+                        LocalFitOptions for_input = options;
+                        orientLasUp(tool_name, args, fileExtension(input) == "las", for_input);
+                        fitOutOfCore(tool_name, args, input, output, for_input,
                                      outOfCoreFields(output, precision, add));
                       });
 }

@@ -61,6 +61,12 @@ std::vector<int> classesArgument(const ToolArguments& args);
  */
 std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args, ToolInput& input);
 
+/** Aerial LiDAR has no single viewpoint: a LAS input fitted without -viewpoint or -orient is
+ *  oriented up (as PDAL's filters.normal), which this says in one line; other inputs keep
+ *  options as they are. */
+void orientLasUp(const char* tool_name, const ToolArguments& args, bool las_input,
+                 LocalFitOptions& options);
+
 /** -memory SIZE (like 2G, 512M), checked before any file is read (UsageError). */
 std::uint64_t memoryArgument(const ToolArguments& args);
 

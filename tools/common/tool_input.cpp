@@ -55,17 +55,18 @@ ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind k
   }
 }
 
-const pcl::PointCloud<pcl::PointXYZ>::Ptr& ToolInput::points() {
-  if (points_) return points_;
-  points_ = toXYZ(positions);
-  if (topology) return points_;
+const LocalCloud& ToolInput::local() {
+  if (local_) return *local_;
   // An organized cloud (a frame, a range image) keeps its pixel grid and its sensor.
-  if (mesh.cloud.height > 1) {
-    points_->width = mesh.cloud.width;
-    points_->height = mesh.cloud.height;
-  }
-  points_->sensor_origin_.head<3>() = sensor_pose.origin.cast<float>();
+  local_ = makeLocalCloud(positions, !topology && mesh.cloud.height > 1 ? mesh.cloud.width : 0);
+  points_ = std::const_pointer_cast<pcl::PointCloud<pcl::PointXYZ>>(local_->points);
+  points_->sensor_origin_.head<3>() = (sensor_pose.origin - local_->origin).cast<float>();
   points_->sensor_orientation_ = sensor_pose.orientation.cast<float>();
+  return *local_;
+}
+
+const pcl::PointCloud<pcl::PointXYZ>::Ptr& ToolInput::points() {
+  local();
   return points_;
 }
 
@@ -99,15 +100,6 @@ double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) {
     }
   }
   return counted > 0 ? sum / counted : 0.0;
-}
-
-pcl::PointCloud<pcl::PointXYZ>::Ptr toXYZ(const Eigen::Matrix3Xd& positions) {
-  auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
-  points->resize(positions.cols());
-  for (Eigen::Index i = 0; i < positions.cols(); ++i)
-    (*points)[i].getVector3fMap() = positions.col(i).cast<float>();
-  points->is_dense = positions.allFinite();
-  return points;
 }
 
 }  // namespace tools

@@ -1,7 +1,8 @@
 #pragma once
 // An input file as every tool loads it: the file (mesh or cloud, exact coordinates, what the format
 // declares), a mesh's topology checked once with one warning line per kind of defect, and what
-// only some tools need (PCL's float points, the sampling's spacing) made on first use.
+// only some tools need (the points about their local origin, the sampling's spacing) made on
+// first use.
 #include <pcl/PolygonMesh.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -11,6 +12,7 @@
 #include <optional>
 #include <string>
 
+#include "pcl_ddg/features/local_cloud.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 
@@ -36,24 +38,25 @@ class ToolInput {
   std::shared_ptr<const LasLayout> las;          ///< a LAS input's layout (for a .las output)
   FieldPrecision coordinate_precision = FieldPrecision::Float;  ///< as the file declares them
 
-  /** positions as PCL points (float, NaN kept); an organized cloud keeps its grid, and the
-   *  sensor pose is the cloud's sensor_origin_ / sensor_orientation_. Made on the first call. */
+  /** positions about their local origin (local_cloud.h): what every fit takes. Its float points
+   *  keep an organized cloud's grid, and the sensor pose is their sensor_origin_ (relative to
+   *  the origin) and sensor_orientation_. Made on the first call. */
+  const LocalCloud& local();
+  /** local()'s float points, to change (a point made NaN is left out of the fits). */
   const pcl::PointCloud<pcl::PointXYZ>::Ptr& points();
   /** h: a mesh's mean edge length, a cloud's mean distance to the nearest other point (over up to
    *  10,000 points, exact duplicates skipped: it costs a kd-tree). Measured on the first call. */
   double spacing();
 
  private:
-  pcl::PointCloud<pcl::PointXYZ>::Ptr points_;
+  std::optional<LocalCloud> local_;
+  pcl::PointCloud<pcl::PointXYZ>::Ptr points_;  ///< local_'s, not const
   std::optional<double> spacing_;
 };
 
 /** Mean distance from a point to its nearest other point (exact duplicates skipped), over up to
  *  10,000 finite points: a cloud's h. */
 double meanSpacing(const pcl::PointCloud<pcl::PointXYZ>::Ptr& points);
-
-/** positions as PCL points (float; NaN kept, is_dense when all are finite). */
-pcl::PointCloud<pcl::PointXYZ>::Ptr toXYZ(const Eigen::Matrix3Xd& positions);
 
 }  // namespace tools
 }  // namespace pcl_ddg

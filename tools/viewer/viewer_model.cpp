@@ -72,7 +72,7 @@ ViewerModel::ViewerModel(tools::ToolInput input, std::string path)
   diagonal_ = box.isEmpty() ? 0.0 : box.diagonal().norm();
   if (!(spacing_ > 0.0)) spacing_ = 1.0;
   positions_["input;"] = std::make_shared<const Eigen::Matrix3Xd>(input_.positions);
-  points_["input;"] = input_.points();
+  clouds_["input;"] = input_.local();
 }
 
 ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingStep>& steps,
@@ -142,22 +142,23 @@ ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingSt
 }
 
 LocalFitResult ViewerModel::fit(LocalFitMethod method, const ViewerState& state,
-                                const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) const {
+                                const LocalCloud& cloud) const {
   LocalFitOptions options;
   options.method = method;
   options.neighbourhood = state.neighbours == Neighbours::MeshRings ? NeighbourhoodKind::MeshRings
                                                                     : NeighbourhoodKind::KdTree;
   options.k = state.k;
   options.viewpoint = input_.sensor_pose.origin;
+  // Aerial LiDAR has no single viewpoint: up, as the tools orient a LAS file by default.
+  if (input_.las && !input_.topology) options.orientation = NormalOrientation::Up;
   const tools::QuietPCLWarnings quiet;
-  return fitLocalSurfaces(points, input_.topology, options);
+  return fitLocalSurfaces(cloud, input_.topology, options);
 }
 
-pcl::PointCloud<pcl::PointXYZ>::Ptr ViewerModel::pointsOf(const std::string& version,
-                                                          const Positions& positions) {
-  auto& points = points_[version];
-  if (!points) points = tools::toXYZ(*positions);
-  return points;
+const LocalCloud& ViewerModel::cloudOf(const std::string& version, const Positions& positions) {
+  const auto it = clouds_.find(version);
+  if (it != clouds_.end()) return it->second;
+  return clouds_[version] = makeLocalCloud(*positions, clouds_.at("input;").origin);
 }
 
 std::shared_ptr<const Eigen::Matrix3Xd> ViewerModel::normalsOf(NormalMethod method,
@@ -189,7 +190,7 @@ std::shared_ptr<const Eigen::Matrix3Xd> ViewerModel::normalsOf(NormalMethod meth
     const LocalFitResult result = fit(method == NormalMethod::PCA       ? LocalFitMethod::PCA
                                       : method == NormalMethod::Quadric ? LocalFitMethod::Quadric
                                                                         : LocalFitMethod::Robust,
-                                      state, pointsOf(version, positions));
+                                      state, cloudOf(version, positions));
     invalid = result.failed_points;
     fallback = result.fallback_points;
     normals = std::make_shared<const Eigen::Matrix3Xd>(tools::normalsOf(result.normals));
@@ -235,7 +236,7 @@ Eigen::VectorXd ViewerModel::fieldOf(const ViewerState& state, const std::string
         warnings.push_back(count(c.invalid_vertices, "vertices without curvature (NaN)"));
     } else {
       const LocalFitResult quadric =
-          fit(LocalFitMethod::Quadric, state, pointsOf(version, positions));
+          fit(LocalFitMethod::Quadric, state, cloudOf(version, positions));
       const Eigen::Index n = static_cast<Eigen::Index>(quadric.curvatures.size());
       for (auto& v : values) v.resize(n);
       for (Eigen::Index i = 0; i < n; ++i) {
@@ -281,7 +282,7 @@ Eigen::VectorXd ViewerModel::fieldOf(const ViewerState& state, const std::string
     options.k = state.k;
     const tools::QuietPCLWarnings quiet;
     const NeighbourhoodComparison comparison =
-        compareNeighbourhoods(pointsOf(version, positions), input_.topology, options);
+        compareNeighbourhoods(cloudOf(version, positions), input_.topology, options);
     std::ostringstream summary;
     summary.precision(3);
     summary << "rings vs kd-tree: mean " << comparison.summary.mean << " deg, "

@@ -74,9 +74,9 @@ class ViewerModel {
                           std::string& label, ColorMap& map, std::vector<std::string>& warnings);
   /** A pca or quadric fit with the state's k and neighbourhood, oriented as the tools do. */
   LocalFitResult fit(LocalFitMethod method, const ViewerState& state,
-                     const pcl::PointCloud<pcl::PointXYZ>::Ptr& points) const;
-  pcl::PointCloud<pcl::PointXYZ>::Ptr pointsOf(const std::string& version,
-                                               const Positions& positions);
+                     const LocalCloud& cloud) const;
+  /** A version's positions about the input's local origin (every version shares it). */
+  const LocalCloud& cloudOf(const std::string& version, const Positions& positions);
 
   tools::ToolInput input_;
   std::string path_;
@@ -88,7 +88,7 @@ class ViewerModel {
   std::map<std::string, Positions> positions_;
   std::map<std::string, std::shared_ptr<const Eigen::Matrix3Xd>> normals_;
   std::map<std::string, Eigen::VectorXd> fields_;
-  std::map<std::string, pcl::PointCloud<pcl::PointXYZ>::Ptr> points_;
+  std::map<std::string, LocalCloud> clouds_;
 };
 
 }  // namespace viewer

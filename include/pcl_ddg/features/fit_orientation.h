@@ -37,10 +37,11 @@ class FitOrientation {
   bool seed_facing_viewpoint = false;
 
   /** Before a compute: fixes the policy (search: the estimator's search method), builds its
-   *  reference and checks it fits the input; false, with a PCL_ERROR naming estimator, if not. */
-  bool prepare(const typename Cloud::ConstPtr& input, bool separate_surface,
-               const typename Search::Ptr& search, const Eigen::Vector3d& viewpoint,
-               const std::string& estimator);
+   *  reference and checks it fits the input; false, with a PCL_ERROR naming estimator, if not.
+   *  positions: the input's exact coordinates (null: its floats). */
+  bool prepare(const typename Cloud::ConstPtr& input, const Eigen::Matrix3Xd* positions,
+               bool separate_surface, const typename Search::Ptr& search,
+               const Eigen::Vector3d& viewpoint, const std::string& estimator);
 
   /** Turns n to agree with the reference of input point index (at position p); true if flipped.
    *  SpanningTree: towards the viewpoint, until makeConsistent. */

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "pcl_ddg/features/consistent_orientation.h"
+#include "pcl_ddg/features/local_cloud.h"
 #include "pcl_ddg/features/normal_orientation.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 
@@ -69,16 +70,18 @@ struct LocalFitResult {
 };
 
 /**
- * Runs PCANormalEstimation, QuadricNormalEstimation or RobustNormalEstimation on cloud. PCA on
- * the grid of a whole
- * organized cloud takes the window-sum path (computeOrganizedPCANormals) over the smallest
- * square window of at least k pixels, and keeps the cloud's width x height. With a topology (one
- * vertex per point) normals are oriented like its faces, whichever neighbourhood is used, so that
- * the two neighbourhoods can be compared point by point; without one, towards the viewpoint (the
- * origin by default) as PCL does; or along a spanning tree (options.orientation). Throws
- * pcl::BadArgumentException for MeshRings without a topology or a bad k / radius.
+ * Runs PCANormalEstimation, QuadricNormalEstimation or RobustNormalEstimation on cloud: searched
+ * in its float points, fitted in its double positions when it has them (local_cloud.h), all in
+ * its local frame (options.viewpoint is in world coordinates; normals and curvatures do not
+ * depend on the frame). PCA on the grid of a whole organized cloud takes the window-sum path
+ * (computeOrganizedPCANormals) over the smallest square window of at least k pixels, and keeps
+ * the cloud's width x height. With a topology (one vertex per point) normals are oriented like
+ * its faces, whichever neighbourhood is used, so that the two neighbourhoods can be compared point
+ * by point; without one, towards the viewpoint (the origin by default) as PCL does; or along a
+ * spanning tree (options.orientation). Throws pcl::BadArgumentException for MeshRings without a
+ * topology or a bad k / radius.
  */
-LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+LocalFitResult fitLocalSurfaces(const LocalCloud& cloud,
                                 const std::shared_ptr<const MeshTopology>& topology,
                                 const LocalFitOptions& options);
 
@@ -87,7 +90,7 @@ int gridWindowRadius(int k);
 
 /** The same for the points `indices` only (one output per index, in their order), their
  *  neighbours taken from the whole cloud: how a tile with a halo is processed. */
-LocalFitResult fitLocalSurfaces(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+LocalFitResult fitLocalSurfaces(const LocalCloud& cloud,
                                 const std::shared_ptr<const MeshTopology>& topology,
                                 const LocalFitOptions& options, const pcl::IndicesPtr& indices);
 

@@ -19,6 +19,9 @@
  * search method (mesh rings, pixel grid or kd-tree: the graph follows the neighbourhood), for
  * clouds without a single viewpoint; the quadric's curvatures change sign with their normals.
  *
+ * The fits read each neighbourhood in double relative to its query point, from the input's
+ * floats or, given setInputPositions, from the exact coordinates beside them.
+ *
  * A point that cannot be estimated (non-finite, or too few finite neighbours) gets NaN output
  * and output.is_dense = false; compute() counts them (getFailedPoints) and warns once.
  */
@@ -137,6 +140,17 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   }
   unsigned int getRadiusSearchMinNeighbours() const { return min_neighbours_; }
 
+  /** The input's coordinates in double, column i for point i: the fits read them instead of the
+   *  input's floats, in which the search method still looks (local_cloud.h: a cloud whose exact
+   *  coordinates are doubles, placed about a local origin). A point is used where its float point
+   *  is finite. Needs the search surface to be the input; null (the default): the floats. */
+  void setInputPositions(std::shared_ptr<const Eigen::Matrix3Xd> positions) {
+    input_positions_ = std::move(positions);
+  }
+  const std::shared_ptr<const Eigen::Matrix3Xd>& getInputPositions() const {
+    return input_positions_;
+  }
+
   /** Threads for compute(), as pcl::NormalEstimationOMP; 0 = as many as the machine has. */
   void setNumberOfThreads(unsigned int nr_threads = 0) { threads_ = nr_threads; }
   unsigned int getNumberOfThreads() const { return threads_; }
@@ -170,6 +184,13 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   /** threads_, with 0 meaning every core. */
   int threadCount() const;
 
+  /** Input point j in double: setInputPositions' column, else its float point. */
+  Eigen::Vector3d inputPosition(pcl::index_t j) const {
+    return input_positions_
+               ? Eigen::Vector3d(input_positions_->col(j))
+               : Eigen::Vector3d((*this->input_)[j].getVector3fMap().template cast<double>());
+  }
+
   unsigned int max_neighbours_ = 0;
   unsigned int min_neighbours_ = 0;
   std::int64_t fallback_points_ = 0;  ///< counted by fitEachNeighbourhood (FitOutcome::FellBack)
@@ -196,6 +217,7 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
     orientation_.chosen = true;
   }
 
+  std::shared_ptr<const Eigen::Matrix3Xd> input_positions_;
   detail::FitOrientation<PointInT> orientation_;
   std::int64_t failed_points_ = 0;
 };

@@ -33,7 +33,7 @@ struct NeighbourhoodComparison {
  *  is ignored. The topological one is the mesh's rings with a topology (one vertex per point),
  *  else the pixel grid of an organized cloud (PCA over its window, as fitLocalSurfaces does;
  *  the overlap is then of that window's pixels); throws pcl::BadArgumentException for neither. */
-NeighbourhoodComparison compareNeighbourhoods(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
+NeighbourhoodComparison compareNeighbourhoods(const LocalCloud& local,
                                               const std::shared_ptr<const MeshTopology>& topology,
                                               LocalFitOptions options);
 

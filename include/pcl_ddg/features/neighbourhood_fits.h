@@ -42,6 +42,9 @@ struct NeighbourhoodQueries {
   const pcl::PointCloud<PointInT>* input = nullptr;
   const pcl::PointCloud<PointInT>* surface = nullptr;
   const pcl::Indices* indices = nullptr;  ///< the query points (input indices)
+  /** The input's (= surface's) coordinates in double, read instead of its floats; null: the
+   *  floats. */
+  const Eigen::Matrix3Xd* positions = nullptr;
   pcl::search::Search<PointInT>* tree = nullptr;
   const SurfaceSearch<PointInT>* search = nullptr;  ///< k or radius search of the surface
   double search_parameter = 0.0;                    ///< its k or radius

@@ -34,6 +34,10 @@ struct OrganizedNormalOptions {
   unsigned int threads = 0;  ///< 0: all cores
   /** Normals are turned towards this point; unset: the cloud's sensor origin. */
   std::optional<Eigen::Vector3d> viewpoint;
+  /** The cloud's coordinates in double (column i: pixel i), summed and fitted instead of its
+   *  floats, which still decide which pixels are finite and where the grid is cut (local_cloud.h);
+   *  null: the floats. */
+  std::shared_ptr<const Eigen::Matrix3Xd> positions;
 };
 
 struct OrganizedNormalResult {
@@ -48,8 +52,8 @@ struct OrganizedNormalResult {
   std::shared_ptr<const OrganizedGridSearch<pcl::PointXYZ>> grid;
 };
 
-/** Throws pcl::BadArgumentException unless cloud is organized, window_radius >= 1 and
- *  max_depth_jump > 0. */
+/** Throws pcl::BadArgumentException unless cloud is organized, window_radius >= 1,
+ *  max_depth_jump > 0 and positions (if given) has a column per pixel. */
 OrganizedNormalResult computeOrganizedPCANormals(
     const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
     const OrganizedNormalOptions& options = OrganizedNormalOptions());

@@ -48,8 +48,10 @@ struct LasLayout {
   std::uint16_t creation_day = 0, creation_year = 0;
   Eigen::Vector3d scale = Eigen::Vector3d::Constant(0.001);
   Eigen::Vector3d offset = Eigen::Vector3d::Zero();
-  Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();  ///< as read
-  std::uint64_t point_count = 0;                                                 ///< as read
+  /** The header's own bounds as read (pcl_ddg_info compares them with the records'); a written
+   *  file's are the records' again. */
+  Eigen::Vector3d min = Eigen::Vector3d::Zero(), max = Eigen::Vector3d::Zero();
+  std::uint64_t point_count = 0;  ///< as read
   /** Every VLR in file order, the Extra Bytes one included (rewritten when the fields change). */
   std::vector<LasVariableLengthRecord> vlrs;
   std::vector<LasVariableLengthRecord> evlrs;

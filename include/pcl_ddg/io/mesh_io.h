@@ -56,9 +56,17 @@ struct MeshFile {
   std::shared_ptr<const LasLayout> las;
 };
 
+/** What readMeshFile does with a valid LAS file whose header counts no point. (A file of another
+ *  format without vertices is refused either way: there is nothing in it to report.) */
+enum class EmptyFilePolicy {
+  Refuse,  ///< FileFormatException naming the file, "no points": nothing to compute on
+  Accept   ///< returned with no points and its header in MeshFile::las: to report on it
+};
+
 /** Loads any supported file. Throws FileFormatException when a finite coordinate lies beyond
- *  float's range (PCL's point types could not hold it). */
-MeshFile readMeshFile(const std::string& path);
+ *  float's range (PCL's point types could not hold it), and for a file of no points unless
+ *  empty is Accept and the file is LAS. */
+MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty = EmptyFilePolicy::Refuse);
 
 /** readMeshFile's mesh; `sensor_pose`, if given, receives the file's VIEWPOINT (PCD). */
 pcl::PolygonMesh loadMesh(const std::string& path, SensorPose* sensor_pose = nullptr);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "pcl_ddg/mesh/mesh_geometry.h"
+#include "pcl_ddg/mesh/positions_ref.h"
 
 namespace pcl_ddg {
 
@@ -18,6 +19,7 @@ struct CloudReport {
   std::int64_t nan_points = 0;  ///< points with a NaN or infinite coordinate
   std::int64_t duplicate_points =
       0;  ///< finite points with exactly the coordinates of an earlier one
+  /** Of the finite points (NaN corners if there is none). */
   BoundingBox bounding_box;
 
   bool organized() const { return height > 1; }
@@ -25,7 +27,9 @@ struct CloudReport {
   std::string toText() const;
 };
 
-/** Throws InvalidMeshException if the cloud has no x, y, z fields. */
-CloudReport makeCloudReport(const pcl::PCLPointCloud2& cloud);
+/** The report of cloud (its layout) whose points are at positions, one column per point: the
+ *  exact coordinates (MeshFile::positions), so that duplicates and the box are those of the
+ *  file's values, not of their float rounding. Throws InvalidMeshException if the counts differ. */
+CloudReport makeCloudReport(const pcl::PCLPointCloud2& cloud, const PositionsRef& positions);
 
 }  // namespace pcl_ddg

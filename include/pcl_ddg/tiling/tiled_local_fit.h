@@ -34,9 +34,14 @@ struct TilingReport {
   double widest_halo = 0.0;         ///< in the cloud's length unit
 };
 
-/** Gathered points, by increasing index in the cloud, and which of them to fit. */
+/** Gathered points, by increasing index in the cloud, and which of them to fit: in the whole
+ *  cloud's local frame (local_cloud.h), whose origin every tile shares, so that a tile's floats
+ *  and doubles are the whole cloud's, bit for bit. */
 struct TilePoints {
   pcl::PointCloud<pcl::PointXYZ>::Ptr points;
+  /** The points in double (relative to origin), parallel to points; null: the floats. */
+  std::shared_ptr<Eigen::Matrix3Xd> positions;
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   std::vector<std::int64_t> global_index;  ///< parallel to points
   pcl::IndicesPtr own;                     ///< positions in points of the points to fit
 };
@@ -49,16 +54,16 @@ using PointGatherer = std::function<TilePoints(int tile, const Eigen::AlignedBox
 using FitConsumer = std::function<void(const TilePoints&, const LocalFitResult&)>;
 
 /**
- * Fits every tile of the plan, one after the other (each fit parallel inside), and hands every
- * finite point's result to consume exactly once. Throws like fitLocalSurfaces;
+ * Fits every tile of the plan (cut from the points' float coordinates in the local frame), one
+ * after the other (each fit parallel inside), and hands every finite point's result to consume
+ * exactly once. Throws like fitLocalSurfaces;
  * options.neighbourhood must be KdTree (mesh rings need the whole mesh).
  */
 void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointGatherer& gather,
               const FitConsumer& consume, TilingReport* report = nullptr);
 
 /** fitLocalSurfaces on a cloud in memory, tile by tile: the same result, bit for bit. */
-LocalFitResult fitLocalSurfacesTiled(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud,
-                                     const LocalFitOptions& options, const TilingOptions& tiling,
-                                     TilingReport* report = nullptr);
+LocalFitResult fitLocalSurfacesTiled(const LocalCloud& cloud, const LocalFitOptions& options,
+                                     const TilingOptions& tiling, TilingReport* report = nullptr);
 
 }  // namespace pcl_ddg

@@ -12,7 +12,8 @@ namespace pcl_ddg {
 namespace detail {
 
 template <typename PointInT>
-bool FitOrientation<PointInT>::prepare(const typename Cloud::ConstPtr& input, bool separate_surface,
+bool FitOrientation<PointInT>::prepare(const typename Cloud::ConstPtr& input,
+                                       const Eigen::Matrix3Xd* positions, bool separate_surface,
                                        const typename Search::Ptr& search,
                                        const Eigen::Vector3d& viewpoint,
                                        const std::string& estimator) {
@@ -32,11 +33,14 @@ bool FitOrientation<PointInT>::prepare(const typename Cloud::ConstPtr& input, bo
                 estimator.c_str(), faces->numVertices(), input->size());
       return false;
     }
-    Eigen::Matrix3Xd positions(3, input->size());
-    for (std::size_t i = 0; i < input->size(); ++i) {
-      positions.col(i) = (*input)[i].getVector3fMap().template cast<double>();
+    if (positions) {
+      reference_normals_ = meshOrientationNormals(*faces, *positions);
+    } else {
+      Eigen::Matrix3Xd floats(3, input->size());
+      for (std::size_t i = 0; i < input->size(); ++i)
+        floats.col(i) = (*input)[i].getVector3fMap().template cast<double>();
+      reference_normals_ = meshOrientationNormals(*faces, floats);
     }
-    reference_normals_ = meshOrientationNormals(*faces, positions);
   }
   if (used_ != NormalOrientation::SpanningTree) return true;
   if (tree_neighbours < 1) {

@@ -58,9 +58,19 @@ bool LocalFitEstimation<PointInT, PointOutT>::computePointNormal(
 
 template <typename PointInT, typename PointOutT>
 bool LocalFitEstimation<PointInT, PointOutT>::initCompute() {
-  return pcl::Feature<PointInT, PointOutT>::initCompute() &&
-         orientation_.prepare(this->input_, this->surface_ != this->input_, this->tree_,
-                              Eigen::Vector3d(vpx_, vpy_, vpz_), this->getClassName());
+  if (!pcl::Feature<PointInT, PointOutT>::initCompute()) return false;
+  if (input_positions_ &&
+      (this->surface_ != this->input_ ||
+       input_positions_->cols() != static_cast<Eigen::Index>(this->input_->size()))) {
+    PCL_ERROR(
+        "[pcl_ddg::%s] the input positions (%lld) must be the input's (%zu points), and the "
+        "input its own search surface\n",
+        this->getClassName().c_str(), static_cast<long long>(input_positions_->cols()),
+        this->input_->size());
+    return false;
+  }
+  return orientation_.prepare(this->input_, input_positions_.get(), this->surface_ != this->input_,
+                              this->tree_, Eigen::Vector3d(vpx_, vpy_, vpz_), this->getClassName());
 }
 
 template <typename PointInT, typename PointOutT>
@@ -100,6 +110,7 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(
   queries.input = this->input_.get();
   queries.surface = this->surface_.get();
   queries.indices = this->indices_.get();
+  queries.positions = input_positions_.get();
   queries.tree = this->tree_.get();
   queries.search = &this->search_method_surface_;
   queries.search_parameter = this->search_parameter_;

@@ -58,7 +58,14 @@ FitCounts fitNeighbourhoods(const NeighbourhoodQueries<PointInT>& queries,
                                     neighbours, squared_distances);
       }
       found = std::min(found, static_cast<int>(neighbours.size()));
-      const Eigen::Vector3d origin = query.getVector3fMap().template cast<double>();
+      // In double, relative to the query point: exact differences of the exact coordinates.
+      const auto position = [&](pcl::index_t j) -> Eigen::Vector3d {
+        if (queries.positions) return queries.positions->col(j);
+        return surface[j].getVector3fMap().template cast<double>();
+      };
+      const Eigen::Vector3d origin =
+          queries.positions ? Eigen::Vector3d(queries.positions->col(indices[i]))
+                            : Eigen::Vector3d(query.getVector3fMap().template cast<double>());
       if (local.cols() < found) local.resize(3, found);
       finite_neighbours.resize(std::max(found, 0));
       int count = 0;
@@ -66,7 +73,7 @@ FitCounts fitNeighbourhoods(const NeighbourhoodQueries<PointInT>& queries,
         const pcl::index_t j = neighbours[n];
         if (pcl::isXYZFinite(surface[j])) {
           finite_neighbours[count] = j;
-          local.col(count++) = surface[j].getVector3fMap().template cast<double>() - origin;
+          local.col(count++) = position(j) - origin;
         }
       }
       const FitOutcome outcome =

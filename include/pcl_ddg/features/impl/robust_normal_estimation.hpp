@@ -63,21 +63,27 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
   const pcl::Indices& indices = *this->indices_;
   pcl::search::Search<PointInT>& tree = *this->tree_;
   const int threads = this->threadCount();
-  // Coordinates relative to one point of the cloud, in double.
+  // Coordinates relative to one point of the cloud, in double (the exact ones when given: then
+  // the surface is the input).
+  const auto absolute = [&](const PointInT& p, pcl::index_t j) -> Eigen::Vector3d {
+    const auto& exact = this->getInputPositions();
+    return exact ? Eigen::Vector3d(exact->col(j))
+                 : Eigen::Vector3d(p.getVector3fMap().template cast<double>());
+  };
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
-  for (const PointInT& p : surface)
-    if (pcl::isXYZFinite(p)) {
-      origin = p.getVector3fMap().template cast<double>();
+  for (std::size_t j = 0; j < surface.size(); ++j)
+    if (pcl::isXYZFinite(surface[j])) {
+      origin = absolute(surface[j], static_cast<pcl::index_t>(j));
       break;
     }
-  const auto relative = [&origin](const PointInT& p) -> Eigen::Vector3d {
-    return p.getVector3fMap().template cast<double>() - origin;
-  };
   std::vector<Eigen::Vector3d> nodes(surface.size());
   for (std::size_t j = 0; j < surface.size(); ++j)
-    nodes[j] = pcl::isXYZFinite(surface[j]) ? relative(surface[j]) : Eigen::Vector3d::Zero();
+    nodes[j] = pcl::isXYZFinite(surface[j])
+                   ? Eigen::Vector3d(absolute(surface[j], static_cast<pcl::index_t>(j)) - origin)
+                   : Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> queries(indices.size());
-  for (std::size_t i = 0; i < indices.size(); ++i) queries[i] = relative(input[indices[i]]);
+  for (std::size_t i = 0; i < indices.size(); ++i)
+    queries[i] = absolute(input[indices[i]], indices[i]) - origin;
 
   // The nodes' rows: on the input itself a query is its node and brings its row; the other
   // nodes (all of a separate search surface) search for theirs.
@@ -121,8 +127,7 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
       surface.begin(), surface.end(), [](const PointInT& p) { return pcl::isXYZFinite(p); }));
   for (std::size_t i = 0; i < planes.size(); ++i) {
     if (planes[i].level < 0) continue;
-    write(output[i], planes[i].normal, indices[i],
-          input[indices[i]].getVector3fMap().template cast<double>());
+    write(output[i], planes[i].normal, indices[i], this->inputPosition(indices[i]));
     scales_[i] = static_cast<float>(std::min(kWideGraphWidth * (planes[i].level + 1), finite));
     confidences_[i] = 1.0f;
   }

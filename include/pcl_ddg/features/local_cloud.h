@@ -1,0 +1,70 @@
+#pragma once
+/** \file
+ * A cloud as the fits take it when its coordinates arrive as doubles (LAS X * scale + offset,
+ * double PLY/PCD/VTK fields, text formats, float64 arrays): placed about a local origin chosen in
+ * double, so that survey coordinates millions of units from the origin are never rounded to float
+ * before they are centred.
+ *
+ * The rule, the same for a whole cloud, a tile and a piece: with P the smallest power of two not
+ * below the longest side of the bounding box of the whole input's finite points, the origin o is,
+ * on each axis, the box's centre rounded to a multiple of P, or 0 where the box comes within P of
+ * 0 on that axis (data around the origin stays where it is). Two things follow:
+ * - x - o is exact in double for every coordinate x of the box (where o != 0, |x| >= P while
+ *   |x - o| <= P and o is a multiple of P), so the positions relative to o are the input's own
+ *   values, and every difference the fits form is the one of the input's coordinates;
+ * - |x - o| < 2 P < 4 times the box's side: the float points the searches look in (PCL's kd-tree,
+ *   the pixel grid) round by at most about 2.4e-7 of the data's extent, not of its distance from
+ *   the origin.
+ * Normals and curvatures do not depend on where the data sits: a cloud moved by any vector gives
+ * the same results, to the last bit wherever the k-th neighbour is not tied with the next (the
+ * float distances the search compares may round differently).
+ */
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <memory>
+
+#include "pcl_ddg/mesh/positions_ref.h"
+
+namespace pcl_ddg {
+
+/** The local origin of positions (3 x N, world coordinates) by the rule above; zero when none is
+ *  finite. NaN and infinite columns are ignored. */
+Eigen::Vector3d localOrigin(const PositionsRef& positions);
+
+/** The local origin of the points within bounds (their finite points' bounding box, world
+ *  coordinates, as a pass over a file finds it); zero for an empty box. */
+Eigen::Vector3d localOrigin(const Eigen::AlignedBox3d& bounds);
+
+/** A cloud relative to its local origin: float points for the searches, and the same points in
+ *  double, relative to the same origin, for the fits. A point takes part where its float point
+ *  is finite (a NaN there leaves it out, whatever its double). */
+struct LocalCloud {
+  LocalCloud() = default;
+  /** A float cloud as it is (origin 0, the fits read its floats): a PCL user's cloud. */
+  LocalCloud(pcl::PointCloud<pcl::PointXYZ>::ConstPtr cloud)  // NOLINT: implicit on purpose
+      : points(std::move(cloud)) {}
+  LocalCloud(const pcl::PointCloud<pcl::PointXYZ>::Ptr& cloud)  // NOLINT: implicit on purpose
+      : points(cloud) {}
+
+  pcl::PointCloud<pcl::PointXYZ>::ConstPtr points;  ///< positions as float (NaN kept)
+  /** World coordinates minus origin, column i for point i; null: the floats are exact. */
+  std::shared_ptr<const Eigen::Matrix3Xd> positions;
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< in world coordinates
+};
+
+/** positions (world coordinates) relative to origin, and their float points (NaN kept; is_dense
+ *  when all are finite), organized width points per row when width > 0 (it must divide their
+ *  number). */
+LocalCloud makeLocalCloud(const PositionsRef& positions, const Eigen::Vector3d& origin,
+                          std::uint32_t width = 0);
+
+/** The same about positions' own local origin. */
+inline LocalCloud makeLocalCloud(const PositionsRef& positions, std::uint32_t width = 0) {
+  return makeLocalCloud(positions, localOrigin(positions), width);
+}
+
+}  // namespace pcl_ddg

@@ -1,0 +1,309 @@
+// Survey coordinates (local_cloud.h): a cloud millions of units from the origin is searched in
+// floats about its local origin and fitted in its exact doubles, so that its normals and
+// curvatures are those of the same cloud at the origin. The clouds are snapped to multiples of
+// 2^-16, so that moving them by (5e5, 5e6, 200) is exact in double: any difference is then the
+// library's, not the test's.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <pcl/search/kdtree.h>
+
+#include "estimator_support.h"
+#include "pcl_ddg/features/local_cloud.h"
+#include "pcl_ddg/features/local_fit.h"
+#include "pcl_ddg/tiling/tiled_local_fit.h"
+
+namespace pcl_ddg {
+namespace test {
+namespace {
+
+const Eigen::Vector3d kSurveyOffset(5e5, 5e6, 200.0);
+
+double snapped(double v) {
+  return std::round(v * 65536.0) / 65536.0;
+}
+
+// A sphere of radius 20 (uniform on it) beside a height field z = 2 sin(x / 7) cos(y / 5) over a
+// jittered 100 x 100 grid of spacing 1: both with exact normals, snapped.
+struct Scene {
+  Eigen::Matrix3Xd points, normals;
+};
+
+Scene makeScene(int sphere_points = 12000) {
+  std::mt19937 random(7);
+  std::normal_distribution<double> gauss;
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  const int grid = 100;
+  Scene s;
+  s.points.resize(3, sphere_points + grid * grid);
+  s.normals.resize(3, s.points.cols());
+  const Eigen::Vector3d centre(150.0, 0.0, 0.0);
+  for (int i = 0; i < sphere_points; ++i) {
+    Eigen::Vector3d d(gauss(random), gauss(random), gauss(random));
+    d.normalize();
+    s.points.col(i) = centre + 20.0 * d;
+    s.normals.col(i) = d;
+  }
+  for (int r = 0; r < grid; ++r) {
+    for (int c = 0; c < grid; ++c) {
+      const int i = sphere_points + r * grid + c;
+      const double x = c - 50.0 + jitter(random), y = r - 50.0 + jitter(random);
+      s.points.col(i) << x, y, 2.0 * std::sin(x / 7.0) * std::cos(y / 5.0);
+      const double zx = 2.0 / 7.0 * std::cos(x / 7.0) * std::cos(y / 5.0);
+      const double zy = -2.0 / 5.0 * std::sin(x / 7.0) * std::sin(y / 5.0);
+      s.normals.col(i) = Eigen::Vector3d(-zx, -zy, 1.0).normalized();
+    }
+  }
+  s.points = s.points.unaryExpr(&snapped);
+  return s;
+}
+
+double angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::atan2(a.cross(b).norm(), std::abs(a.dot(b)));
+}
+
+// Points whose k-th and (k+1)-th nearest distances differ by less than the float searches can
+// tell apart: each frame's floats round a coordinate by up to 2.4e-7 of the cloud's side
+// (local_cloud.h), a distance by up to sqrt(3) times that, so two frames may order such a pair
+// either way and fit another k-th neighbour. Found among the k + 8 nearest of a float search,
+// measured in double.
+std::vector<bool> nearTies(const Eigen::Matrix3Xd& points, int k) {
+  const double side = (points.rowwise().maxCoeff() - points.rowwise().minCoeff()).maxCoeff();
+  const double tolerance = 4.0 * std::sqrt(3.0) * 2.4e-7 * side;
+  pcl::search::KdTree<pcl::PointXYZ> tree;
+  tree.setInputCloud(toCloud(points));
+  std::vector<bool> tied(points.cols(), false);
+  pcl::Indices found;
+  std::vector<float> squared;
+  std::vector<double> distances;
+  for (Eigen::Index i = 0; i < points.cols(); ++i) {
+    const int n = tree.nearestKSearch(static_cast<pcl::index_t>(i), k + 8, found, squared);
+    distances.clear();
+    for (int j = 0; j < n; ++j) distances.push_back((points.col(found[j]) - points.col(i)).norm());
+    std::sort(distances.begin(), distances.end());
+    tied[i] = n > k && distances[k] - distances[k - 1] <= tolerance;
+  }
+  return tied;
+}
+
+TEST(LocalOrigin, StaysAtZeroForDataAroundTheOrigin) {
+  Eigen::Matrix3Xd p(3, 2);
+  p << -1.0, 3.0, 0.5, 1.5, 2.0, 2.5;
+  EXPECT_EQ(localOrigin(p), Eigen::Vector3d::Zero());
+  EXPECT_EQ(localOrigin(Eigen::Matrix3Xd(3, 0)), Eigen::Vector3d::Zero());
+  Eigen::Matrix3Xd nan = Eigen::Matrix3Xd::Constant(3, 2, std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(localOrigin(nan), Eigen::Vector3d::Zero());
+}
+
+TEST(LocalOrigin, IsAMultipleOfThePowerOfTwoAboveTheExtentNearTheCentre) {
+  Eigen::Matrix3Xd p(3, 3);
+  p.col(0) = kSurveyOffset;
+  p.col(1) = kSurveyOffset + Eigen::Vector3d(300.0, 200.0, 50.0);
+  p.col(2) = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  const Eigen::Vector3d o = localOrigin(p);
+  const double step = 512.0;  // the smallest power of two not below the side, 300
+  EXPECT_EQ(std::fmod(o.x(), step), 0.0);
+  EXPECT_EQ(std::fmod(o.y(), step), 0.0);
+  EXPECT_LE(std::abs(o.x() - (kSurveyOffset.x() + 150.0)), step / 2);
+  EXPECT_LE(std::abs(o.y() - (kSurveyOffset.y() + 100.0)), step / 2);
+  EXPECT_EQ(o.z(), 0.0);  // z from 200 to 250 comes within 512 of 0
+  // One place: the origin is the place.
+  Eigen::Matrix3Xd one(3, 1);
+  one.col(0) = kSurveyOffset;
+  EXPECT_EQ(localOrigin(one), kSurveyOffset);
+}
+
+TEST(LocalCloud, PositionsAreTheExactDifferencesAndTheFloatsRoundByAFractionOfTheExtent) {
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (const double side : {1e-3, 0.7, 123.0, 4096.0, 3e5}) {
+    Eigen::Matrix3Xd p(3, 2000);
+    for (Eigen::Index i = 0; i < p.cols(); ++i)
+      for (int d = 0; d < 3; ++d) p(d, i) = (d == 1 ? 4.3e6 : 6.8e5) + side * u(random);
+    const LocalCloud local = makeLocalCloud(p);
+    ASSERT_TRUE(local.positions);
+    double worst = 0.0;
+    for (Eigen::Index i = 0; i < p.cols(); ++i) {
+      for (int d = 0; d < 3; ++d) {
+        const long double exact =
+            static_cast<long double>(p(d, i)) - static_cast<long double>(local.origin[d]);
+        EXPECT_EQ(static_cast<long double>((*local.positions)(d, i)), exact);
+        EXPECT_EQ((*local.positions)(d, i) + local.origin[d], p(d, i));
+        worst = std::max(worst, std::abs(static_cast<double>((*local.points)[i].data[d]) -
+                                         (*local.positions)(d, i)));
+      }
+    }
+    EXPECT_LE(worst, 2.4e-7 * side) << "side " << side;
+  }
+}
+
+LocalFitOptions kdTree(LocalFitMethod method, int k) {
+  LocalFitOptions options;
+  options.method = method;
+  options.k = k;
+  options.orientation = NormalOrientation::Up;
+  return options;
+}
+
+struct Moved {
+  double max_angle = 0.0;     ///< radians, over the points not near a tie
+  double max_relative = 0.0;  ///< principal curvatures, relative, over the same
+  int differing = 0;          ///< points beyond 1e-9 (all near ties)
+  int near_ties = 0;
+};
+
+Moved compareMoved(const Scene& scene, LocalFitMethod method, int k) {
+  const Eigen::Matrix3Xd moved = scene.points.colwise() + kSurveyOffset;
+  for (Eigen::Index i = 0; i < moved.cols(); ++i)  // the move is exact
+    EXPECT_EQ(moved.col(i) - kSurveyOffset, scene.points.col(i));
+  const LocalFitResult here =
+      fitLocalSurfaces(makeLocalCloud(scene.points), nullptr, kdTree(method, k));
+  const LocalFitResult there = fitLocalSurfaces(makeLocalCloud(moved), nullptr, kdTree(method, k));
+  const std::vector<bool> tied = nearTies(scene.points, k);
+  const Eigen::Matrix3Xd a = normalsOf(here.normals), b = normalsOf(there.normals);
+  Moved m;
+  for (Eigen::Index i = 0; i < a.cols(); ++i) {
+    EXPECT_TRUE(a.col(i).allFinite() && b.col(i).allFinite()) << i;
+    double relative = 0.0;
+    if (method == LocalFitMethod::Quadric) {
+      const auto& p = here.curvatures[i];
+      const auto& q = there.curvatures[i];
+      relative = std::max(std::abs(p.pc1 - q.pc1) / std::max(std::abs(p.pc1), 1e-3f),
+                          std::abs(p.pc2 - q.pc2) / std::max(std::abs(p.pc2), 1e-3f));
+    }
+    const double difference = angle(a.col(i), b.col(i));
+    m.near_ties += tied[i];
+    if (difference > 1e-9 || relative > 1e-9) ++m.differing;
+    if (tied[i]) continue;
+    m.max_angle = std::max(m.max_angle, difference);
+    m.max_relative = std::max(m.max_relative, relative);
+  }
+  return m;
+}
+
+// The normals' float output rounds at 6e-8: 1e-9 rad means the fits were the same.
+TEST(LocalFit, PCANormalsDoNotDependOnWhereTheCloudSits) {
+  const Moved m = compareMoved(makeScene(), LocalFitMethod::PCA, 16);
+  EXPECT_LE(m.max_angle, 1e-9);
+  EXPECT_LE(m.differing, m.near_ties);
+  EXPECT_LE(m.near_ties, 220);  // 1 % of 22,000 points
+}
+
+TEST(LocalFit, QuadricNormalsAndCurvaturesDoNotDependOnWhereTheCloudSits) {
+  const Moved m = compareMoved(makeScene(), LocalFitMethod::Quadric, 20);
+  EXPECT_LE(m.max_angle, 1e-9);
+  EXPECT_LE(m.max_relative, 1e-9);
+  EXPECT_LE(m.differing, m.near_ties);
+}
+
+TEST(LocalFit, RobustNormalsDoNotDependOnWhereTheCloudSits) {
+  const Moved m = compareMoved(makeScene(4000), LocalFitMethod::Robust, 48);
+  EXPECT_LE(m.max_angle, 1e-9);
+}
+
+// Against an independent fit: each sampled point's k nearest found by brute force in long double
+// on the world coordinates, their covariance about their mean, Eigen's eigenvector of the smallest
+// eigenvalue. Also against the exact normal, at the accuracy PCA has on this sampling.
+TEST(LocalFit, SurveyCloudNormalsEqualAnIndependentDoublePCA) {
+  const Scene scene = makeScene();
+  const Eigen::Matrix3Xd world = scene.points.colwise() + kSurveyOffset;
+  const int k = 16;
+  const LocalFitResult fit =
+      fitLocalSurfaces(makeLocalCloud(world), nullptr, kdTree(LocalFitMethod::PCA, k));
+  const Eigen::Matrix3Xd ours = normalsOf(fit.normals);
+  double worst = 0.0, worst_truth = 0.0;
+  for (Eigen::Index i = 0; i < world.cols(); i += 97) {
+    std::vector<std::pair<long double, Eigen::Index>> d;
+    for (Eigen::Index j = 0; j < world.cols(); ++j) {
+      long double s = 0.0L;
+      for (int c = 0; c < 3; ++c) {
+        const long double e = static_cast<long double>(world(c, j)) - world(c, i);
+        s += e * e;
+      }
+      d.emplace_back(s, j);
+    }
+    std::partial_sort(d.begin(), d.begin() + k, d.end());
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int n = 0; n < k; ++n) mean += world.col(d[n].second) - world.col(i);
+    mean /= k;
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (int n = 0; n < k; ++n) {
+      const Eigen::Vector3d e = world.col(d[n].second) - world.col(i) - mean;
+      covariance += e * e.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+    worst = std::max(worst, angle(ours.col(i), eigen.eigenvectors().col(0)));
+    worst_truth = std::max(worst_truth, angle(ours.col(i), scene.normals.col(i)));
+  }
+  EXPECT_LE(worst, 1e-6);
+  EXPECT_LE(worst_truth, 3.0 * M_PI / 180.0);  // PCA's own error on this sampling
+}
+
+// Far from the origin the floats of the world coordinates step by 0.5 at 5e6: fitted as floats,
+// the height field's normals would be degrees off. This is what the local origin cures (and what
+// a float cloud given as such keeps: its floats are its coordinates).
+TEST(LocalFit, TheWorldsFloatsWouldHaveBeenWrong) {
+  const Scene scene = makeScene(0);  // scaled to a spacing of 0.2 below (its normals unchanged)
+  const Eigen::Matrix3Xd world = (0.2 * scene.points).colwise() + kSurveyOffset;
+  const LocalFitResult rounded =
+      fitLocalSurfaces(toCloud(world), nullptr, kdTree(LocalFitMethod::PCA, 16));
+  const LocalFitResult exact =
+      fitLocalSurfaces(makeLocalCloud(world), nullptr, kdTree(LocalFitMethod::PCA, 16));
+  const AngleErrors bad =
+      angleErrors(normalsOf(rounded.normals), scene.normals, SignMode::Unsigned);
+  const AngleErrors good = angleErrors(normalsOf(exact.normals), scene.normals, SignMode::Unsigned);
+  EXPECT_GT(bad.mean, 3.0) << bad.mean;    // 3.9 degrees here
+  EXPECT_LT(good.mean, 1.0) << good.mean;  // PCA's own error on this sampling
+}
+
+TEST(LocalFit, TilesOfASurveyCloudGiveTheWholeCloudsBits) {
+  const Scene scene = makeScene(6000);
+  const LocalCloud local = makeLocalCloud(scene.points.colwise() + kSurveyOffset);
+  for (const LocalFitMethod method : {LocalFitMethod::PCA, LocalFitMethod::Quadric}) {
+    const LocalFitOptions options = kdTree(method, 16);
+    const LocalFitResult whole = fitLocalSurfaces(local, nullptr, options);
+    TilingOptions tiling;
+    tiling.max_points_per_tile = 2000;
+    TilingReport report;
+    const LocalFitResult tiled = fitLocalSurfacesTiled(local, options, tiling, &report);
+    EXPECT_GT(report.tiles, 4u);
+    ASSERT_EQ(tiled.normals.size(), whole.normals.size());
+    for (std::size_t i = 0; i < whole.normals.size(); ++i) {
+      EXPECT_EQ(std::memcmp(&tiled.normals[i], &whole.normals[i], sizeof(pcl::Normal)), 0) << i;
+      if (method == LocalFitMethod::Quadric)
+        EXPECT_EQ(tiled.curvatures[i].pc1, whole.curvatures[i].pc1) << i;
+    }
+  }
+}
+
+// The pixel grid's window sums read the exact coordinates too: an organized height field far
+// away, its sensor 30 above its middle, gives the normals it gives at the origin.
+TEST(LocalFit, GridNormalsDoNotDependOnWhereTheFrameSits) {
+  const Scene scene = makeScene(0);  // 100 x 100, row by row
+  LocalFitOptions options = kdTree(LocalFitMethod::PCA, 25);
+  options.neighbourhood = NeighbourhoodKind::Grid;
+  Eigen::Matrix3Xd a, b;
+  for (const Eigen::Vector3d& offset : {Eigen::Vector3d::Zero().eval(), kSurveyOffset}) {
+    LocalCloud cloud = makeLocalCloud(scene.points.colwise() + offset, 100);
+    const Eigen::Vector3d sensor = offset + Eigen::Vector3d(0.0, 0.0, 30.0);
+    std::const_pointer_cast<pcl::PointCloud<pcl::PointXYZ>>(cloud.points)
+        ->sensor_origin_.head<3>() = (sensor - cloud.origin).cast<float>();
+    options.viewpoint = sensor;
+    (offset.isZero() ? a : b) = normalsOf(fitLocalSurfaces(cloud, nullptr, options).normals);
+  }
+  double worst = 0.0;
+  for (Eigen::Index i = 0; i < a.cols(); ++i) worst = std::max(worst, angle(a.col(i), b.col(i)));
+  EXPECT_LE(worst, 1e-9);
+  EXPECT_LT(angleErrors(b, scene.normals, SignMode::Unsigned).mean, 1.5);  // PCA's own error
+}
+
+}  // namespace
+}  // namespace test
+}  // namespace pcl_ddg
