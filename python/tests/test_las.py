@@ -1,7 +1,9 @@
 """LAS through the module: exact coordinates and fields against an independent reader written
-here from the ASPRS LAS 1.4 R15 tables, read -> write round trips of the records, the warning of
-a new file that carries no VLR of its input, the LAZ, truncated-file and no-point refusals, and
-normals equal to pcl_ddg_normals' on the same file."""
+here from the ASPRS LAS 1.4 R15 tables (every readable shared file: formats 0, 1, 2, 3, 6, 7 from
+libLAS/PDAL), read -> write round trips of the records, normals written as Extra Bytes checked in
+every record's bytes, a new file's scale and offset, the warning of a new file that carries no
+VLR of its input, the LAZ, truncated-file and no-point refusals, and normals equal to
+pcl_ddg_normals' on the same file. test_las_formats.py checks every field of formats 0-10."""
 
 import struct
 import warnings
@@ -11,14 +13,20 @@ import pytest
 
 import pcl_ddg
 from conftest import run_tool, shared_data
+from test_las_formats import eb_layout, parse_extra_bytes, parse_header, parse_vlrs, record_bytes
 
-FILES = ["autzen_trim.las", "extrabytes.las", "test1_4.las"]
+# Every readable LAS file of the shared data, written by libLAS, PDAL and others: point formats
+# 0, 1, 2 (formats/), 3, 6 and 7 in LAS 1.0-1.4. test_las_formats.py checks every field of
+# every record of these (and of formats 4, 5, 8-10 written there from the specification).
+FILES = ([f"formats/1.{minor}_{fmt}.las" for minor in (0, 1, 2) for fmt in (0, 1, 2, 3)
+          if minor == 2 or fmt < 2]
+         + ["autzen_trim.las", "autzen_trim_7.las", "mvk-thin.las", "epsg_4326.las",
+            "extrabytes.las", "test1_4.las", "1.2-with-color.las", "gps-time-nan.las"])
 
 
 def las_path(name):
     path = shared_data() / "las" / name
-    if not path.exists():
-        pytest.skip(f"{path} is not in the shared data")
+    assert path.exists(), f"{path} is not in the shared data (CATALOG.md): a failure, not a skip"
     return path
 
 
@@ -61,6 +69,11 @@ LAYOUTS = {
     6: _EXTENDED,
     7: _EXTENDED + [(n, t, 30 + o) for n, t, o in _RGB],
 }
+
+
+def test_every_layout_is_read_from_a_file_of_another_writer():
+    formats = {header_of(las_path(name).read_bytes())["format"] for name in FILES}
+    assert formats == set(LAYOUTS)  # no dead layout: each one checks a shared file
 
 
 def records_of(raw: bytes, header: dict) -> np.ndarray:
@@ -120,7 +133,10 @@ def test_coordinates_and_fields_equal_the_specification(name):
     for field in ("intensity", "user_data", "point_source_id", "gps_time", "red", "green",
                   "blue"):
         if field in records.dtype.names:
-            np.testing.assert_array_equal(m.fields[field], records[field], err_msg=field)
+            got, want = m.fields[field], records[field]
+            if want.dtype.kind == "f":  # bit for bit: gps-time-nan.las holds a NaN
+                got, want = got.view(np.uint64), want.view("<u8")
+            np.testing.assert_array_equal(got, want, err_msg=field)
             assert m.fields[field].dtype == records.dtype[field].newbyteorder("=")
     for field, values in expected_fields(records, header["format"]).items():
         np.testing.assert_array_equal(m.fields[field], values, err_msg=field)
@@ -151,7 +167,7 @@ def test_read_write_read_keeps_records_and_vlrs(name, tmp_path):
     path = las_path(name)
     raw = path.read_bytes()
     m = pcl_ddg.read(path)
-    out = tmp_path / name
+    out = tmp_path / name.replace("/", "_")
     pcl_ddg.write(out, m.points, fields=m.fields, las=m.las)
     written = out.read_bytes()
     assert header_of(written)["format"] == header_of(raw)["format"]
@@ -169,7 +185,7 @@ def test_read_write_read_keeps_records_and_vlrs(name, tmp_path):
         np.testing.assert_array_equal(again.fields[key], values, err_msg=key)
 
     # ... and once more: the rewritten file rewrites to the same records
-    out2 = tmp_path / ("again_" + name)
+    out2 = tmp_path / ("again_" + name.replace("/", "_"))
     pcl_ddg.write(out2, again.points, fields=again.fields, las=again.las)
     assert record_block(out2.read_bytes()) == record_block(raw)
 
@@ -181,7 +197,31 @@ def test_new_file_and_normals_as_extra_bytes(tmp_path):
     fields = dict(m.fields, normals=n.normals, curvature=n.curvature)
     pcl_ddg.write(out, m.points, fields=fields, las=m.las)
     back = pcl_ddg.read(out)
-    assert record_block(out.read_bytes())[:30] == record_block(las_path("test1_4.las").read_bytes())[:30]
+    # every record: the input's 30 bytes (format 6), then the four new dimensions, read here
+    # from the file's Extra Bytes descriptors (LAS 1.4 R15, 192 bytes each)
+    source = las_path("test1_4.las").read_bytes()
+    written = out.read_bytes()
+    h, w = parse_header(source), parse_header(written)
+    assert w["point_format"] == 6 and w["points"] == h["points"] == len(m.points)
+    assert h["record_length"] == 30
+    new, old = record_bytes(written, w), record_bytes(source, h)
+    np.testing.assert_array_equal(new[:, :30], old)
+    eb = [v for v in parse_vlrs(written, w) if (v["user"], v["id"]) == ("LASF_Spec", 4)]
+    assert len(eb) == 1
+    dims = parse_extra_bytes(eb[0]["payload"])
+    assert [d["name"] for d in dims] == ["NormalX", "NormalY", "NormalZ", "Curvature"]
+    at, stored = 30, []
+    for d in dims:
+        kind, count = eb_layout(d["data_type"], d["options"])
+        assert count == 1 and d["options"] == 0 and np.dtype(kind).kind == "f", d
+        size = np.dtype(kind).itemsize
+        stored.append(np.ascontiguousarray(new[:, at:at + size]).view(kind)[:, 0])
+        at += size
+    assert at == w["record_length"]
+    assert n.normals.dtype == n.curvature.dtype == np.float64  # stored as doubles (type 10)
+    for i, want in enumerate([n.normals[:, 0], n.normals[:, 1], n.normals[:, 2], n.curvature]):
+        assert stored[i].dtype == np.float64, dims[i]
+        np.testing.assert_array_equal(stored[i].view(np.uint64), want.view(np.uint64))  # bits
     # NormalX NormalY NormalZ Curvature in the file (PDAL's names); normal_x ... in the cloud
     assert [d[0] for d in back.las.extra_bytes] == ["normal_x", "normal_y", "normal_z", "curvature"]
     assert [d[1][4:13] for d in back.las.extra_bytes[:3]] == [b"NormalX\0\0", b"NormalY\0\0",
@@ -198,7 +238,16 @@ def test_new_file_and_normals_as_extra_bytes(tmp_path):
     f = pcl_ddg.read(fresh)
     assert f.las.version == (1, 4) and f.las.point_format == 6
     np.testing.assert_array_equal(f.fields["intensity"], m.fields["intensity"])
-    np.testing.assert_allclose(f.points, m.points, rtol=0, atol=np.max(f.las.scale))
+    # docs/las.md: per axis a power of ten scale that holds the extent in 10^9 steps, an offset
+    # below the minimum; every coordinate is then the nearest step (half a step away at most)
+    extent = m.points.max(axis=0) - m.points.min(axis=0)
+    assert np.all(extent > 1.0)  # test1_4: 501 x 5.3 x 6.3 units
+    step = 10.0 ** np.ceil(np.log10(extent / 1e9))  # 1e-6, 1e-8, 1e-8
+    np.testing.assert_allclose(f.las.scale, step, rtol=1e-12)
+    assert np.all(np.array(f.las.offset) <= m.points.min(axis=0))
+    rounding = np.spacing(np.abs(m.points).max(axis=0))  # X * scale + offset in double
+    error = np.abs(f.points - m.points).max(axis=0)
+    assert np.all(error <= 0.5 * step + 4 * rounding), (error, step)
 
 
 def test_a_new_las_file_warns_that_it_carries_no_vlr_of_the_input(tmp_path):

@@ -14,6 +14,7 @@
 
 #include "laplacian_flow.h"
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/mesh/local_cloud.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/surface/inner_ball.h"
 
@@ -170,11 +171,15 @@ double surfaceArea(const MeshTopology& topology, const PositionsRef& positions) 
   return area;
 }
 
-Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
-                                     const Eigen::Matrix3Xd& positions,
+Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology, const Eigen::Matrix3Xd& world,
                                      const MeshSmoothingParameters& p, MeshSmoothingReport* report,
                                      const SmoothingProgress& progress) {
   const int n = topology.numVertices();
+  if (world.cols() == n) requireFinite(world);
+  // The flow moves the positions about the mesh's local origin (mesh/local_cloud.h; exact):
+  // far from the origin the solves' residuals would be relative to |x|, not to the mesh's size.
+  const Eigen::Vector3d origin = localOrigin(world);
+  const Eigen::Matrix3Xd positions = world.colwise() - origin;
   if (n == 0 || topology.numTriangles() == 0) throw InvalidMeshException("mesh has no triangles");
   if (positions.cols() != n) throw InvalidMeshException("positions do not match the mesh");
   requireFinite(positions);
@@ -288,7 +293,7 @@ Eigen::Matrix3Xd smoothMeshPositions(const MeshTopology& topology,
     if (closed) r.volume_after = enclosedVolume(topology, current);
     *report = r;
   }
-  return current;
+  return current.colwise() + origin;
 }
 
 void MeshSmoothing::process(pcl::PolygonMesh& output) {

@@ -16,7 +16,7 @@
 #include <pcl/search/kdtree.h>
 
 #include "estimator_support.h"
-#include "pcl_ddg/features/local_cloud.h"
+#include "pcl_ddg/mesh/local_cloud.h"
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/tiling/tiled_local_fit.h"
 

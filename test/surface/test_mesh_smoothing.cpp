@@ -246,6 +246,31 @@ TEST(MeshSmoothing, VolumeAndAreaArePreservedWhenAsked) {
   EXPECT_NEAR(enclosedVolume(topology, kept_far) / enclosedVolume(topology, far), 1.0, 1e-9);
 }
 
+// About the mesh's local origin (mesh/local_cloud.h): a noisy sphere of radius 1 at a survey's
+// place, on a 2^-20 grid so that the move is exact, smooths to the sphere smoothed at the origin,
+// moved, but for the rounding of the result to doubles near 5e6 (half their spacing, 4.7e-10).
+// In the world's coordinates every step's residuals were relative to 5e6, and grew with the steps.
+TEST(MeshSmoothing, AMeshFarFromTheOriginSmoothsAsAtTheOrigin) {
+  const SurfaceSample sphere = makeIcosphere(3);
+  const MeshTopology topology = topologyOf(sphere);
+  const Eigen::Matrix3Xd noisy = noisySphere(sphere, 0.1, 5).unaryExpr([](double v) {
+    return std::round(v * 1048576.0) / 1048576.0;
+  });
+  const Eigen::Vector3d offset(5e5, 5e6, 200.0);
+  const Eigen::Matrix3Xd far = noisy.colwise() + offset;
+  const double rounding = 0.5 * std::nextafter(5e6, 1e7) - 0.5 * 5e6;
+  for (const SmoothingScheme scheme : {SmoothingScheme::Implicit, SmoothingScheme::Explicit}) {
+    MeshSmoothingParameters p;
+    p.scheme = scheme;
+    p.time_step = (scheme == SmoothingScheme::Implicit ? 0.2 : 0.02) * squaredEdge(topology, noisy);
+    p.iterations = 20;
+    p.weight_update = WeightUpdate::EveryIteration;
+    const Eigen::Matrix3Xd here = smoothMeshPositions(topology, noisy, p);
+    const Eigen::Matrix3Xd there = smoothMeshPositions(topology, far, p);
+    EXPECT_LE((there - (here.colwise() + offset)).cwiseAbs().maxCoeff(), 1.01 * rounding);
+  }
+}
+
 TEST(MeshSmoothing, APlaneStaysAPlane) {
   SurfaceSample plane = makePlane({16, 0.2, 5});
   plane.rotateAndShiftFar();

@@ -1,4 +1,4 @@
-#include "pcl_ddg/features/local_cloud.h"
+#include "pcl_ddg/mesh/local_cloud.h"
 
 #include <pcl/exceptions.h>
 
