@@ -250,7 +250,7 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
       (*cloud)[i].z = p[3 * i + 2];
     }
     LocalCloud local(cloud);
-    local.positions = std::make_shared<const Eigen::Matrix3Xd>(
+    local.positions = std::make_shared<Eigen::Matrix3Xd>(
         Eigen::Map<const Eigen::Matrix3Xd>(exact.data(), 3, static_cast<Eigen::Index>(m)));
     local.origin = Eigen::Vector3d(local_origin[0], local_origin[1], local_origin[2]);
     for (std::size_t j = 0; j < n_own; ++j) {

@@ -15,6 +15,11 @@
 #   --report FILE   also write the result table (Markdown) to FILE
 #   --keep          keep the scratch folder (source copy, build, logs) and print where it is
 #   --reuse DIR     use the scratch folder a --keep run left (its build is updated incrementally)
+#   --in-place DIR  no copy: mutate the repository itself and rebuild DIR (a configured, built
+#                   Release build of it, tests and tools ON) incrementally; each file is restored
+#                   after its mutant, and DIR's targets are rebuilt unmutated at the end (CI)
+#   --pick N        run N mutants chosen from the commit hash (git rev-parse HEAD) among the
+#                   selected ones: each commit checks another pair, the same pair on every rerun
 #
 # How it runs:
 #   1. The source tree (`git ls-files`: tracked and untracked-not-ignored files, with their
@@ -33,6 +38,10 @@
 #      is then restored.
 #   5. A table (id, file:line, description, result, seconds, what caught it) and the totals.
 #
+# A test is a test target of test/CMakeLists.txt, or pytest:PATH[::NAME] (a pytest file or case,
+# from the repository root) for the Python module and the Dask runner: it rebuilds the module and
+# the tools and runs pytest on the copy with the build's module, tools and the shared data.
+#
 # Exit status: 0 when every mutant was killed and the baseline passed; 1 when a mutant survived or
 # is an ERROR, or the baseline had failures; 2 on a usage or setup error (configure or build of the
 # unmutated tree failed).
@@ -47,6 +56,8 @@ list=$here/mutants.txt
 jobs=$(nproc 2>/dev/null || echo 2)
 check_only=0
 all_tests=0
+in_place=""
+pick=0
 timeout_override=""
 report=""
 keep=0
@@ -67,6 +78,8 @@ while (($#)); do
     --report) [[ $# -ge 2 ]] || die "--report needs a file"; report=$2; shift 2 ;;
     --keep) keep=1; shift ;;
     --reuse) [[ $# -ge 2 ]] || die "--reuse needs a folder"; reuse=$2; keep=1; shift 2 ;;
+    --in-place) [[ $# -ge 2 ]] || die "--in-place needs a build folder"; in_place=$2; shift 2 ;;
+    --pick) [[ $# -ge 2 && $2 =~ ^[1-9][0-9]*$ ]] || die "--pick needs a number"; pick=$2; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     -*) usage >&2; die "unknown option $1" ;;
     *) selected+=("$1"); shift ;;
@@ -128,6 +141,18 @@ if ((${#selected[@]})); then
 else
   selected=("${ids[@]}")
 fi
+if ((pick > 0)); then
+  # Distinct mutants at places given by successive 8-hex-digit windows of the commit hash.
+  hash=$(git -C "$repo" rev-parse HEAD 2>/dev/null) || die "--pick needs a git checkout"
+  pool=("${selected[@]}")
+  selected=()
+  for ((w = 0; ${#selected[@]} < pick && ${#pool[@]} > 0; w++)); do
+    at=$((16#${hash:$(((8 * w) % 33)):8} % ${#pool[@]}))
+    selected+=("${pool[$at]}")
+    pool=("${pool[@]:0:$at}" "${pool[@]:$((at + 1))}")
+  done
+  echo "== picked from commit ${hash:0:12}: ${selected[*]}"
+fi
 
 # Reads a file whole (every byte but NUL, trailing newlines included) into the variable named $2.
 read_whole() { IFS= read -r -d '' "$2" < "$1" || true; }
@@ -162,6 +187,12 @@ if ((check_only)); then
       problems=$((problems + 1))
     fi
     for t in ${m_tests[$id]}; do
+      if [[ $t == pytest:* ]]; then
+        path=${t#pytest:}
+        [[ -f $repo/${path%%::*} ]] || {
+          echo "$id: $t names no pytest file"; problems=$((problems + 1)); }
+        continue
+      fi
       grep -qx "$t" <<< "$known_targets" || {
         echo "$id: $t is not a test target of test/CMakeLists.txt"; problems=$((problems + 1)); }
     done
@@ -181,6 +212,11 @@ else
   scratch=$(mktemp -d "${TMPDIR:-/tmp}/pcl_ddg_mutants.XXXXXX") || die "mktemp failed"
 fi
 src=$scratch/src build=$scratch/build logs=$scratch/logs
+if [[ -n $in_place ]]; then
+  src=$repo
+  build=$(realpath "$in_place") || die "no build folder $in_place"
+  [[ -f $build/CMakeCache.txt ]] || die "$build is not a configured build"
+fi
 mkdir -p "$src" "$logs" "$scratch/tmp"
 
 current_file=""   # the file a mutant is applied to, restored by restore_current
@@ -193,6 +229,12 @@ restore_current() {
 }
 cleanup() {
   restore_current
+  if [[ -n $in_place && -s $scratch/rebuild ]]; then
+    # The mutated targets, built again from the restored sources.
+    # shellcheck disable=SC2046
+    cmake --build "$build" -j"$jobs" --target $(sort -u "$scratch/rebuild") > "$logs/restore.log" 2>&1 ||
+      echo "run_mutants: rebuilding $build after the mutants failed (log: $logs/restore.log)" >&2
+  fi
   if ((keep)); then
     echo "run_mutants: scratch folder kept: $scratch (reuse it with --reuse $scratch)" >&2
   else
@@ -203,6 +245,13 @@ trap cleanup EXIT
 trap 'echo "run_mutants: interrupted" >&2; exit 130' INT TERM
 
 start_all=$SECONDS
+shared_data=${PCL_DDG_SHARED_DATA:-}
+if [[ -z $shared_data ]]; then
+  for candidate in "$repo/../shared/data" /work/shared/data; do
+    [[ -f $candidate/CATALOG.md ]] && { shared_data=$(realpath "$candidate"); break; }
+  done
+fi
+if [[ -z $in_place ]]; then
 echo "== copying the source tree ($repo) to $src"
 # Tracked files and untracked ones that are not ignored, as they are in the working tree; files
 # deleted in the working tree are skipped. Modification times are kept, so that a --reuse run
@@ -216,12 +265,6 @@ if [[ -f $scratch/touched ]]; then
   rm -f "$scratch/touched"
 fi
 
-shared_data=${PCL_DDG_SHARED_DATA:-}
-if [[ -z $shared_data ]]; then
-  for candidate in "$repo/../shared/data" /work/shared/data; do
-    [[ -f $candidate/CATALOG.md ]] && { shared_data=$(realpath "$candidate"); break; }
-  done
-fi
 generator=()
 if [[ ! -f $build/CMakeCache.txt ]] && command -v ninja > /dev/null; then generator=(-G Ninja); fi
 echo "== configuring $build (Release; tests and tools ON; benchmarks, fuzzers, viewer, examples OFF)"
@@ -235,6 +278,9 @@ build_start=$SECONDS
 cmake --build "$build" -j"$jobs" > "$logs/build.log" 2>&1 ||
   { tail -n 40 "$logs/build.log" >&2; die "the unmutated tree does not build (log: $logs/build.log)"; }
 echo "   built in $((SECONDS - build_start)) s"
+else
+  echo "== in place: $repo, built in $build"
+fi
 
 # ---- running tests -----------------------------------------------------------------------------
 export TMPDIR=$scratch/tmp GTEST_COLOR=no  # F23: the tests' scratch names are per name only
@@ -242,6 +288,21 @@ export TMPDIR=$scratch/tmp GTEST_COLOR=no  # F23: the tests' scratch names are p
 # run_program TARGET FILTER TIMEOUT LOG: sets run_rc, run_seconds and run_failed (what failed).
 run_program() {
   local target=$1 filter=$2 limit=$3 log=$4 start=$SECONDS args=()
+  if [[ $target == pytest:* ]]; then
+    (cd "$build" && PYTHONPATH=$build/python PCL_DDG_TOOLS_DIR=$build/tools \
+      PCL_DDG_SHARED_DATA=$shared_data PCL_DDG_BUNDLED_DATA_DIR=$src/data \
+      timeout -k 10 "$limit" /usr/bin/python3 -m pytest -q -x -p no:cacheprovider \
+      "$src/${target#pytest:}") > "$log" 2>&1
+    run_rc=$?
+    run_seconds=$((SECONDS - start))
+    run_failed=""
+    ((run_rc == 0)) && return
+    if ((run_rc == 124 || run_rc == 137)); then run_failed="timeout after ${limit} s"; return; fi
+    run_failed=$(grep -E '^(FAILED|ERROR) ' "$log" | sed -E 's/^(FAILED|ERROR) ([^ ]+).*/\2/' |
+      sed 's|.*/||' | sort -u | paste -sd' ' -)
+    [[ -n $run_failed ]] || run_failed="pytest exit status $run_rc"
+    return
+  fi
   [[ -n $filter ]] && args=("--gtest_filter=$filter")
   (cd "$build/test" && timeout -k 10 "$limit" "./$target" "${args[@]}") > "$log" 2>&1
   run_rc=$?
@@ -270,10 +331,29 @@ for id in "${selected[@]}"; do
     programs+=("$t")
   done
 done
+# The targets a test entry needs built: its program, or for pytest the module and the tools.
+targets_of() {
+  local t
+  for t in "$@"; do
+    if [[ $t == pytest:* ]]; then
+      echo pcl_ddg_python pcl_ddg_normals pcl_ddg_curvature pcl_ddg_info pcl_ddg_smooth
+    else
+      echo "$t"
+    fi
+  done | tr ' ' '\n' | sort -u
+}
+if [[ -n $in_place ]]; then
+  # The build may have been made for other test groups: build the programs the mutants name.
+  echo "== building the unmutated programs in $build"
+  # shellcheck disable=SC2046
+  cmake --build "$build" -j"$jobs" --target $(targets_of "${programs[@]}") > "$logs/build.log" 2>&1 ||
+    { tail -n 40 "$logs/build.log" >&2; die "building the test programs failed (log: $logs/build.log)"; }
+fi
 baseline_failures=0
 echo "== baseline: ${#programs[@]} unmutated test programs"
 for t in "${programs[@]}"; do
-  [[ -x $build/test/$t ]] || die "test program $t was not built (a target of test/CMakeLists.txt?)"
+  [[ $t == pytest:* || -x $build/test/$t ]] ||
+    die "test program $t was not built (a target of test/CMakeLists.txt?)"
   run_program "$t" "" "${timeout_override:-1800}" "$logs/baseline_$t.log"
   baseline_seconds[$t]=$run_seconds
   if ((run_rc != 0)); then
@@ -313,7 +393,9 @@ for id in "${selected[@]}"; do
     log=$logs/$id.log
     : > "$log"
     # shellcheck disable=SC2086
-    if ! cmake --build "$build" -j"$jobs" --target ${m_tests[$id]} > "$logs/${id}_build.log" 2>&1; then
+    mapfile -t targets < <(targets_of ${m_tests[$id]})
+    [[ -n $in_place ]] && printf '%s\n' "${targets[@]}" >> "$scratch/rebuild"
+    if ! cmake --build "$build" -j"$jobs" --target "${targets[@]}" > "$logs/${id}_build.log" 2>&1; then
       r_result[$id]=ERROR r_by[$id]="does not build (log: ${id}_build.log)"
     else
       r_result[$id]=survived

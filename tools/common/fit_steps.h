@@ -54,10 +54,10 @@ std::vector<int> classesArgument(const ToolArguments& args);
 
 /**
  * With -classes: the points of other classes (by the input's `classification` field, as LAS
- * files have it) become NaN in input.points, so that they are neither fitted nor anyone's
- * neighbour, and every point is still written (NaN there). Prints how many are fitted; returns how
- * many were left out (to subtract from the fit's failures). Throws when the input has no
- * classification or no point of those classes.
+ * files have it) become NaN in input.local() (floats and doubles), so that they are neither fitted
+ * nor anyone's neighbour, and every point is still written (NaN there). Prints how many are fitted;
+ * returns how many were left out (to subtract from the fit's failures). Throws when the input has
+ * no classification or no point of those classes.
  */
 std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args, ToolInput& input);
 

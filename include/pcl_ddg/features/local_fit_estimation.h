@@ -142,8 +142,9 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
 
   /** The input's coordinates in double, column i for point i: the fits read them instead of the
    *  input's floats, in which the search method still looks (local_cloud.h: a cloud whose exact
-   *  coordinates are doubles, placed about a local origin). A point is used where its float point
-   *  is finite. Needs the search surface to be the input; null (the default): the floats. */
+   *  coordinates are doubles, placed about a local origin). A neighbour is used where its
+   *  position is finite (a point left out is NaN in both). Needs the search surface to be the
+   *  input; null (the default): the floats. */
   void setInputPositions(std::shared_ptr<const Eigen::Matrix3Xd> positions) {
     input_positions_ = std::move(positions);
   }

@@ -40,8 +40,8 @@ Eigen::Vector3d localOrigin(const PositionsRef& positions);
 Eigen::Vector3d localOrigin(const Eigen::AlignedBox3d& bounds);
 
 /** A cloud relative to its local origin: float points for the searches, and the same points in
- *  double, relative to the same origin, for the fits. A point takes part where its float point
- *  is finite (a NaN there leaves it out, whatever its double). */
+ *  double, relative to the same origin, for the fits. A point is left out where its coordinates
+ *  are NaN, in both (the searches skip its float, the fits its double). */
 struct LocalCloud {
   LocalCloud() = default;
   /** A float cloud as it is (origin 0, the fits read its floats): a PCL user's cloud. */
@@ -52,7 +52,7 @@ struct LocalCloud {
 
   pcl::PointCloud<pcl::PointXYZ>::ConstPtr points;  ///< positions as float (NaN kept)
   /** World coordinates minus origin, column i for point i; null: the floats are exact. */
-  std::shared_ptr<const Eigen::Matrix3Xd> positions;
+  std::shared_ptr<Eigen::Matrix3Xd> positions;
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< in world coordinates
 };
 

@@ -69,11 +69,17 @@ FitCounts fitNeighbourhoods(const NeighbourhoodQueries<PointInT>& queries,
       if (local.cols() < found) local.resize(3, found);
       finite_neighbours.resize(std::max(found, 0));
       int count = 0;
+      // The neighbours' columns are scattered over the positions: ask for all of them at once.
+      if (queries.positions)
+        for (int n = 0; n < found; ++n)
+          __builtin_prefetch(queries.positions->col(neighbours[n]).data());
       for (int n = 0; n < found; ++n) {
         const pcl::index_t j = neighbours[n];
-        if (pcl::isXYZFinite(surface[j])) {
+        // With exact positions their NaN marks a point left out: one read per neighbour.
+        const Eigen::Vector3d p = position(j);
+        if (queries.positions ? p.allFinite() : pcl::isXYZFinite(surface[j])) {
           finite_neighbours[count] = j;
-          local.col(count++) = position(j) - origin;
+          local.col(count++) = p - origin;
         }
       }
       const FitOutcome outcome =
