@@ -17,17 +17,19 @@ Eigen::Vector3d localOrigin(const PositionsRef& positions) {
 
 Eigen::Vector3d localOrigin(const Eigen::AlignedBox3d& bounds) {
   if (bounds.isEmpty()) return Eigen::Vector3d::Zero();
-  const Eigen::Vector3d& low = bounds.min();
-  const Eigen::Vector3d& high = bounds.max();
-  const double side = (high - low).maxCoeff();
-  // Halves, not (low + high) / 2: the sum of two coordinates near DBL_MAX would overflow.
-  const Eigen::Vector3d centre = low / 2 + high / 2;
-  if (side == 0.0) return centre;  // one place: x - centre is 0, exactly
-  const double step = std::exp2(std::ceil(std::log2(side)));
   Eigen::Vector3d origin;
   for (int d = 0; d < 3; ++d) {
-    const bool near_zero = low[d] < step && high[d] > -step;
-    origin[d] = near_zero ? 0.0 : std::round(centre[d] / step) * step;
+    const double low = bounds.min()[d], high = bounds.max()[d];
+    // Halves, not (low + high) / 2: the sum of two coordinates near DBL_MAX would overflow.
+    const double centre = low / 2 + high / 2;
+    const double side = high - low;
+    if (side == 0.0) {  // one place along this axis: x - centre is 0, exactly
+      origin[d] = centre;
+      continue;
+    }
+    const double step = std::exp2(std::ceil(std::log2(side)));
+    const bool near_zero = low < step && high > -step;
+    origin[d] = near_zero ? 0.0 : std::round(centre / step) * step;
   }
   return origin;
 }
@@ -46,6 +48,13 @@ LocalCloud makeLocalCloud(const PositionsRef& positions, const Eigen::Vector3d& 
     (*points)[i].getVector3fMap() = p.cast<float>();
   }
   points->is_dense = relative->allFinite();
+  // Floats that hold the positions exactly (a float file's, data near the origin) are what the
+  // fits read: the doubles would only cost memory and a second read per neighbour.
+  bool exact = true;
+  for (Eigen::Index i = 0; i < relative->cols() && exact; ++i)
+    exact = relative->col(i).cast<float>().cast<double>() == relative->col(i) ||
+            !relative->col(i).allFinite();
+  if (exact) relative.reset();
   if (width > 0) {
     if (points->size() % width != 0)
       throw pcl::BadArgumentException("an organized cloud's rows must hold all of its points");

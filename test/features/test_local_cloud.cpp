@@ -16,8 +16,8 @@
 #include <pcl/search/kdtree.h>
 
 #include "estimator_support.h"
-#include "pcl_ddg/mesh/local_cloud.h"
 #include "pcl_ddg/features/local_fit.h"
+#include "pcl_ddg/mesh/local_cloud.h"
 #include "pcl_ddg/tiling/tiled_local_fit.h"
 
 namespace pcl_ddg {
@@ -93,10 +93,12 @@ std::vector<bool> nearTies(const Eigen::Matrix3Xd& points, int k) {
   return tied;
 }
 
-TEST(LocalOrigin, StaysAtZeroForDataAroundTheOrigin) {
+TEST(LocalOrigin, StaysAtZeroAlongAxesTheDataSpansAroundTheOrigin) {
   Eigen::Matrix3Xd p(3, 2);
   p << -1.0, 3.0, 0.5, 1.5, 2.0, 2.5;
-  EXPECT_EQ(localOrigin(p), Eigen::Vector3d::Zero());
+  // x spans 0, y comes within its side (1) of 0; z (2 to 2.5, a side of 0.5) lies 4 sides away:
+  // its centre 2.25 rounds to a multiple of 0.5.
+  EXPECT_EQ(localOrigin(p), Eigen::Vector3d(0.0, 0.0, 2.5));
   EXPECT_EQ(localOrigin(Eigen::Matrix3Xd(3, 0)), Eigen::Vector3d::Zero());
   Eigen::Matrix3Xd nan = Eigen::Matrix3Xd::Constant(3, 2, std::numeric_limits<double>::quiet_NaN());
   EXPECT_EQ(localOrigin(nan), Eigen::Vector3d::Zero());
@@ -108,12 +110,20 @@ TEST(LocalOrigin, IsAMultipleOfThePowerOfTwoAboveTheExtentNearTheCentre) {
   p.col(1) = kSurveyOffset + Eigen::Vector3d(300.0, 200.0, 50.0);
   p.col(2) = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   const Eigen::Vector3d o = localOrigin(p);
-  const double step = 512.0;  // the smallest power of two not below the side, 300
-  EXPECT_EQ(std::fmod(o.x(), step), 0.0);
-  EXPECT_EQ(std::fmod(o.y(), step), 0.0);
-  EXPECT_LE(std::abs(o.x() - (kSurveyOffset.x() + 150.0)), step / 2);
-  EXPECT_LE(std::abs(o.y() - (kSurveyOffset.y() + 100.0)), step / 2);
-  EXPECT_EQ(o.z(), 0.0);  // z from 200 to 250 comes within 512 of 0
+  // The smallest powers of two not below the sides 300, 200 and 50.
+  EXPECT_EQ(std::fmod(o.x(), 512.0), 0.0);
+  EXPECT_EQ(std::fmod(o.y(), 256.0), 0.0);
+  EXPECT_EQ(o.z(), 256.0);  // 225 rounded to a multiple of 64
+  EXPECT_LE(std::abs(o.x() - (kSurveyOffset.x() + 150.0)), 256.0);
+  EXPECT_LE(std::abs(o.y() - (kSurveyOffset.y() + 100.0)), 128.0);
+  // Longitude and latitude (a side of 0.01 degree) beside heights in metres (a side of 100): each
+  // axis is centred on its own scale, so the floats resolve the degrees too.
+  Eigen::Matrix3Xd geographic(3, 2);
+  geographic << -123.075, -123.065, 44.05, 44.06, 120.0, 220.0;
+  const Eigen::Vector3d g = localOrigin(geographic);
+  EXPECT_LE(std::abs(g.x() + 123.07), 1.0 / 128);
+  EXPECT_LE(std::abs(g.y() - 44.055), 1.0 / 128);
+  EXPECT_EQ(g.z(), 0.0);  // 120 lies within 128 of 0
   // One place: the origin is the place.
   Eigen::Matrix3Xd one(3, 1);
   one.col(0) = kSurveyOffset;
@@ -125,23 +135,37 @@ TEST(LocalCloud, PositionsAreTheExactDifferencesAndTheFloatsRoundByAFractionOfTh
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (const double side : {1e-3, 0.7, 123.0, 4096.0, 3e5}) {
     Eigen::Matrix3Xd p(3, 2000);
+    const Eigen::Vector3d sides(side, 0.01 * side, side);  // one axis a hundred times thinner
     for (Eigen::Index i = 0; i < p.cols(); ++i)
-      for (int d = 0; d < 3; ++d) p(d, i) = (d == 1 ? 4.3e6 : 6.8e5) + side * u(random);
+      for (int d = 0; d < 3; ++d) p(d, i) = (d == 1 ? 4.3e6 : 6.8e5) + sides[d] * u(random);
     const LocalCloud local = makeLocalCloud(p);
-    ASSERT_TRUE(local.positions);
-    double worst = 0.0;
+    Eigen::Vector3d worst = Eigen::Vector3d::Zero();
     for (Eigen::Index i = 0; i < p.cols(); ++i) {
       for (int d = 0; d < 3; ++d) {
+        const double fitted = local.positions ? (*local.positions)(d, i)
+                                              : static_cast<double>((*local.points)[i].data[d]);
         const long double exact =
             static_cast<long double>(p(d, i)) - static_cast<long double>(local.origin[d]);
-        EXPECT_EQ(static_cast<long double>((*local.positions)(d, i)), exact);
-        EXPECT_EQ((*local.positions)(d, i) + local.origin[d], p(d, i));
-        worst = std::max(worst, std::abs(static_cast<double>((*local.points)[i].data[d]) -
-                                         (*local.positions)(d, i)));
+        EXPECT_EQ(static_cast<long double>(fitted), exact);
+        EXPECT_EQ(fitted + local.origin[d], p(d, i));
+        worst[d] =
+            std::max(worst[d], std::abs(static_cast<double>((*local.points)[i].data[d]) - fitted));
       }
     }
-    EXPECT_LE(worst, 2.4e-7 * side) << "side " << side;
+    for (int d = 0; d < 3; ++d) EXPECT_LE(worst[d], 2.4e-7 * sides[d]) << "side " << sides[d];
   }
+}
+
+// A float file's coordinates (or any the floats hold exactly about the origin) need no doubles:
+// the fits read the floats, as they read a PCL user's float cloud.
+TEST(LocalCloud, KeepsTheDoublesOnlyWhereTheFloatsRoundThem) {
+  Eigen::Matrix3Xd p(3, 3);
+  p << 0.5, 1.25, -3.0, 1e5, 2.0, 0.125, 7.0, 8.0, 9.0;
+  EXPECT_FALSE(makeLocalCloud(p).positions);
+  p(0, 0) = 0.1;  // not a float
+  const LocalCloud local = makeLocalCloud(p);
+  ASSERT_TRUE(local.positions);
+  EXPECT_EQ((*local.positions)(0, 0) + local.origin.x(), 0.1);
 }
 
 LocalFitOptions kdTree(LocalFitMethod method, int k) {

@@ -306,7 +306,8 @@ std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args, T
       continue;
     pcl::PointXYZ& p = (*input.points())[static_cast<std::size_t>(i)];
     p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
-    input.local().positions->col(i).setConstant(std::numeric_limits<double>::quiet_NaN());
+    if (input.local().positions)
+      input.local().positions->col(i).setConstant(std::numeric_limits<double>::quiet_NaN());
     ++left_out;
   }
   const std::int64_t fitted = classification.size() - left_out;

@@ -5,16 +5,17 @@
  * double, so that survey coordinates millions of units from the origin are never rounded to float
  * before they are centred.
  *
- * The rule, the same for a whole cloud, a tile and a piece: with P the smallest power of two not
- * below the longest side of the bounding box of the whole input's finite points, the origin o is,
- * on each axis, the box's centre rounded to a multiple of P, or 0 where the box comes within P of
- * 0 on that axis (data around the origin stays where it is). Two things follow:
+ * The rule, the same for a whole cloud, a tile and a piece: on each axis, with P the smallest
+ * power of two not below the side of the bounding box of the whole input's finite points along
+ * it, the origin is the box's centre rounded to a multiple of P, or 0 where the box comes within
+ * P of 0 (data around the origin stays where it is). Two things follow:
  * - x - o is exact in double for every coordinate x of the box (where o != 0, |x| >= P while
  *   |x - o| <= P and o is a multiple of P), so the positions relative to o are the input's own
  *   values, and every difference the fits form is the one of the input's coordinates;
- * - |x - o| < 2 P < 4 times the box's side: the float points the searches look in (PCL's kd-tree,
- *   the pixel grid) round by at most about 2.4e-7 of the data's extent, not of its distance from
- *   the origin.
+ * - |x - o| < 2 P < 4 times the box's side along that axis: the float points the searches look
+ *   in (PCL's kd-tree, the pixel grid) round by at most about 2.4e-7 of the data's extent along
+ *   each axis (geographic longitudes and latitudes beside heights in metres included), not of its
+ *   distance from the origin.
  * Normals and curvatures do not depend on where the data sits: a cloud moved by any vector gives
  * the same results, to the last bit wherever the k-th neighbour is not tied with the next (the
  * float distances the search compares may round differently).
@@ -58,7 +59,8 @@ struct LocalCloud {
 
 /** positions (world coordinates) relative to origin, and their float points (NaN kept; is_dense
  *  when all are finite), organized width points per row when width > 0 (it must divide their
- *  number). */
+ *  number). The doubles are kept only where the floats do not hold them exactly (a float file's
+ *  coordinates near the origin need none). */
 LocalCloud makeLocalCloud(const PositionsRef& positions, const Eigen::Vector3d& origin,
                           std::uint32_t width = 0);
 
