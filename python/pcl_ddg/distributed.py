@@ -434,6 +434,42 @@ def _write_atomic(path: str, data: bytes) -> None:
     os.replace(temporary, path)
 
 
+def _file_digest(path: str) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def project_version() -> str:
+    """The project's version, ``pcl_ddg.__version__`` (the CMake project's), read at every run."""
+    from . import __version__
+
+    return str(__version__)
+
+
+def _code_identity() -> Dict[str, str]:
+    """What computes the tiles: the project version, and the compiled module's SHA-256 (a rebuild
+    that keeps the version number still changes results)."""
+    module = getattr(_pcl_ddg, "__file__", None)
+    return {"version": project_version(),
+            "module_sha256": _file_digest(module) if module else ""}
+
+
+def _file_state(path: str) -> Dict[str, Any]:
+    """An input as stat sees it: real path, size, and modification and change times in ns. The
+    change time cannot be set back (touch -d, os.utime and cp -p set only mtime), so a rewrite
+    that keeps the size and restores mtime still shows here."""
+    st = os.stat(path)
+    return {"path": os.path.realpath(path), "size": st.st_size, "mtime_ns": st.st_mtime_ns,
+            "ctime_ns": st.st_ctime_ns}
+
+
+def _same_file_state(recorded: Any, now: Dict[str, Any]) -> bool:
+    return isinstance(recorded, dict) and all(recorded.get(k) == v for k, v in now.items())
+
+
 def _tile_paths(state: str, tile: int) -> Tuple[str, str]:
     base = os.path.join(state, "tiles", f"tile_{tile:06d}")
     return base + ".bin", base + ".sha256"
@@ -452,6 +488,27 @@ def tile_complete(state: str, tile: int) -> bool:
     return digest == expected.get("sha256")
 
 
+def _drop_tile(state: str, tile: int) -> None:
+    for path in _tile_paths(state, tile):
+        try:
+            os.remove(path)
+        except FileNotFoundError:
+            pass
+
+
+def _tiles_reading(state: str, tiles: Sequence[int], boxes: Sequence[Sequence[float]]) -> List[int]:
+    """The finished tiles whose gathers met one of these boxes (or that do not say where they
+    gathered): a tile's results depend on the points inside its gather boxes alone."""
+    hit = []
+    for t in tiles:
+        record = _read_json(_tile_paths(state, t)[1])
+        gathered = record.get("boxes") if isinstance(record, dict) else None
+        if not isinstance(gathered, list) or any(
+                _intersects(np.array(g[:3]), np.array(g[3:]), b) for g in gathered for b in boxes):
+            hit.append(t)
+    return hit
+
+
 def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options: Dict[str, Any],
              state: str) -> Dict[str, Any]:
     """One tile on a worker: gather, certify, widen, fit; results written atomically."""
@@ -467,6 +524,9 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
     radius = options["radius"]
     halo = radius * (1.0 + 1e-5) if radius > 0 else plan.halo_guess
     growths = 0
+    # Every box gathered from, kept with the results: a later run with a changed input redoes
+    # only the tiles whose boxes meet that input's chunks.
+    boxes = [[float(v) for v in (*(core_lo - halo), *(core_hi + halo))]]
     xyz, exact, index, own = _gather(plan, paths, firsts, core_lo - halo, core_hi + halo, tile)
     largest = len(xyz)
     results_index = [np.zeros(0, np.int64)]
@@ -490,6 +550,7 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
                 halo = 1.05 * p99 if np.isfinite(p99) else 2 * halo + float(
                     np.linalg.norm(core_hi - core_lo))
                 growths += 1
+                boxes.append([float(v) for v in (*(core_lo - halo), *(core_hi + halo))])
                 del xyz, exact, index, own, rec
                 xyz, exact, index, own = _gather(plan, paths, firsts, core_lo - halo,
                                                  core_hi + halo, tile)
@@ -513,6 +574,7 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
             a_lo, a_hi = np.maximum(a_lo, b[:3] - 1.0), np.minimum(a_hi, b[3:] + 1.0)
             far_index = index[far]
             del xyz, exact, own
+            boxes.append([float(v) for v in (*a_lo, *a_hi)])
             xyz2, exact2, index2, _ = _gather(plan, paths, firsts, a_lo, a_hi, -1)
             largest = max(largest, len(xyz2))
             positions = np.searchsorted(index2, far_index)
@@ -532,7 +594,8 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
     data_path, check_path = _tile_paths(state, tile)
     _write_atomic(data_path, payload)
     _write_atomic(check_path, json.dumps({"sha256": hashlib.sha256(payload).hexdigest(),
-                                          "points": int(len(gi)), "floats": floats}).encode())
+                                          "points": int(len(gi)), "floats": floats,
+                                          "boxes": boxes}).encode())
     return {"tile": tile, "points": int(len(gi)), "gathered": int(largest), "halo": float(halo),
             "halo_growths": growths, "far_points": int(far_count), "failed": int(failed),
             "fallback": int(fallback), "peak_bytes": _peak_bytes(), "pid": os.getpid(),
@@ -716,16 +779,27 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
         outputs = [merge]
     os.makedirs(output_dir, exist_ok=True)
     state = os.path.join(output_dir, STATE_FOLDER, tool)
-    config = {"tool": tool, "options": options, "precision": precision, "memory": memory,
-              "inputs": [(c.path, os.path.getsize(c.path), os.path.getmtime(c.path))
-                         for c in clouds]}
     config_path = os.path.join(state, "run.json")
-    previous = _read_json(config_path)
-    if previous != json.loads(json.dumps(config)) or not resume:
+    # What every tile's results depend on: the tool, the options that change them (not the
+    # threads, memory, precision or outputs: the outputs are written again on every run), the
+    # code, and the inputs in order with their point counts (which place each point in the merged
+    # cloud). A change of any of them starts afresh; a changed input's content alone redoes only
+    # the tiles that read it (below).
+    identity = json.loads(json.dumps({
+        "tool": tool, "options": {k: v for k, v in options.items() if k != "threads"},
+        **_code_identity(), "inputs": [[os.path.realpath(c.path), c.points] for c in clouds]}))
+    previous = _read_json(config_path) if resume else None
+    recorded = previous.get("files") if isinstance(previous, dict) else None
+    fresh = not isinstance(recorded, list) or len(recorded) != len(clouds) or \
+        previous.get("identity") != identity
+    if fresh:
         shutil.rmtree(state, ignore_errors=True)
+        recorded = [None] * len(clouds)
+    recorded = [r if isinstance(r, dict) else None for r in recorded]
+    # Stat before any read, so that a write during the run shows at the next one.
+    files_now = [_file_state(c.path) for c in clouds]
     for sub in ("tiles", "attempts"):
         os.makedirs(os.path.join(state, sub), exist_ok=True)
-    _write_atomic(config_path, json.dumps(config).encode())
 
     own_client = client is None
     if own_client:
@@ -754,16 +828,38 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
             raise ValueError(f"--memory-per-worker {memory_per_worker} leaves no room for a tile "
                              f"(the workers hold {resident >> 20}M before any point)")
         started = time.perf_counter()
+        # An input whose stat differs from the record (every input on a fresh start) is hashed
+        # by a worker while the others measure the chunks: its content decides, not its times.
+        to_hash = [i for i, now in enumerate(files_now) if not _same_file_state(recorded[i], now)]
+        hashing = client.map(_file_digest, [clouds[i].path for i in to_hash], pure=False,
+                             key=[f"pcl_ddg-sha256-{uuid.uuid4().hex[:8]}-{i}" for i in to_hash])
         plan = make_plan(client, clouds, points_per_tile, options)
+        digests = dict(zip(to_hash, client.gather(hashing)))
+        changed = [i for i in to_hash if (recorded[i] or {}).get("sha256") != digests[i]]
         seconds_plan = time.perf_counter() - started
         described = json.loads(json.dumps({
             "origin": plan.origin, "lo": plan.lo, "hi": plan.hi, "dims": plan.dims, "tiles": plan.tiles,
             "points_per_tile": plan.points_per_tile, "halo_guess": plan.halo_guess}))
-        same_plan = _read_json(plan_path) == described
-        if not same_plan:  # tiles of another plan are not this one's
+        chunks = json.loads(json.dumps(plan.chunks))
+        previous_plan = _read_json(plan_path)
+        previous_chunks = previous_plan.pop("chunks", None) \
+            if isinstance(previous_plan, dict) else None
+        if previous_plan != described:  # tiles of another plan are not this one's
             shutil.rmtree(os.path.join(state, "tiles"), ignore_errors=True)
             os.makedirs(os.path.join(state, "tiles"))
-        _write_atomic(plan_path, json.dumps(described).encode())
+        elif changed:
+            # A changed input's points, where they were and where they are now: the tiles that
+            # gathered, or would now gather, from its chunks' boxes are redone.
+            boxes = [c[3] for c in chunks + (previous_chunks or []) if c[0] in changed]
+            stale = plan.tiles if not isinstance(previous_chunks, list) else \
+                _tiles_reading(state, plan.tiles, boxes)
+            for t in stale:
+                _drop_tile(state, t)
+        _write_atomic(plan_path, json.dumps({**described, "chunks": chunks}).encode())
+        # The inputs as they are now, recorded once the tiles they invalidate are gone.
+        files = [{**now, "sha256": digests[i] if i in digests else recorded[i].get("sha256")}
+                 for i, now in enumerate(files_now)]
+        _write_atomic(config_path, json.dumps({"identity": identity, "files": files}).encode())
         todo = [t for t in plan.tiles if not (resume and tile_complete(state, t))]
         skipped = len(plan.tiles) - len(todo)
         before = set(os.listdir(os.path.join(state, "attempts")))
@@ -838,6 +934,7 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
         "points": total, "finite_points": plan.finite_points, "tiles": len(plan.tiles),
         "orientation": options["orient"] + (" (a LAS input's default)" if las_up else ""),
         "tiles_run": len(tiles), "tiles_skipped": skipped,
+        "inputs_hashed": len(to_hash), "inputs_changed": len(changed),
         "retries": max(0, len(attempts) - len(tiles)), "seconds": seconds,
         "points_per_second": computed / seconds if seconds > 0 else 0.0,
         "halo_growths": sum(r["halo_growths"] for r in tiles),
@@ -860,11 +957,14 @@ def estimate_normals(inputs, output_dir, client=None, **options) -> Dict[str, An
     options: method ("pca"|"quadric"), k, radius, max_nn, viewpoint, orient ("viewpoint"|"up"),
     up, precision ("float"|"double"), merge (one output file) or one file per input in
     output_dir (``output_format`` "ply"|"pcd"|"las" to change it), memory_per_worker ("2G"), retries
-    (3), resume (True: tiles whose results and checksum are complete are skipped),
+    (3), resume (True: the tiles of an earlier run of the same tool, options, code and inputs whose
+    results match their checksum are skipped; docs/distributed.md, "Resume"),
     threads_per_worker (1), progress (False: a progress line on stderr).
 
-    Returns a summary: points, tiles, tiles_run, tiles_skipped, retries, seconds,
-    points_per_second, halo_growths, far_points, worker_peak_bytes, outputs, dashboard.
+    Returns a summary: points, tiles, tiles_run, tiles_skipped, inputs_hashed (inputs whose stat
+    differed from the state's record, or all on a fresh start), inputs_changed (those of them
+    whose content differed), retries, seconds, points_per_second, halo_growths, far_points,
+    worker_peak_bytes, outputs, dashboard.
     """
     return _run("normals", inputs, output_dir, client, **options)
 
@@ -895,26 +995,48 @@ def find_tool(name: str) -> str:
     return found
 
 
-def _file_digest(path: str) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for block in iter(lambda: f.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
+def _batch_identity(executable: str, arguments: Sequence[str]) -> Dict[str, Any]:
+    """What a batch output depends on besides its input: the tool (its name and its executable's
+    SHA-256: a rebuilt tool is another tool), its arguments and the project version."""
+    return {"tool": os.path.basename(executable), "tool_sha256": _file_digest(executable),
+            "arguments": [str(a) for a in arguments], "version": project_version()}
 
 
-def _batch_complete(output: str, check: str) -> bool:
+def _batch_complete(output: str, record: str, identity: Dict[str, Any], source: str) -> str:
+    """Whether an output is done, from its record (state folder, <output name>.json): "complete"
+    when the record names this tool, arguments and version, this input with the stat it has now,
+    and the output matches its checksum; "hash" when all but the input's stat match (its content
+    decides: the worker hashes it); else "run"."""
+    previous = _read_json(record)
     try:
-        with open(check) as f:
-            return json.load(f)["sha256"] == _file_digest(output)
-    except (OSError, ValueError, KeyError):
-        return False
+        if not isinstance(previous, dict) or \
+                any(previous.get(k) != v for k, v in identity.items()):
+            return "run"
+        recorded, now = previous["input"], _file_state(source)
+        if recorded["path"] != now["path"] or previous["output_sha256"] != _file_digest(output):
+            return "run"
+    except (OSError, KeyError, TypeError):
+        return "run"
+    return "complete" if _same_file_state(recorded, now) else "hash"
 
 
-def run_file(tool: str, arguments: List[str], source: str, output: str, check: str) -> Dict:
+def run_file(tool: str, arguments: List[str], source: str, output: str, record: str,
+             identity: Optional[Dict[str, Any]] = None, recheck: bool = False) -> Dict:
     """One file through the tool on a worker: the output under a temporary name, renamed when
-    complete, then its checksum."""
+    complete, then its record (identity, the input's stat and SHA-256, the output's SHA-256).
+    recheck: the input's stat changed but its record is otherwise complete; an input whose
+    content is the one recorded is not run again (skipped: True)."""
     start = time.perf_counter()
+    state = _file_state(source)  # before the read: a write during the run shows next time
+    digest = _file_digest(source)
+    if recheck:
+        previous = _read_json(record)
+        if isinstance(previous, dict) and isinstance(previous.get("input"), dict) and \
+                previous["input"].get("sha256") == digest:
+            _write_atomic(record, json.dumps({**previous, "input": {**state, "sha256": digest}})
+                          .encode())
+            return {"input": source, "output": output, "skipped": True,
+                    "seconds": time.perf_counter() - start, "peak_bytes": _peak_bytes()}
     folder, name = os.path.split(output)
     temporary = os.path.join(folder, f".{uuid.uuid4().hex[:8]}.partial.{name}")
     result = subprocess.run([tool, source, temporary, *arguments], capture_output=True,
@@ -924,9 +1046,13 @@ def run_file(tool: str, arguments: List[str], source: str, output: str, check: s
             os.remove(temporary)
         raise RuntimeError(f"{os.path.basename(tool)} {source}: {result.stderr.strip()}")
     os.replace(temporary, output)
-    _write_atomic(check, json.dumps({"sha256": _file_digest(output)}).encode())
-    return {"input": source, "output": output, "seconds": time.perf_counter() - start,
-            "peak_bytes": _peak_bytes()}
+    _write_atomic(record, json.dumps({**(identity or {}), "input": {**state, "sha256": digest},
+                                      "output_sha256": _file_digest(output)}).encode())
+    legacy = os.path.splitext(record)[0] + ".sha256"  # the record before issue 47: checksum only
+    if os.path.exists(legacy):
+        os.remove(legacy)
+    return {"input": source, "output": output, "skipped": False,
+            "seconds": time.perf_counter() - start, "peak_bytes": _peak_bytes()}
 
 
 def _batch_output_name(path: str) -> str:
@@ -944,7 +1070,9 @@ def batch(inputs, output_dir, tool: str, arguments: Sequence[str] = (), client=N
     """Runs the tool (``normals``, ``curvature``, ... or ``pcl_ddg_smooth``) on every input file
     (a cloud or a mesh; a folder gives all of its files the tools read) independently, one task
     each: OUTPUT_DIR/<input's name> equals the tool run on that file, written as .ply for a mesh
-    format the tools do not write (a.off gives a.ply)."""
+    format the tools do not write (a.off gives a.ply). resume: a file whose output was written
+    by the same tool (executable), arguments and version from the same input content, and is
+    intact, is skipped (docs/distributed.md, "Resume")."""
     stream = stream or sys.stderr
     start = time.perf_counter()
     executable = find_tool(tool)
@@ -959,14 +1087,16 @@ def batch(inputs, output_dir, tool: str, arguments: Sequence[str] = (), client=N
         written_by[n] = p
     state = os.path.join(output_dir, STATE_FOLDER, "batch")
     os.makedirs(state, exist_ok=True)
+    identity = json.loads(json.dumps(_batch_identity(executable, arguments)))
     jobs = []
     skipped = 0
     for p, n in zip(paths, names):
-        out, check = os.path.join(output_dir, n), os.path.join(state, n + ".sha256")
-        if resume and _batch_complete(out, check):
+        out, record = os.path.join(output_dir, n), os.path.join(state, n + ".json")
+        status = _batch_complete(out, record, identity, p) if resume else "run"
+        if status == "complete":
             skipped += 1
             continue
-        jobs.append((p, out, check))
+        jobs.append((p, out, record, status == "hash"))
     own_client = client is None
     if own_client:
         client = connect(scheduler, workers, 1, connect_timeout)
@@ -975,10 +1105,10 @@ def batch(inputs, output_dir, tool: str, arguments: Sequence[str] = (), client=N
         if progress:
             stream.write(f"pcl_ddg.distributed: dashboard {dashboard}\n")
         distributed = _import_distributed()
-        futures = [client.submit(run_file, executable, list(arguments), p, o, c,
-                                 retries=retries, pure=False,
+        futures = [client.submit(run_file, executable, list(arguments), p, o, r, identity,
+                                 recheck, retries=retries, pure=False,
                                  key=f"pcl_ddg-file-{i}-{uuid.uuid4().hex[:8]}")
-                   for i, (p, o, c) in enumerate(jobs)]
+                   for i, (p, o, r, recheck) in enumerate(jobs)]
         report = _Progress(len(jobs), 0, stream, progress, unit="files")
         done = []
         for future in distributed.as_completed(futures):
@@ -993,7 +1123,9 @@ def batch(inputs, output_dir, tool: str, arguments: Sequence[str] = (), client=N
             client.close()
             if cluster is not None:
                 cluster.close()
-    return {"files": len(paths), "files_run": len(done), "files_skipped": skipped,
+    rechecked = sum(1 for d in done if d["skipped"])
+    return {"files": len(paths), "files_run": len(done) - rechecked,
+            "files_skipped": skipped + rechecked, "files_rechecked": rechecked,
             "seconds": time.perf_counter() - start,
             "outputs": [os.path.join(output_dir, n) for n in names], "dashboard": dashboard}
 
