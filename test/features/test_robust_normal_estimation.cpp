@@ -4,11 +4,14 @@
 #include <gtest/gtest.h>
 #include <pcl/search/kdtree.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "analytic_surfaces.h"
 #include "estimator_support.h"
@@ -464,6 +467,208 @@ TEST(RobustNormals, PlanesWidenOnlyFromAKNearestSearchOfAtLeastTheGraphsWidth) {
   by_radius.compute(normals);
   EXPECT_LE(widest(by_radius.getScales()), 200);
   EXPECT_LT(widest(by_radius.getScales()), kWideGraphWidth * (kFirstWideLevel + 1));
+}
+
+TEST(RobustPlaneFit, OnAGaussianNoisyPlaneSigmaHatIsTheNoiseAndThreeSigmaKeepNearlyAll) {
+  // 200 neighbourhoods of 200 points uniform on a unit disk, Gaussian noise sigma = 0.01 normal to
+  // it (a plane at every scale: the whole neighbourhood is used). sigma-hat = 1.4826 x the median
+  // absolute residual estimates sigma (|N(0, s)| has median 0.6745 s); the final plane keeps the
+  // points within 3 sigma-hat, 2 Phi(3) - 1 = 99.73 % of Gaussian residuals.
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const double sigma = 0.01;
+  const int count = 200, trials = 200;
+  double sigma_hat = 0.0, confidence = 0.0, used = 0.0;
+  for (int trial = 0; trial < trials; ++trial) {
+    Eigen::Matrix3Xd points(3, count);
+    const Eigen::Vector3d query(0.0, 0.0, sigma * gauss(rng));
+    points.col(0).setZero();
+    for (int i = 1; i < count; ++i) {
+      Eigen::Vector2d d;
+      do d = Eigen::Vector2d(u(rng), u(rng));
+      while (d.squaredNorm() > 1.0);
+      points.col(i) = Eigen::Vector3d(d.x(), d.y(), sigma * gauss(rng)) - query;
+    }
+    const RobustPlaneFit fit = fitRobustPlane(points, count);
+    ASSERT_TRUE(fit.valid) << trial;
+    sigma_hat += fit.noise / trials;
+    confidence += fit.confidence / trials;
+    used += static_cast<double>(fit.scale) / trials;
+  }
+  std::printf("sigma-hat %.4f sigma, confidence %.4f, scale %.1f of %d\n", sigma_hat / sigma,
+              confidence, used, count);
+  EXPECT_GT(sigma_hat, 0.85 * sigma);
+  EXPECT_LT(sigma_hat, 1.15 * sigma);
+  EXPECT_GT(confidence, 0.985);
+  EXPECT_LE(confidence, 1.0);
+  EXPECT_NEAR(used, confidence * count, 1e-9 * count);  // the scale is the points kept
+}
+
+TEST(RobustNormals, TheCurvatureIsTheSurfaceVariationOfThePointsOfTheFinalFit) {
+  // The noisy plane of NoisyPlaneUsesTheWholeNeighbourhood..., 24 neighbours (no plane widens):
+  // where the final fit kept all 24 (scale 24), its curvature is l0 / (l0 + l1 + l2) of their
+  // covariance, computed here from the k-d tree's 24 nearest with Eigen's eigensolver.
+  std::mt19937 rng(8);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  Sampling sampling;
+  sampling.resolution = 100;
+  SurfaceSample s = makePlane(sampling);
+  for (Eigen::Index i = 0; i < s.points.cols(); ++i) s.points(2, i) += noise(rng);
+  const int k = 24;
+  const RobustResult r = robust(s.points, k);
+  const auto cloud = toCloud(s.points);
+  pcl::search::KdTree<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  pcl::Indices found;
+  std::vector<float> distances;
+  int compared = 0, differ = 0;
+  for (Eigen::Index i = 0; i < s.points.cols(); ++i) {
+    if (r.scales[i] != k) continue;
+    ASSERT_EQ(tree.nearestKSearch(static_cast<pcl::index_t>(i), k, found, distances), k);
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const pcl::index_t j : found) mean += (*cloud)[j].getVector3fMap().cast<double>();
+    mean /= k;
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const pcl::index_t j : found) {
+      const Eigen::Vector3d d = (*cloud)[j].getVector3fMap().cast<double>() - mean;
+      covariance += d * d.transpose() / k;
+    }
+    const Eigen::Vector3d l =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvalues();
+    const double variation = l[0] / l.sum();
+    ++compared;
+    differ += !(std::abs(r.normals[i].curvature - variation) <= 1e-4 * variation);
+  }
+  EXPECT_GT(compared, 0.8 * s.points.cols());
+  EXPECT_LE(differ, compared / 200) << differ << " of " << compared;
+}
+
+TEST(RobustNormals, ConfidenceIsTheScaleOverTheNeighboursFound) {
+  // On a clean sphere the fit stays local (scale about 16 of the 96 found) and no plane widens:
+  // confidence = scale / 96, not scale over the neighbours of the scale chosen.
+  const SurfaceSample s = noisySphere(5000, 0.0, 3);
+  const RobustResult r = robust(s.points);
+  int local = 0;
+  for (std::size_t i = 0; i < r.scales.size(); ++i) {
+    ASSERT_LE(r.scales[i], kRobustNormalNeighbours) << i;
+    EXPECT_EQ(r.confidences[i],
+              static_cast<float>(static_cast<double>(r.scales[i]) / kRobustNormalNeighbours))
+        << i;
+    local += r.scales[i] <= 32;
+  }
+  EXPECT_GT(local, 0.9 * r.scales.size());
+}
+
+TEST(RobustNormals, PlanesWidenFromExactlyTheGraphsWidth) {
+  // k = kWideGraphWidth nearest is enough for the planes to widen (the header: k >= the width).
+  const SurfaceSample s = noisySphere(4000, 0.02, 7);
+  const RobustResult r = robust(s.points, kWideGraphWidth);
+  const float widest = *std::max_element(r.scales.begin(), r.scales.end());
+  EXPECT_GT(widest, kWideGraphWidth);
+  EXPECT_EQ(r.failed, 0);
+}
+
+TEST(WidestPlanes, EqualTheSumsOfWalksOverTheGraphComputedByBruteForce) {
+  // widening_planes.h: level l's moments at node j sum the points x_m weighted by the number of
+  // (l + 1)-step walks from j to m along the rows, W_l = G^(l + 1) (G_jm = 1 for m in row j).
+  // The plane of a level is the PCA of those weighted points; the reference level
+  // kFirstWideLevel - 1 must have lambda0 <= largest_reference, and levels from kFirstWideLevel
+  // are kept while lambda0 <= kWideGrowth x the reference's. Here: G, the walk counts and the
+  // weighted PCA by brute force on 600 nodes of a surface flat for x < 0 and curved beyond (the
+  // planes widen far on one side, stop early on the other), with random bounds, some -1.
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const int n = 600, width = 32;
+  std::vector<Eigen::Vector3d> nodes(n);
+  for (Eigen::Vector3d& p : nodes) {
+    const double x = u(rng), y = u(rng);
+    p = Eigen::Vector3d(x, y, 0.5 * std::max(x, 0.0) * std::max(x, 0.0) + noise(rng));
+  }
+  NeighbourGraph graph;
+  graph.width = width;
+  for (int j = 0; j < n; ++j) {
+    std::vector<std::pair<double, int>> by_distance;
+    for (int m = 0; m < n; ++m) by_distance.push_back({(nodes[m] - nodes[j]).squaredNorm(), m});
+    std::stable_sort(by_distance.begin(), by_distance.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (int c = 0; c < width; ++c) graph.neighbours.push_back(by_distance[c].second);
+  }
+  // lambda0 and the normal of every level at every node.
+  std::vector<std::vector<double>> lambda0(kWideLevels, std::vector<double>(n));
+  std::vector<std::vector<Eigen::Vector3d>> normal(kWideLevels, std::vector<Eigen::Vector3d>(n));
+  std::vector<double> walks(static_cast<std::size_t>(n) * n, 0.0), next(walks.size());
+  for (int j = 0; j < n; ++j)
+    for (int c = 0; c < width; ++c)
+      walks[static_cast<std::size_t>(j) * n + graph.neighbours[j * width + c]] += 1.0;
+  for (int level = 0; level < kWideLevels; ++level) {
+    if (level > 0) {  // W_l(j) = sum over m in row j of W_(l-1)(m)
+      std::fill(next.begin(), next.end(), 0.0);
+      for (int j = 0; j < n; ++j)
+        for (int c = 0; c < width; ++c) {
+          const std::size_t row = static_cast<std::size_t>(graph.neighbours[j * width + c]);
+          const double* from = &walks[row * n];
+          double* to = &next[static_cast<std::size_t>(j) * n];
+          for (int m = 0; m < n; ++m) to[m] += from[m];
+        }
+      std::swap(walks, next);
+    }
+    for (int j = 0; j < n; ++j) {
+      const double* w = &walks[static_cast<std::size_t>(j) * n];
+      double total = 0.0;
+      Eigen::Vector3d first = Eigen::Vector3d::Zero();
+      for (int m = 0; m < n; ++m) {
+        total += w[m];
+        first += w[m] * (nodes[m] - nodes[j]);
+      }
+      const Eigen::Vector3d centroid = first / total;
+      Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+      for (int m = 0; m < n; ++m) {
+        const Eigen::Vector3d d = nodes[m] - nodes[j] - centroid;
+        covariance += (w[m] / total) * d * d.transpose();
+      }
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+      lambda0[level][j] = eigen.eigenvalues()[0];
+      normal[level][j] = eigen.eigenvectors().col(0);
+    }
+  }
+  std::vector<double> bound(n);
+  std::vector<int> expected(n, -1);
+  int borderline = 0;
+  const auto near = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::abs(b); };
+  for (int j = 0; j < n; ++j) {
+    const double reference = lambda0[kFirstWideLevel - 1][j];
+    bound[j] = j % 10 == 0 ? -1.0 : reference * std::exp(1.5 * u(rng));
+    borderline += near(reference, bound[j]);
+    if (!(reference <= bound[j])) continue;
+    for (int level = kFirstWideLevel; level < kWideLevels; ++level) {
+      borderline += near(lambda0[level][j], kWideGrowth * reference);
+      if (!(lambda0[level][j] <= kWideGrowth * reference)) break;
+      expected[j] = level;
+    }
+  }
+  ASSERT_EQ(borderline, 0);
+  std::vector<int> as_nodes(n);
+  for (int j = 0; j < n; ++j) as_nodes[j] = j;
+  const std::vector<WidePlane> planes = widestPlanes(nodes, graph, nodes, as_nodes, {}, bound, 2);
+  const std::vector<WidePlane> apart =
+      widestPlanes(nodes, graph, nodes, std::vector<int>(n, -1), graph, bound, 1);
+  int none = 0, some = 0, widest = 0;
+  for (int j = 0; j < n; ++j) {
+    ASSERT_EQ(planes[j].level, expected[j]) << j;
+    ASSERT_EQ(apart[j].level, expected[j]) << j;
+    none += expected[j] < 0;
+    some += expected[j] >= kFirstWideLevel && expected[j] < kWideLevels - 1;
+    widest += expected[j] == kWideLevels - 1;
+    if (expected[j] < 0) continue;
+    EXPECT_LT(degreesBetween(planes[j].normal, normal[expected[j]][j]), 1e-4) << j;
+    EXPECT_LT(degreesBetween(apart[j].normal, normal[expected[j]][j]), 1e-4) << j;
+  }
+  std::printf("no wider plane %d, some levels %d, all levels %d\n", none, some, widest);
+  EXPECT_GT(none, n / 10);
+  EXPECT_GT(some, n / 20);
+  EXPECT_GT(widest, 10);
 }
 
 }  // namespace

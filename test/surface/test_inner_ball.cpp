@@ -5,10 +5,12 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <vector>
 
 #include "analytic_surfaces.h"
 #include "estimator_support.h"
 #include "pcl_ddg/surface/inner_ball.h"
+#include "pcl_ddg/surface/mesh_smoothing.h"
 
 namespace pcl_ddg {
 namespace test {
@@ -115,6 +117,43 @@ TEST(InnerBall, TheSameFarFromTheOriginWoundInwardOrWithADoubledVertex) {
   // coarse torus), but neither ball stops at the other (it would be 0).
   EXPECT_GT(shared_copy[0], 0.3 * 0.7);
   EXPECT_GT(shared_copy[n], 0.3 * 0.7);
+}
+
+TEST(InnerBall, AnOpenSurfaceKeepsTheSideItsFacesGive) {
+  // A cap of a unit sphere (z > 0.3: open, consistently oriented). Wound outward its inner side
+  // is the sphere's inside: every ball is the sphere's (radius 1, the 20 % a normal's tilt can
+  // take off allowed). Wound inward (normals to the centre) the faces' side is kept as it is on
+  // an open surface, although its volume about its vertices' mean is negative: the inner side is
+  // outside the sphere, where a ball tangent at p holds no vertex, so every radius is infinite.
+  const SurfaceSample sphere = makeIcosphere(3, 1.0);
+  std::vector<int> kept;
+  for (Eigen::Index t = 0; t < sphere.triangles.cols(); ++t) {
+    bool above = true;
+    for (int c = 0; c < 3; ++c) above = above && sphere.points(2, sphere.triangles(c, t)) > 0.3;
+    if (above) kept.push_back(static_cast<int>(t));
+  }
+  Eigen::Matrix3Xi outward(3, kept.size());
+  for (std::size_t t = 0; t < kept.size(); ++t) outward.col(t) = sphere.triangles.col(kept[t]);
+  Eigen::Matrix3Xi inward = outward;
+  inward.row(1).swap(inward.row(2));
+  const int n = static_cast<int>(sphere.points.cols());
+  const MeshTopology out_topology(n, outward), in_topology(n, inward);
+  ASSERT_GT(out_topology.counts().boundary_edges, 0);
+  ASSERT_TRUE(in_topology.counts().consistently_oriented);
+  ASSERT_LT(componentVolumes(in_topology, sphere.points)[0], 0.0);
+
+  const Eigen::VectorXd out_radii = innerBallRadii(out_topology, sphere.points);
+  const Eigen::VectorXd in_radii = innerBallRadii(in_topology, sphere.points);
+  int on_cap = 0;
+  for (int v = 0; v < n; ++v) {
+    if (out_topology.isIsolated(v)) continue;
+    ++on_cap;
+    EXPECT_TRUE(std::isinf(in_radii[v])) << v << ": " << in_radii[v];
+    if (out_topology.isBoundary(v)) continue;  // a one-sided normal, tilted: the ball may leave
+    EXPECT_GT(out_radii[v], 0.8) << v;
+    EXPECT_LT(out_radii[v], 1.02) << v;
+  }
+  EXPECT_GT(on_cap, 100);
 }
 
 }  // namespace
