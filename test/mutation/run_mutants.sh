@@ -354,13 +354,14 @@ echo "== baseline: ${#programs[@]} unmutated test programs"
 for t in "${programs[@]}"; do
   [[ $t == pytest:* || -x $build/test/$t ]] ||
     die "test program $t was not built (a target of test/CMakeLists.txt?)"
-  run_program "$t" "" "${timeout_override:-1800}" "$logs/baseline_$t.log"
+  # A pytest entry's path holds '/': its log is named with them turned into '_'.
+  run_program "$t" "" "${timeout_override:-1800}" "$logs/baseline_${t//[\/:]/_}.log"
   baseline_seconds[$t]=$run_seconds
   if ((run_rc != 0)); then
     baseline_failures=$((baseline_failures + 1))
     echo "   $t FAILS UNMUTATED (${run_seconds} s): $run_failed" >&2
     if [[ $run_failed == *timeout* || $run_failed == crash* || $run_failed == exit* ]]; then
-      die "baseline $t: $run_failed; cannot tell mutants apart (log: $logs/baseline_$t.log)"
+      die "baseline $t: $run_failed; cannot tell mutants apart (log: $logs/baseline_${t//[\/:]/_}.log)"
     fi
     baseline_excluded[$t]=${run_failed// /:}
   else
@@ -405,7 +406,7 @@ for id in "${selected[@]}"; do
           filter="${filter:-*}-${baseline_excluded[$t]}"
         fi
         limit=${timeout_override:-$((4 * ${baseline_seconds[$t]} + 120))}
-        run_program "$t" "$filter" "$limit" "$logs/${id}_$t.log"
+        run_program "$t" "$filter" "$limit" "$logs/${id}_${t//[\/:]/_}.log"
         if ((run_rc != 0)); then
           r_result[$id]=killed
           r_by[$id]+="${r_by[$id]:+; }$t: $run_failed"
