@@ -436,7 +436,9 @@ table() {
     [[ $result == ERROR ]] && result="**ERROR**"
     local by=${r_by[$id]}
     [[ ${r_result[$id]} == survived ]] && by="(not caught by: ${m_tests[$id]})"
-    echo "| $id | ${r_where[$id]} | ${m_why[$id]//|/\\|} | $result | ${r_seconds[$id]} | ${by//|/\\|} |"
+    by=${by//|/\\|}
+    # "\::": Doxygen reads a bare "file.py::name" as a link to a symbol (Markdown shows "::").
+    echo "| $id | ${r_where[$id]} | ${m_why[$id]//|/\\|} | $result | ${r_seconds[$id]} | ${by//::/\\::} |"
   done
   echo
   echo "Total: ${#selected[@]} mutants: $killed killed, $survived survived, $errors errors." \
