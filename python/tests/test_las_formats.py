@@ -416,6 +416,37 @@ def test_the_oracle_tables_are_the_specifications():
     assert [name for name, _, _ in SPEC[10]][-7:] == [n for n, _, _ in _wave(0)]
 
 
+def test_a_format_3_survey_written_as_format_7_keeps_its_angles_and_matches_the_twin(tmp_path):
+    """autzen_trim.las's records written without a layout (LAS 1.4 format 7, since it has colours):
+    every field as in PDAL's format 7 twin, and the scan angle rank (whole degrees) becomes the
+    scan angle in 0.006 degree steps, rounded to the nearest step (PDAL truncates: rank 1 gives
+    167 here, 166 in the twin)."""
+    m3 = pcl_ddg.read(las_dir() / "autzen_trim.las")
+    twin = pcl_ddg.read(las_dir() / "autzen_trim_7.las")
+    out = tmp_path / "autzen_7.las"
+    with pytest.warns(UserWarning, match="no CRS"):
+        pcl_ddg.write(out, m3.points, fields=m3.fields)
+    raw = out.read_bytes()
+    h = parse_header(raw)
+    assert (h["version"], h["point_format"]) == ((1, 4), 7)
+    records = records_of(raw, h)
+    rank = m3.fields["scan_angle_rank"].astype(np.float64)
+    assert np.unique(rank).size > 5  # the angles compared vary
+    # the nearest 0.006 degree step: k / 0.006 is never half-way for a whole k
+    np.testing.assert_array_equal(records["scan_angle"], np.round(rank / 0.006).astype(np.int16))
+    b, t = pcl_ddg.read(out).fields, twin.fields
+    # the same grid points (this file's scale and offset are chosen here, so X * scale + offset
+    # may differ from the twin's by an ulp)
+    np.testing.assert_allclose(pcl_ddg.read(out).points, twin.points, rtol=0,
+                               atol=0.25 * min(twin.las.scale))
+    for key in ("intensity", "return_number", "number_of_returns", "classification", "red",
+                "green", "blue", "point_source_id", "user_data", "scan_direction_flag",
+                "edge_of_flight_line", "classification_flags", "scanner_channel"):
+        np.testing.assert_array_equal(b[key], t[key], err_msg=key)
+    np.testing.assert_array_equal(b["gps_time"].view(np.uint64), t["gps_time"].view(np.uint64))
+    assert np.max(np.abs(b["scan_angle"].astype(int) - t["scan_angle"])) == 1  # rounding vs trunc
+
+
 @pytest.mark.parametrize("point_format", range(11))
 def test_every_format_written_from_the_tables(point_format, tmp_path):
     """A file of each format 0-10, its bytes written here, read field by field and written back
