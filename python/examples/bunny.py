@@ -26,7 +26,7 @@ def main(out_folder):
           f"{report['boundary_loops']} boundary loops, genus {report['genus']}")
 
     # Normals from the faces, and fitted to 16 neighbours: on the mesh (rings) and in space.
-    faces = pcl_ddg.vertex_normals(V, F, weighting="area")
+    faces = pcl_ddg.vertex_normals(V, F, weights="area")
     rings = pcl_ddg.estimate_normals(V, faces=F, k=16)
     comparison = pcl_ddg.compare_neighbourhoods(V, F, k=16)
     agree = np.abs(np.einsum("ij,ij->i", faces.normals, rings.normals))

@@ -27,6 +27,7 @@ Conventions, the same as the C++ library and the ``pcl_ddg_*`` tools:
 from __future__ import annotations
 
 import json
+import numbers
 import os
 import warnings
 from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
@@ -67,8 +68,53 @@ __all__ = [
 ]
 
 ArrayLike = Any
-Faces = Union[np.ndarray, Sequence[Sequence[int]]]
-Vector3 = Optional[Sequence[float]]
+Faces = Union[np.ndarray, Sequence[np.ndarray], Sequence[Sequence[int]]]
+Vector3 = Optional[Union[Sequence[float], np.ndarray]]
+
+_INDEX_MAX = 2**31 - 1  # the library counts points and neighbours in int
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _integer(value: Any, name: str, minimum: int = 0) -> Any:
+    """An integer option as an int (None stays None), or ValueError naming it: bools and floats
+    are refused, as are values the library cannot index."""
+    if value is None:
+        return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise ValueError(f"{name} must be a whole number, not {_shown(value)}")
+    if not minimum <= int(value) <= _INDEX_MAX:
+        raise ValueError(f"{name} must be from {minimum} to {_INDEX_MAX}, not {int(value)}")
+    return int(value)
+
+
+def _real(value: Any, name: str) -> Any:
+    """A real option as a float (None stays None), or ValueError naming it."""
+    if value is None:
+        return None
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} must be a number, not {_shown(value)}")
+    return float(value)
+
+
+def _text(value: Any, name: str) -> Any:
+    """A named choice as a str (None stays None), or ValueError naming it."""
+    if value is None or isinstance(value, str):
+        return value
+    raise ValueError(f"{name} must be a name (str), not {_shown(value)}")
+
+
+def _renamed(old_value: Any, old: str, new: str, value: Any, default: Any) -> Any:
+    """value, or the deprecated keyword's (with a DeprecationWarning) when only it is given."""
+    if old_value is None:
+        return value
+    warnings.warn(f"{old}= is deprecated: use {new}=", DeprecationWarning, stacklevel=3)
+    if value != default:
+        raise ValueError(f"{old}= and {new}= name the same option: give {new}= only")
+    return old_value
 
 
 def _array(value: ArrayLike, name: str) -> np.ndarray:
@@ -81,9 +127,11 @@ def _array(value: ArrayLike, name: str) -> np.ndarray:
         raise ValueError(f"{name} must be an array: {error}") from None
 
 
-def _faces(F: Faces) -> Any:
+def _faces(F: Optional[Faces]) -> Any:
     if isinstance(F, np.ndarray):
         return F
+    if F is None:
+        raise ValueError("F is None: no faces (a cloud, or a file without faces)")
     if isinstance(F, (list, tuple)):
         # A rectangular list of lists is an array; ragged polygons stay a list.
         lengths = {len(p) if hasattr(p, "__len__") else -1 for p in F}
@@ -92,6 +140,12 @@ def _faces(F: Faces) -> Any:
             if array.dtype.kind in "iu" or array.size == 0:
                 return array.astype(np.int64, copy=False).reshape(len(F), -1)
         return list(F)
+    try:  # an array-like: Open3D's mesh.triangles, a memoryview, ...
+        array = np.asarray(F)
+    except (TypeError, ValueError):
+        array = None
+    if array is not None and array.ndim == 2 and array.dtype.kind in "iu":
+        return array
     raise ValueError("F must be an (m, 3) integer array or a sequence of polygons")
 
 
@@ -135,14 +189,15 @@ class VertexNormals(NamedTuple):
 
 def vertex_normals(
     V: ArrayLike,
-    F: Faces,
-    weighting: str = "area",
+    F: Optional[Faces],
+    weights: str = "area",
     epsilon: Optional[float] = None,
     mass: str = "mixed",
+    weighting: Optional[str] = None,
 ) -> VertexNormals:
     """Normals of a triangle mesh, oriented like its faces (``pcl_ddg_normals -method ...``).
 
-    weighting:
+    weights:
         ``"area"`` (sum of the triangles' area vectors; the default), ``"uniform"`` (every face
         the same), ``"angle"`` (unit face normals weighted by the corner angle), or
         ``"mean_curvature"`` (the direction of -M^-1 L x, the area normal where the surface is
@@ -152,10 +207,17 @@ def vertex_normals(
     mass:
         the vertex areas M of ``mean_curvature``: ``"mixed"``, ``"voronoi"``, ``"barycentric"``.
 
+    weighting:
+        the former name of ``weights`` (deprecated).
+
     Vertices with no non-degenerate triangle, or whose face normals cancel, get NaN and
     ``valid=False``.
     """
-    normals, valid, _ = _pcl_ddg.vertex_normals(_array(V, "V"), _faces(F), weighting, epsilon, mass)
+    weights = _renamed(weighting, "weighting", "weights", weights, "area")
+    normals, valid, _ = _pcl_ddg.vertex_normals(
+        _array(V, "V"), _faces(F), _text(weights, "weights"), _real(epsilon, "epsilon"),
+        _text(mass, "mass"),
+    )
     return VertexNormals(normals, valid)
 
 
@@ -167,7 +229,7 @@ def _csr(data: np.ndarray, indices: np.ndarray, indptr: np.ndarray) -> Any:
 
 
 def laplacian(
-    V: ArrayLike, F: Faces, weights: str = "cotan", form: str = "summed", mass: str = "mixed"
+    V: ArrayLike, F: Optional[Faces], weights: str = "cotan", form: str = "summed", mass: str = "mixed"
 ) -> Any:
     """The discrete Laplace-Beltrami operator L as a ``scipy.sparse.csr_matrix`` (n x n).
 
@@ -186,21 +248,30 @@ def laplacian(
     mass:
         M of the averaged form: ``"mixed"``, ``"voronoi"`` or ``"barycentric"``.
     """
-    data, indices, indptr = _pcl_ddg.laplacian(_array(V, "V"), _faces(F), weights, form, mass)
+    data, indices, indptr = _pcl_ddg.laplacian(
+        _array(V, "V"), _faces(F), _text(weights, "weights"), _text(form, "form"),
+        _text(mass, "mass"),
+    )
     return _csr(data, indices, indptr)
 
 
-def mass_matrix(V: ArrayLike, F: Faces, kind: str = "mixed") -> Any:
+def mass_matrix(
+    V: ArrayLike, F: Optional[Faces], mass: str = "mixed", kind: Optional[str] = None
+) -> Any:
     """The lumped (diagonal) mass matrix M as a ``scipy.sparse.csr_matrix``: vertex areas.
 
-    kind:
+    mass:
         ``"mixed"`` (Meyer et al. 2003's mixed Voronoi areas, never negative; the default),
         ``"voronoi"`` (circumcentric cells, negative contributions on obtuse triangles) or
         ``"barycentric"`` (a third of every incident triangle).
 
+    kind:
+        the former name of ``mass`` (deprecated).
+
     The masses sum to the total area for every kind.
     """
-    area = _pcl_ddg.mass_matrix(_array(V, "V"), _faces(F), kind)
+    mass = _renamed(kind, "kind", "mass", mass, "mixed")
+    area = _pcl_ddg.mass_matrix(_array(V, "V"), _faces(F), _text(mass, "mass"))
     n = area.shape[0]
     index = np.arange(n, dtype=np.int32)
     return _csr(area, index, np.arange(n + 1, dtype=np.int32))
@@ -221,7 +292,7 @@ class Curvatures(NamedTuple):
         return np.isfinite(self.mean)
 
 
-def curvatures(V: ArrayLike, F: Faces, mass: str = "mixed") -> Curvatures:
+def curvatures(V: ArrayLike, F: Optional[Faces], mass: str = "mixed") -> Curvatures:
     """Mean, Gaussian and principal curvatures of a mesh (``pcl_ddg_curvature -method cotan``).
 
     H from the cotangent Laplacian (``Hn = -1/2 M^-1 L x``, signed by the area normal), K from the
@@ -229,11 +300,11 @@ def curvatures(V: ArrayLike, F: Faces, mass: str = "mixed") -> Curvatures:
     that ``sum(gauss * area) = 2 pi chi`` (Gauss-Bonnet). ``mass`` (the ``-area`` flag): ``"mixed"``,
     ``"voronoi"``, ``"barycentric"``.
     """
-    mean, gauss, k1, k2, area, _, _ = _pcl_ddg.curvatures(_array(V, "V"), _faces(F), mass)
+    mean, gauss, k1, k2, area, _, _ = _pcl_ddg.curvatures(_array(V, "V"), _faces(F), _text(mass, "mass"))
     return Curvatures(mean, gauss, k1, k2, area)
 
 
-def mesh_report(V: ArrayLike, F: Faces) -> Dict[str, Any]:
+def mesh_report(V: ArrayLike, F: Optional[Faces]) -> Dict[str, Any]:
     """Everything worth knowing about a mesh before trusting numbers computed on it.
 
     The dict of ``pcl_ddg_info -json``: counts of degenerate, duplicate, out-of-range and
@@ -246,7 +317,7 @@ def mesh_report(V: ArrayLike, F: Faces) -> Dict[str, Any]:
 
 def smooth(
     V: ArrayLike,
-    F: Faces,
+    F: Optional[Faces],
     method: str = "implicit",
     weights: Optional[str] = None,
     average: Optional[str] = None,
@@ -306,29 +377,29 @@ def smooth(
     return _pcl_ddg.smooth(
         _array(V, "V"),
         _faces(F),
-        method,
-        weights,
-        average,
-        mass,
-        lambda_dt,
-        lambda_,
-        None if mu is None else float(mu),
-        int(iterations),
+        _text(method, "method"),
+        _text(weights, "weights"),
+        _text(average, "average"),
+        _text(mass, "mass"),
+        _real(lambda_dt, "lambda_dt"),
+        _real(lambda_, "lambda_"),
+        _real(mu, "mu"),
+        _integer(iterations, "iterations"),
         bool(absolute_time),
         bool(freeze_weights),
         bool(update_mass),
         bool(rebuild_weights),
-        None if thickness_limit is None else float(thickness_limit),
+        _real(thickness_limit, "thickness_limit"),
         bool(fix_boundary),
         bool(allow_unstable),
-        preserve,
-        solver,
+        _text(preserve, "preserve"),
+        _text(solver, "solver"),
     )
 
 
 def smooth_field(
     V: ArrayLike,
-    F: Faces,
+    F: Optional[Faces],
     values: ArrayLike,
     time: float,
     method: str = "implicit",
@@ -346,18 +417,20 @@ def smooth_field(
     below a wavelength of about 2 pi sqrt(time) is gone. The mass-weighted sum is conserved on a
     closed mesh; a free boundary is insulated, a fixed one (``fix_boundary``) keeps its values.
     """
+    if time is None:
+        raise ValueError("time must be a number (the diffusion time), not None")
     return _pcl_ddg.smooth_field(
         _array(V, "V"),
         _faces(F),
         _array(values, "values"),
-        float(time),
-        method,
-        weights,
-        mass,
-        int(iterations),
+        _real(time, "time"),
+        _text(method, "method"),
+        _text(weights, "weights"),
+        _text(mass, "mass"),
+        _integer(iterations, "iterations"),
         bool(absolute_time),
         bool(fix_boundary),
-        solver,
+        _text(solver, "solver"),
     )
 
 
@@ -438,18 +511,18 @@ def _fitted_normals(
     points, faces, viewpoint, orient = _file_defaults(points, faces, viewpoint, orient)
     return _pcl_ddg.estimate_normals(
         _array(points, "points"),
-        method,
-        k,
-        radius,
-        max_nn,
-        min_nn,
-        neighbours,
+        _text(method, "method"),
+        _integer(k, "k"),
+        _real(radius, "radius"),
+        _integer(max_nn, "max_nn"),
+        _integer(min_nn, "min_nn"),
+        _text(neighbours, "neighbours"),
         None if faces is None else _faces(faces),
         _vector(viewpoint, "viewpoint"),
-        orient,
+        _text(orient, "orient"),
         _vector(up, "up"),
-        max_depth_jump,
-        int(threads),
+        _real(max_depth_jump, "max_depth_jump"),
+        _integer(threads, "threads"),
     )
 
 
@@ -514,16 +587,16 @@ def principal_curvatures(
     points, faces, viewpoint, orient = _file_defaults(points, faces, viewpoint, orient)
     k1, k2, direction, normals, valid, _ = _pcl_ddg.principal_curvatures(
         _array(points, "points"),
-        k,
-        radius,
-        max_nn,
-        min_nn,
-        neighbours,
+        _integer(k, "k"),
+        _real(radius, "radius"),
+        _integer(max_nn, "max_nn"),
+        _integer(min_nn, "min_nn"),
+        _text(neighbours, "neighbours"),
         None if faces is None else _faces(faces),
         _vector(viewpoint, "viewpoint"),
-        orient,
+        _text(orient, "orient"),
         _vector(up, "up"),
-        int(threads),
+        _integer(threads, "threads"),
     )
     return PrincipalCurvatures(k1, k2, direction, normals, valid)
 
@@ -583,10 +656,10 @@ def orient_normals(
     out, flipped = _pcl_ddg.orient_normals(
         _array(points, "points"),
         _array(normals, "normals"),
-        method,
+        _text(method, "method"),
         _vector(viewpoint, "viewpoint"),
         _vector(up, "up"),
-        int(k),
+        _integer(k, "k"),
         None if faces is None else _faces(faces),
     )
     return OrientedNormals(out, flipped)
@@ -611,7 +684,13 @@ def compare_neighbourhoods(
     None) and Euclidean (kd-tree) neighbourhoods, and how much they differ at every vertex
     (``pcl_ddg_compare_neighbourhoods``; k default 16)."""
     angle, overlap, summary = _pcl_ddg.compare_neighbourhoods(
-        _array(V, "V"), None if F is None else _faces(F), method, k, radius, max_nn, int(threads)
+        _array(V, "V"),
+        None if F is None else _faces(F),
+        _text(method, "method"),
+        _integer(k, "k"),
+        _real(radius, "radius"),
+        _integer(max_nn, "max_nn"),
+        _integer(threads, "threads"),
     )
     return NeighbourhoodComparison(angle, overlap, summary)
 

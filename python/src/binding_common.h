@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "pcl_ddg/interruption.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 
 namespace pcl_ddg {
@@ -85,7 +86,12 @@ double& lastComputeSeconds();
 /** Library time spent before the call (building the topology), added to it by compute(). */
 double& pendingComputeSeconds();
 
-/** Runs body with the GIL released and records how long it took. */
+/** True when Python's signal handlers raised (Ctrl-C: KeyboardInterrupt is then set). Takes
+ *  the GIL; only the main thread runs handlers, elsewhere it is false. */
+bool pythonSignalRaised();
+
+/** Runs body with the GIL released, interruptible by Ctrl-C (the library's long loops poll
+ *  pythonSignalRaised about every 0.1 s: interruption.h), and records how long it took. */
 template <typename Body>
 auto compute(Body&& body) {
   const auto start = std::chrono::steady_clock::now();
@@ -99,8 +105,13 @@ auto compute(Body&& body) {
     }
   } record{start};
   py::gil_scoped_release release;
+  const InterruptionScope interruptible(pythonSignalRaised);
   return body();
 }
+
+/** Sets a Python exception of type with e's description (errorDescription), its bytes that are
+ *  not UTF-8 escaped. */
+void setError(PyObject* type, const std::exception& e);
 
 void bindMeshes(py::module_& m);
 void bindClouds(py::module_& m);

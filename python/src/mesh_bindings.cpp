@@ -88,18 +88,18 @@ void checkSignals(int, int) {
 void bindMeshes(py::module_& m) {
   m.def(
       "vertex_normals",
-      [](const py::array& V, const py::object& F, const std::string& weighting,
+      [](const py::array& V, const py::object& F, const std::string& weights,
          std::optional<double> epsilon, const std::string& mass) {
         MeshNormalOptions options;
         const std::string w =
-            choice("weighting", weighting, {"area", "uniform", "angle", "mean_curvature"});
+            choice("weights", weights, {"area", "uniform", "angle", "mean_curvature"});
         options.weighting = w == "uniform"          ? NormalWeighting::Uniform
                             : w == "angle"          ? NormalWeighting::Angle
                             : w == "mean_curvature" ? NormalWeighting::MeanCurvature
                                                     : NormalWeighting::Area;
         if (epsilon) {
           if (w != "mean_curvature")
-            throw py::value_error("epsilon applies to weighting='mean_curvature' only");
+            throw py::value_error("epsilon applies to weights='mean_curvature' only");
           if (!(*epsilon >= 0.0) || !std::isfinite(*epsilon))
             throw py::value_error("epsilon must be >= 0");
           options.epsilon = *epsilon;
@@ -115,7 +115,7 @@ void bindMeshes(py::module_& m) {
         return py::make_tuple(rowsArray(std::move(normals.normals)), maskArray(normals.valid),
                               counts);
       },
-      py::arg("V"), py::arg("F"), py::arg("weighting") = "area", py::arg("epsilon") = py::none(),
+      py::arg("V"), py::arg("F"), py::arg("weights") = "area", py::arg("epsilon") = py::none(),
       py::arg("mass") = "mixed", "(normals, valid, counts) of computeMeshNormals.");
 
   m.def(
@@ -147,14 +147,13 @@ void bindMeshes(py::module_& m) {
 
   m.def(
       "mass_matrix",
-      [](const py::array& V, const py::object& F, const std::string& kind) {
-        const std::string k = choice("kind", kind, {"mixed", "voronoi", "barycentric"});
-        const MassType type = massOf(k);
+      [](const py::array& V, const py::object& F, const std::string& mass) {
+        const MassType type = massOf(mass);
         Mesh mesh = meshOf(V, F);
         return vectorArray(
             compute([&] { return lumpedMass(mesh.topology, mesh.positions.map(), type); }));
       },
-      py::arg("V"), py::arg("F"), py::arg("kind") = "mixed", "The diagonal of M (vertex areas).");
+      py::arg("V"), py::arg("F"), py::arg("mass") = "mixed", "The diagonal of M (vertex areas).");
 
   m.def(
       "curvatures",

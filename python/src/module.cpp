@@ -273,6 +273,21 @@ double& pendingComputeSeconds() {
   return seconds;
 }
 
+bool pythonSignalRaised() {
+  py::gil_scoped_acquire acquire;
+  return PyErr_CheckSignals() != 0;
+}
+
+void setError(PyObject* type, const std::exception& e) {
+  // A message may quote a file's bytes: what is not UTF-8 is escaped (\\xff), never lost.
+  const std::string text = pcl_ddg::errorDescription(e);
+  PyObject* message = PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()),
+                                           "backslashreplace");
+  if (message == nullptr) return;  // MemoryError is set
+  PyErr_SetObject(type, message);
+  Py_DECREF(message);
+}
+
 }  // namespace python
 }  // namespace pcl_ddg
 
@@ -292,15 +307,24 @@ PYBIND11_MODULE(_pcl_ddg, m) {
     try {
       if (thrown) std::rethrow_exception(thrown);
     } catch (const pcl_ddg::InvalidMeshException& e) {
-      PyErr_SetString(invalid_mesh.ptr(), pcl_ddg::errorDescription(e).c_str());
+      setError(invalid_mesh.ptr(), e);
     } catch (const pcl_ddg::SurfaceCollapseException& e) {
-      PyErr_SetString(collapse.ptr(), pcl_ddg::errorDescription(e).c_str());
+      setError(collapse.ptr(), e);
+    } catch (const pcl_ddg::InterruptedException&) {
+      // Python's handler raised KeyboardInterrupt when the library asked (pythonSignalRaised).
+      if (PyErr_Occurred() == nullptr) PyErr_SetNone(PyExc_KeyboardInterrupt);
     } catch (const pcl::IOException& e) {
-      PyErr_SetString(PyExc_OSError, pcl_ddg::errorDescription(e).c_str());
+      setError(PyExc_OSError, e);
     } catch (const pcl::BadArgumentException& e) {
-      PyErr_SetString(PyExc_ValueError, pcl_ddg::errorDescription(e).c_str());
+      setError(PyExc_ValueError, e);
     } catch (const pcl::PCLException& e) {
-      PyErr_SetString(PyExc_RuntimeError, pcl_ddg::errorDescription(e).c_str());
+      setError(PyExc_RuntimeError, e);
+    } catch (const py::builtin_exception&) {
+      throw;  // pybind11's own (py::value_error, ...): its translator sets them
+    } catch (const std::bad_alloc&) {
+      throw;  // MemoryError, by pybind11's translator
+    } catch (const std::exception& e) {
+      setError(PyExc_RuntimeError, e);
     }
   });
 

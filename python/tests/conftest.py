@@ -115,9 +115,9 @@ def bunny():
     return pcl_ddg.read(shared_data() / "meshes" / "bunny.off")
 
 
-def python_subprocess(code: str) -> subprocess.CompletedProcess:
+def python_subprocess(code: str, timeout: float = 300) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          timeout=300, env=dict(os.environ))
+                          timeout=timeout, env=dict(os.environ))
 
 
 @pytest.fixture

@@ -43,12 +43,12 @@ CASES = {
     "polygon out of range": ("pcl_ddg.mass_matrix(V, [[0, 1, 2, 99]])", "ValueError"),
     "faces out of range (cloud)": ("pcl_ddg.estimate_normals(V, faces=F + 100)", "ValueError"),
     # options
-    "unknown weighting": ("pcl_ddg.vertex_normals(V, F, weighting='cot')", "ValueError"),
+    "unknown weighting": ("pcl_ddg.vertex_normals(V, F, weights='cot')", "ValueError"),
     "epsilon without mean_curvature": ("pcl_ddg.vertex_normals(V, F, epsilon=0.1)", "ValueError"),
-    "negative epsilon": ("pcl_ddg.vertex_normals(V, F, weighting='mean_curvature', epsilon=-1)",
+    "negative epsilon": ("pcl_ddg.vertex_normals(V, F, weights='mean_curvature', epsilon=-1)",
                          "ValueError"),
     "unknown form": ("pcl_ddg.laplacian(V, F, form='normalised')", "ValueError"),
-    "unknown mass": ("pcl_ddg.mass_matrix(V, F, kind='lumped')", "ValueError"),
+    "unknown mass": ("pcl_ddg.mass_matrix(V, F, mass='lumped')", "ValueError"),
     "iterations 0": ("pcl_ddg.smooth(V, F, iterations=0)", "ValueError"),
     "negative time step": ("pcl_ddg.smooth(V, F, lambda_dt=-1)", "ValueError"),
     "NaN time step": ("pcl_ddg.smooth(V, F, lambda_dt=float('nan'))", "ValueError"),
@@ -124,3 +124,57 @@ def test_invalid_mesh_error_is_a_value_error():
 
     assert issubclass(pcl_ddg.InvalidMeshError, ValueError)
     assert issubclass(pcl_ddg.SurfaceCollapseError, RuntimeError)
+
+
+# Options of the wrong kind or out of range: ValueError with one line naming the option (never
+# pybind11's TypeError listing every argument, the arrays included).
+OPTION_CASES = {
+    "k beyond int": ("pcl_ddg.estimate_normals(P, k=2**31)", "k"),
+    "k a float": ("pcl_ddg.estimate_normals(P, k=16.0)", "k"),
+    "k a bool": ("pcl_ddg.orient_normals(P, P, k=True)", "k"),
+    "k a string": ("pcl_ddg.principal_curvatures(P, k='20')", "k"),
+    "threads negative": ("pcl_ddg.estimate_normals(P, threads=-1)", "threads"),
+    "threads a float": ("pcl_ddg.compare_neighbourhoods(V, F, threads=1.5)", "threads"),
+    "max_nn a float": ("pcl_ddg.estimate_normals(P, radius=0.2, max_nn=8.0)", "max_nn"),
+    "radius a string": ("pcl_ddg.principal_curvatures(P, radius='0.1')", "radius"),
+    "method a number": ("pcl_ddg.estimate_normals(P, method=3)", "method"),
+    "orient a list": ("pcl_ddg.estimate_normals(P, orient=['up'])", "orient"),
+    "iterations a float": ("pcl_ddg.smooth(V, F, iterations=2.5)", "iterations"),
+    "lambda_dt a list": ("pcl_ddg.smooth(V, F, lambda_dt=[1.0])", "lambda_dt"),
+    "time missing": ("pcl_ddg.smooth_field(V, F, V[:, 0], None)", "time"),
+    "epsilon a string": ("pcl_ddg.vertex_normals(V, F, weights='mean_curvature', epsilon='x')",
+                         "epsilon"),
+    "weights a number": ("pcl_ddg.laplacian(V, F, weights=1)", "weights"),
+    "mass a number": ("pcl_ddg.mass_matrix(V, F, mass=2)", "mass"),
+}
+
+
+@pytest.mark.parametrize("name", sorted(OPTION_CASES))
+def test_a_bad_option_is_a_value_error_of_one_line_naming_it(name):
+    import numpy as np  # noqa: F401 (the cases' namespace)
+    import pcl_ddg  # noqa: F401
+
+    code, option = OPTION_CASES[name]
+    namespace: dict = {}
+    exec(SETUP, namespace)
+    with pytest.raises(ValueError) as error:
+        exec(code, namespace)
+    message = str(error.value)
+    assert message.startswith(option + " ") and "\n" not in message and len(message) < 120, message
+
+
+@pytest.mark.parametrize("name, content, where", [
+    ("random.pcd", bytes(range(255, -1, -1)) * 12, "line 1"),
+    ("bad_line.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n\xff\xfe 1 2 3\nf 1 2 3\n", "line 4"),
+], ids=["random.pcd", "bad_line.obj"])
+def test_a_message_keeps_bytes_that_are_not_utf8(tmp_path, name, content, where):
+    """The tool prints these files' bytes in its message; Python escapes them (never '')."""
+    import pcl_ddg
+
+    path = tmp_path / name
+    path.write_bytes(content)
+    with pytest.raises(OSError) as error:
+        pcl_ddg.read(path)
+    message = str(error.value)
+    assert message.startswith(str(path) + ": " + where), message
+    assert "\\x" in message, message  # the bytes that are not UTF-8, escaped

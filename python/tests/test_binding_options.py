@@ -137,7 +137,7 @@ def test_mass_kinds_are_their_closed_forms(kind):
     expected = lumped_mass(V, F, kind)
     others = [lumped_mass(V, F, k) for k in ("mixed", "voronoi", "barycentric") if k != kind]
     assert all(max_relative(o, expected) > 1e-3 for o in others)  # the kinds are told apart
-    got = pcl_ddg.mass_matrix(V, F, kind=kind).diagonal()
+    got = pcl_ddg.mass_matrix(V, F, mass=kind).diagonal()
     assert max_relative(got, expected) < 1e-12
     # curvatures(mass=) reports that area, and K = angle defect / area with it
     c = pcl_ddg.curvatures(V, F, mass=kind)

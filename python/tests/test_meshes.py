@@ -33,7 +33,7 @@ def test_sphere_normals_are_radial():
     R = 3.0
     V, F = icosphere(4, R)
     for weighting in ("area", "uniform", "angle", "mean_curvature"):
-        n = pcl_ddg.vertex_normals(V, F, weighting=weighting)
+        n = pcl_ddg.vertex_normals(V, F, weights=weighting)
         assert n.valid.all()
         assert np.allclose(np.linalg.norm(n.normals, axis=1), 1.0, atol=1e-14)
         # Symmetric 1-rings give the radial direction to rounding, the others to O(h^2).
@@ -93,10 +93,10 @@ def test_mass_sums_to_the_area():
     V, F = random_mesh(400, seed=5)
     area = triangle_areas(V, F).sum()
     for kind in ("mixed", "voronoi", "barycentric"):
-        M = pcl_ddg.mass_matrix(V, F, kind=kind)
+        M = pcl_ddg.mass_matrix(V, F, mass=kind)
         assert isinstance(M, sparse.csr_matrix)
         assert abs(M.sum() - area) < 1e-12 * area, kind
-    assert (pcl_ddg.mass_matrix(V, F, kind="mixed").diagonal() >= 0).all()
+    assert (pcl_ddg.mass_matrix(V, F, mass="mixed").diagonal() >= 0).all()
 
 
 def test_polygon_lists_are_fan_triangulated():
@@ -162,3 +162,43 @@ def test_a_mesh_without_faces_gives_nan_rows():
     V, _ = icosphere(1)
     c = pcl_ddg.curvatures(V, np.zeros((0, 3), dtype=np.int32))
     assert c.mean.shape == (V.shape[0],) and not c.valid.any()
+
+
+def test_one_keyword_per_concept_and_the_former_names_still_work_with_a_warning():
+    import warnings
+
+    V, F = icosphere(1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the current names warn about nothing
+        area = pcl_ddg.vertex_normals(V, F, weights="angle").normals
+        mixed = pcl_ddg.mass_matrix(V, F, mass="voronoi").diagonal()
+    with pytest.warns(DeprecationWarning, match="weighting= is deprecated: use weights="):
+        old = pcl_ddg.vertex_normals(V, F, weighting="angle").normals
+    np.testing.assert_array_equal(old, area)
+    with pytest.warns(DeprecationWarning, match="kind= is deprecated: use mass="):
+        old = pcl_ddg.mass_matrix(V, F, kind="voronoi").diagonal()
+    np.testing.assert_array_equal(old, mixed)
+    with pytest.raises(ValueError, match="give mass= only"), pytest.warns(DeprecationWarning):
+        pcl_ddg.mass_matrix(V, F, mass="barycentric", kind="voronoi")
+
+
+class _TriangleVector:
+    """Open3D's mesh.triangles: no ndarray, but the buffer protocol (as Vector3iVector)."""
+
+    def __init__(self, F):
+        self._array = np.ascontiguousarray(F, dtype=np.int32)
+
+    def __buffer__(self, flags):  # Python 3.12
+        return memoryview(self._array)
+
+    def __array__(self, dtype=None):
+        return self._array if dtype is None else self._array.astype(dtype)
+
+
+def test_faces_as_an_array_like_such_as_open3d_triangles():
+    V, F = icosphere(1)
+    expected = pcl_ddg.vertex_normals(V, F).normals
+    for faces in (_TriangleVector(F), memoryview(np.ascontiguousarray(F, dtype=np.int32))):
+        np.testing.assert_array_equal(pcl_ddg.vertex_normals(V, faces).normals, expected)
+        np.testing.assert_array_equal(pcl_ddg.curvatures(V, faces).mean,
+                                      pcl_ddg.curvatures(V, F).mean)

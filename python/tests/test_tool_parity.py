@@ -23,7 +23,7 @@ def test_vertex_normals_equal_pcl_ddg_normals(tmp_path, weighting):
     out = tmp_path / "normals.ply"
     run_tool("pcl_ddg_normals", source, out, "-method", weighting, "-precision", "double")
     mesh = pcl_ddg.read(source)
-    n = pcl_ddg.vertex_normals(mesh.points, mesh.faces, weighting=weighting)
+    n = pcl_ddg.vertex_normals(mesh.points, mesh.faces, weights=weighting)
     np.testing.assert_array_equal(n.normals, stacked(out, ["nx", "ny", "nz"]))
 
 
@@ -132,6 +132,27 @@ def test_grid_normals_equal_pcl_ddg_normals_on_an_organized_frame(tmp_path):
     run_tool("pcl_ddg_normals", source, out, "-precision", "double")
     cloud = pcl_ddg.read(source)
     r = pcl_ddg.grid_normals(cloud.grid, viewpoint=cloud.viewpoint)
+    np.testing.assert_array_equal(r.normals.reshape(-1, 3),
+                                  stacked(out, ["normal_x", "normal_y", "normal_z"]))
+
+
+def test_grid_normals_of_a_double_frame_measure_ranges_from_the_camera(tmp_path):
+    """A flat wall 5.125 m in front of a camera at the origin, float64 pixels that floats do not
+    hold: fitted about its local origin (the wall's centre), its depth jumps are still measured
+    on ranges from the camera (a range from the local origin, near 0 at the centre, cut the
+    pixels there off: NaN in a diamond around the axis). Every pixel faces the camera, and the
+    tool reads the same frame from a double PCD to the same bits."""
+    v, u = np.mgrid[0:240, 0:320]
+    spacing = 0.00976
+    frame = np.dstack([(u - 160) * spacing, (v - 120) * spacing, np.full(u.shape, 5.125)])
+    assert np.any(frame.astype(np.float32) != frame)  # the doubles are needed
+    r = pcl_ddg.grid_normals(frame)
+    assert r.valid.all()
+    np.testing.assert_allclose(r.normals.reshape(-1, 3), [[0.0, 0.0, -1.0]] * frame[..., 0].size,
+                               rtol=0, atol=1e-9)
+    source, out = tmp_path / "wall.pcd", tmp_path / "normals.pcd"
+    pcl_ddg.write(source, frame, precision="double")
+    run_tool("pcl_ddg_normals", source, out, "-precision", "double")
     np.testing.assert_array_equal(r.normals.reshape(-1, 3),
                                   stacked(out, ["normal_x", "normal_y", "normal_z"]))
 

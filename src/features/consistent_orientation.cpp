@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "../mesh/disjoint_sets.h"
+#include "pcl_ddg/interruption.h"
 #include "pcl_ddg/search/point_kd_tree.h"
 
 #ifdef _OPENMP
@@ -246,6 +247,7 @@ ConsistentOrientationReport orientNormalsConsistently(const pcl::PointCloud<pcl:
   // Each point's k nearest others fill its own k slots: the edge list does not depend on threads.
   const int k = options.k;
   std::vector<GraphEdge> slots(points.size() * static_cast<std::size_t>(k), GraphEdge{-1, -1});
+  detail::InterruptionPoll interruption;
 #ifdef _OPENMP
   const int threads =
       options.threads > 0 ? static_cast<int>(options.threads) : omp_get_max_threads();
@@ -256,6 +258,7 @@ ConsistentOrientationReport orientNormalsConsistently(const pcl::PointCloud<pcl:
     std::vector<float> distances;
 #pragma omp for schedule(dynamic, 1024)
     for (std::int64_t p = 0; p < static_cast<std::int64_t>(points.size()); ++p) {
+      if (interruption.stopped()) continue;
       const int i = points[p];
       tree.nearestK(cloud[i].data, k + 1, found, distances);
       int slot = 0;
@@ -265,6 +268,7 @@ ConsistentOrientationReport orientNormalsConsistently(const pcl::PointCloud<pcl:
       }
     }
   }
+  interruption.throwIfStopped();
   slots.erase(
       std::remove_if(slots.begin(), slots.end(), [](const GraphEdge& e) { return e.first < 0; }),
       slots.end());

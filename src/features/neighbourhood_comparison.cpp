@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "pcl_ddg/interruption.h"
 #include "pcl_ddg/search/kd_tree_search.h"
 #include "pcl_ddg/search/mesh_ring_search.h"
 #include "pcl_ddg/search/organized_grid_search.h"
@@ -37,12 +38,14 @@ Eigen::VectorXd jaccardOverlaps(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
   tree.setInputCloud(cloud);
   const auto n = static_cast<Eigen::Index>(cloud->size());
   Eigen::VectorXd overlap(n);
+  detail::InterruptionPoll interruption;
 #pragma omp parallel
   {
     pcl::Indices a, b, common;
     std::vector<float> distances;
 #pragma omp for schedule(dynamic, 256)
     for (Eigen::Index i = 0; i < n; ++i) {
+      if (interruption.stopped()) continue;
       const auto index = static_cast<pcl::index_t>(i);
       if (grid_window) {
         grid->windowSearch(index, gridWindowRadius(options.k), a, distances);
@@ -63,6 +66,7 @@ Eigen::VectorXd jaccardOverlaps(const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& 
           united > 0 ? static_cast<double>(common.size()) / static_cast<double>(united) : 0.0;
     }
   }
+  interruption.throwIfStopped();
   return overlap;
 }
 

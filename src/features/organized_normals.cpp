@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pcl_ddg/features/plane_fit.h"
+#include "pcl_ddg/interruption.h"
 #include "vector_lanes.h"
 #include "window_masks.h"
 #include "window_sums.h"
@@ -118,6 +119,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
   const int tiles_y = (image.height + kTile - 1) / kTile;
   const std::uint64_t flood_shape = windowShape(w);
   std::int64_t failed = 0, window_points = 0, jump_points = 0;
+  detail::InterruptionPoll interruption;
 #pragma omp parallel reduction(+ : failed, window_points, jump_points) num_threads(threads)
   {
     detail::WindowSums sums(*cloud, positions, finite, w);
@@ -128,6 +130,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
     Eigen::Matrix3Xd points(3, (2 * w + 1) * (2 * w + 1));
 #pragma omp for schedule(dynamic, 1)
     for (int tile = 0; tile < tiles_x * tiles_y; ++tile) {
+      if (interruption.stopped()) continue;
       const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
       const int x1 = std::min(image.width, x0 + kTile), y1 = std::min(image.height, y0 + kTile);
       const int tile_width = x1 - x0;
@@ -198,6 +201,7 @@ OrganizedNormalResult computeOrganizedPCANormals(
       }
     }
   }
+  interruption.throwIfStopped();
   result.failed_points = failed;
   result.window_points = window_points;
   result.jump_points = jump_points;

@@ -61,6 +61,9 @@ LocalCloud makeLocalCloud(const PositionsRef& positions, const Eigen::Vector3d& 
     points->width = width;
     points->height = static_cast<std::uint32_t>(points->size() / width);
   }
+  // PCL's default sensor, the origin, where it lies in the local frame (organized clouds measure
+  // ranges from it); a caller who knows the sensor sets its own.
+  points->sensor_origin_.head<3>() = (-origin).cast<float>();
   LocalCloud cloud;
   cloud.points = std::move(points);
   cloud.positions = std::move(relative);

@@ -60,7 +60,8 @@ struct LocalCloud {
 /** positions (world coordinates) relative to origin, and their float points (NaN kept; is_dense
  *  when all are finite), organized width points per row when width > 0 (it must divide their
  *  number). The doubles are kept only where the floats do not hold them exactly (a float file's
- *  coordinates near the origin need none). */
+ *  coordinates near the origin need none). The points' sensor_origin_ is the world origin in the
+ *  local frame (PCL's default sensor; organized clouds measure their ranges from it). */
 LocalCloud makeLocalCloud(const PositionsRef& positions, const Eigen::Vector3d& origin,
                           std::uint32_t width = 0);
 

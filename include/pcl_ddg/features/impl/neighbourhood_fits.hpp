@@ -6,6 +6,7 @@
 
 #include "pcl_ddg/features/neighbourhood_fits.h"
 #include "pcl_ddg/features/spatial_order.h"
+#include "pcl_ddg/interruption.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -29,6 +30,7 @@ FitCounts fitNeighbourhoods(const NeighbourhoodQueries<PointInT>& queries,
     query_positions[i] = input[indices[i]].getVector3fMap();
   const std::vector<int> order = spatialOrder(query_positions);
   const bool capped_radius = queries.radius > 0.0 && queries.max_neighbours > 0;
+  InterruptionPoll interruption;
 #pragma omp parallel num_threads(queries.threads) reduction(+ : failed, fell_back)
   {
     // Per-thread buffers, grown once and reused for every point.
@@ -37,6 +39,7 @@ FitCounts fitNeighbourhoods(const NeighbourhoodQueries<PointInT>& queries,
     Eigen::Matrix3Xd local(3, 64);
 #pragma omp for schedule(dynamic, 256)
     for (std::ptrdiff_t visit = 0; visit < static_cast<std::ptrdiff_t>(indices.size()); ++visit) {
+      if (interruption.stopped()) continue;
       const std::ptrdiff_t i = order[visit];
       const PointInT& query = input[indices[i]];
       // Sized to k before every search, as pcl::NormalEstimationOMP does: a search may write its
@@ -88,6 +91,7 @@ FitCounts fitNeighbourhoods(const NeighbourhoodQueries<PointInT>& queries,
       if (outcome == FitOutcome::FellBack) ++fell_back;
     }
   }
+  interruption.throwIfStopped();
   return {failed, fell_back};
 }
 

@@ -8,6 +8,7 @@
 #include "pcl_ddg/features/robust_normal_estimation.h"
 #include "pcl_ddg/features/robust_plane_fit.h"
 #include "pcl_ddg/features/widening_planes.h"
+#include "pcl_ddg/interruption.h"
 
 namespace pcl_ddg {
 
@@ -104,13 +105,14 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
     }
     query_graph = NeighbourGraph();  // every query is a node: its rows are no longer needed
   }
+  detail::InterruptionPoll interruption;
 #pragma omp parallel num_threads(threads)
   {
     pcl::Indices found;
     std::vector<float> distances;
 #pragma omp for schedule(dynamic, 256)
     for (std::ptrdiff_t j = 0; j < static_cast<std::ptrdiff_t>(surface.size()); ++j) {
-      if (has_row[j] || !pcl::isXYZFinite(surface[j])) continue;
+      if (interruption.stopped() || has_row[j] || !pcl::isXYZFinite(surface[j])) continue;
       found.resize(width);
       distances.resize(width);
       const int answered = tree.nearestKSearch(surface, static_cast<pcl::index_t>(j),
@@ -121,6 +123,7 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
         if (pcl::isXYZFinite(surface[found[f]])) node_graph.neighbours[j * width + n++] = found[f];
     }
   }
+  interruption.throwIfStopped();
   const std::vector<WidePlane> planes = widestPlanes(nodes, node_graph, queries, query_nodes,
                                                      query_graph, largest_reference, threads);
   const auto finite = static_cast<int>(std::count_if(
