@@ -92,12 +92,66 @@ def test_orient_normals_only_changes_signs():
     assert np.all(up.normals[:, 2] >= 0)
 
 
+def _plate(n: int, z: float, seed: int, flip: bool):
+    """A jittered n x n grid over [-1, 1]^2 at height z (jitter in the plane: flat exactly),
+    two triangles per cell, wound towards +z (or -z when flip)."""
+    h = 2.0 / n
+    u, v = np.meshgrid(np.linspace(-1, 1, n + 1), np.linspace(-1, 1, n + 1), indexing="ij")
+    xy = np.stack([u.ravel(), v.ravel()], axis=1)
+    xy += np.random.default_rng(seed).uniform(-0.1 * h, 0.1 * h, xy.shape)
+    V = np.column_stack([xy, np.full(len(xy), z)])
+    index = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    a, b = index[:-1, :-1].ravel(), index[1:, :-1].ravel()
+    c, d = index[1:, 1:].ravel(), index[:-1, 1:].ravel()
+    F = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    return V, (F[:, [0, 2, 1]] if flip else F)
+
+
+def test_compare_neighbourhoods_on_two_close_sheets_against_brute_force():
+    # Two flat plates 1.5 h apart (h = 1/12). Mesh rings stay on their plate, whose points are
+    # coplanar: their PCA normal is the plate's, +-z, exactly. So the angle difference at a vertex
+    # is the angle of the k-nearest PCA normal to z, computed here by brute force (numpy's eigh of
+    # the covariance of the 16 nearest, the vertex included), and on average it is large: the
+    # kd-tree's neighbourhoods reach the other plate.
+    n, k = 24, 16
+    top, top_faces = _plate(n, 0.0, 1, flip=False)
+    bottom, bottom_faces = _plate(n, -1.5 * 2.0 / n, 2, flip=True)
+    V = np.vstack([top, bottom])
+    F = np.vstack([top_faces, bottom_faces + len(top)])
+    c = pcl_ddg.compare_neighbourhoods(V, F, k=k)
+    assert c.angle_difference.shape == (len(V),) and c.overlap.shape == (len(V),)
+    assert np.isfinite(c.angle_difference).all()
+    P = V.astype(np.float32).astype(np.float64)  # the coordinates the estimator fits (float)
+    d2 = ((P[:, None, :] - P[None, :, :]) ** 2).sum(axis=2)
+    order = np.argsort(d2, axis=1, kind="stable")
+    expected = np.empty(len(V))
+    same_plate = np.empty(len(V))
+    for i in range(len(V)):
+        nearest = order[i, :k]
+        centred = P[nearest] - P[nearest].mean(axis=0)
+        normal = np.linalg.eigh(centred.T @ centred)[1][:, 0]
+        expected[i] = np.degrees(np.arccos(min(abs(normal[2]), 1.0)))
+        # the ring side's neighbours: the same plate; the kd-tree's: how many from it
+        same_plate[i] = np.mean((nearest < len(top)) == (i < len(top)))
+    np.testing.assert_allclose(c.angle_difference, expected, rtol=0, atol=1e-3)
+    assert expected.mean() > 15.0
+    assert np.all(c.overlap <= same_plate + 1e-12)  # what the kd-tree took from the other plate
+    # The summary is of the arrays.
+    s = c.summary
+    assert s["compared"] == len(V)
+    assert s["mean"] == pytest.approx(expected.mean(), abs=1e-3)
+    assert s["max"] == pytest.approx(expected.max(), abs=1e-3)
+    assert s["share_over_30"] == pytest.approx(np.mean(c.angle_difference > 30.0))
+    assert s["mean_overlap"] == pytest.approx(c.overlap.mean())
+
+
 def test_compare_neighbourhoods_on_a_mesh():
     V, F = icosphere(3)
     c = pcl_ddg.compare_neighbourhoods(V, F, k=12)
     assert c.angle_difference.shape == (V.shape[0],)
     assert c.summary["compared"] == V.shape[0]
     assert np.all((c.overlap >= 0) & (c.overlap <= 1))
+    assert c.summary["mean"] == pytest.approx(c.angle_difference.mean())
 
 
 def _survey_scene(seed: int = 5) -> np.ndarray:

@@ -49,14 +49,26 @@ def test_organized_cloud_and_viewpoint(tmp_path):
 
 
 def test_shared_scans_read():
+    # Counts from the shared data's CATALOG.md (measured there with other tools).
     data = shared_data()
     office = pcl_ddg.read(data / "clouds" / "office1.pcd")
     assert office.organized_shape == (480, 640) and office.faces is None
+    assert office.points.shape == (307200, 3)
     assert office.fields["rgb"].dtype == np.uint8 and office.fields["rgb"].shape == (307200, 3)
+    # A Kinect frame: a pixel has a whole point or none (NaN x y z), and most have one.
+    finite = np.isfinite(office.points)
+    assert np.array_equal(finite.all(axis=1), finite.any(axis=1))
+    assert 0.5 * 307200 < finite.all(axis=1).sum() < 307200
+    np.testing.assert_array_equal(office.grid.reshape(-1, 3), office.points)
     igea = pcl_ddg.read(data / "meshes" / "igea.ply")  # faces as one tristrips element
-    assert len(igea.faces) > 268000
-    quads = pcl_ddg.read(data / "meshes" / "bun045_rangegrid_tri.ply")
-    assert quads.points.shape[1] == 3
+    assert igea.points.shape == (134345, 3) and len(igea.faces) == 268686
+    assert np.isfinite(igea.points).all()
+    assert int(np.max(igea.faces)) < len(igea.points) and int(np.min(igea.faces)) >= 0
+    grid = pcl_ddg.read(data / "meshes" / "bun045_rangegrid_tri.ply")
+    assert grid.points.shape == (40097, 3) and len(grid.faces) == 79057
+    assert np.isfinite(grid.points).all()
+    # its 6 unused vertices (CATALOG.md): every other vertex is a corner of some triangle
+    assert len(grid.points) - len(np.unique(np.asarray(grid.faces))) == 6
 
 
 def test_file_errors_are_oserrors(tmp_path):

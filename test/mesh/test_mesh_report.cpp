@@ -3,6 +3,9 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "analytic_surfaces.h"
@@ -106,6 +109,98 @@ TEST(MeshReport, JsonHasEveryDocumentedKey) {
     EXPECT_NE(json.find(std::string("\"") + key + "\": "), std::string::npos) << key;
   }
   EXPECT_NE(json.find("\"genus\": 0"), std::string::npos);
+}
+
+// toText, line by line, on boxes whose every count is known by hand: a closed box [0,1] x [0,2] x
+// [0,3] of six quads (each split into two triangles along a diagonal: 12 box edges and 6
+// diagonals), and the same box without its top, with an unreferenced vertex and a triangle with a
+// repeated corner.
+std::map<std::string, std::string> textReportLines(const std::string& text) {
+  std::map<std::string, std::string> lines;
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    const std::size_t colon = line.find(':');
+    EXPECT_NE(colon, std::string::npos) << line;
+    if (colon == std::string::npos) continue;
+    const std::size_t value = line.find_first_not_of(' ', colon + 1);
+    EXPECT_EQ(lines.count(line.substr(0, colon)), 0u) << "repeated: " << line;
+    lines[line.substr(0, colon)] = value == std::string::npos ? "" : line.substr(value);
+  }
+  return lines;
+}
+
+TEST(MeshReport, TextReportStatesEveryCountOfAClosedAndAnOpenBox) {
+  Eigen::Matrix3Xd p(3, 9);
+  for (int v = 0; v < 8; ++v) p.col(v) = Eigen::Vector3d(v & 1, 2 * ((v >> 1) & 1), 3 * (v >> 2));
+  p.col(8) = Eigen::Vector3d(0.5, 1.0, 1.5);  // inside the box: no triangle uses it
+  // Outward quads (corner index x + 2y + 4z), the top last.
+  const std::vector<std::vector<int>> sides = {
+      {0, 2, 3, 1}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  const std::vector<int> top = {4, 5, 7, 6};
+  const double box_edges = 4 * (1.0 + 2.0 + 3.0);
+  const double d12 = std::sqrt(5.0), d13 = std::sqrt(10.0), d23 = std::sqrt(13.0);
+
+  std::vector<std::vector<int>> closed_faces = sides;
+  closed_faces.push_back(top);
+  const Eigen::Matrix3Xd corners = p.leftCols(8);
+  const pcl::PolygonMesh closed = makeMesh(corners, closed_faces);
+  const auto closed_lines = textReportLines(makeMeshReport(MeshTopology(closed), corners).toText());
+  const std::map<std::string, std::string> closed_expected = {
+      {"vertices", "8"},
+      {"faces", "6  [4-gons: 6]"},
+      {"triangles", "12"},
+      {"edges", "18"},
+      {"out-of-range faces", "0"},
+      {"degenerate faces", "0 (zero area: 0)"},
+      {"duplicate faces", "0"},
+      {"boundary edges", "0 in 0 loops"},
+      {"non-manifold edges", "0"},
+      {"non-manifold vertices", "0"},
+      {"unreferenced vertices", "0"},
+      {"non-finite vertices", "0"},
+      {"components", "1"},
+      {"Euler characteristic", "2"},  // 8 - 18 + 12
+      {"genus", "0"},
+      {"orientable", "yes, consistently oriented"},
+      {"bounding box", "[0 0 0] .. [1 2 3]"}};
+  // The 17 facts above and the mean edge length, each once.
+  EXPECT_EQ(closed_lines.size(), closed_expected.size() + 1);
+  for (const auto& [label, value] : closed_expected) {
+    ASSERT_EQ(closed_lines.count(label), 1u) << label;
+    EXPECT_EQ(closed_lines.at(label), value) << label;
+  }
+  // Printed to 6 significant digits: two diagonals of each face shape.
+  ASSERT_EQ(closed_lines.count("mean edge length"), 1u);
+  const double closed_mean = (box_edges + 2 * (d12 + d13 + d23)) / 18;
+  EXPECT_NEAR(std::stod(closed_lines.at("mean edge length")), closed_mean, 1e-5 * closed_mean);
+
+  // Without the top: 12 box edges (the top's four are the boundary loop) and 5 diagonals;
+  // V - E + T = 8 - 17 + 10 = 1 (the unreferenced vertex is not counted), a disk: no genus.
+  std::vector<std::vector<int>> open_faces = sides;
+  open_faces.push_back({0, 0, 1});
+  const pcl::PolygonMesh open = makeMesh(p, open_faces);
+  const auto open_lines = textReportLines(makeMeshReport(MeshTopology(open), p).toText());
+  const std::map<std::string, std::string> open_expected = {
+      {"vertices", "9"},
+      {"faces", "6  [3-gons: 1]  [4-gons: 5]"},
+      {"triangles", "10"},
+      {"edges", "17"},
+      {"degenerate faces", "1 (zero area: 0)"},
+      {"boundary edges", "4 in 1 loops"},
+      {"unreferenced vertices", "1"},
+      {"components", "1"},
+      {"Euler characteristic", "1"},
+      {"genus", "n/a"},
+      {"orientable", "yes, consistently oriented"},
+      {"bounding box", "[0 0 0] .. [1 2 3]"}};
+  EXPECT_EQ(open_lines.size(), closed_lines.size());
+  for (const auto& [label, value] : open_expected) {
+    ASSERT_EQ(open_lines.count(label), 1u) << label;
+    EXPECT_EQ(open_lines.at(label), value) << label;
+  }
+  const double open_mean = (box_edges + d12 + 2 * (d13 + d23)) / 17;
+  EXPECT_NEAR(std::stod(open_lines.at("mean edge length")), open_mean, 1e-5 * open_mean);
 }
 
 }  // namespace

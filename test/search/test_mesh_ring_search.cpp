@@ -159,6 +159,8 @@ TEST(MeshRingSearch, PCLNormalEstimationRunsOnItUnchanged) {
   parallel.compute(parallel_normals);
   const AngleErrors difference =
       angleErrors(normalsOf(parallel_normals), normalsOf(normals), SignMode::Unsigned);
+  ASSERT_EQ(parallel_normals.size(), cloud->size());
+  EXPECT_EQ(difference.invalid, 0) << "NaN normals from the OpenMP variant";
   EXPECT_LT(difference.max, 1e-3);
 }
 

@@ -1,14 +1,19 @@
 // OrganizedGridSearch: pixel-grid neighbourhoods of organized clouds, checked against brute force
 // over the window and on synthetic range images with a depth step.
 #include <gtest/gtest.h>
+#include <pcl/common/point_tests.h>
 #include <pcl/exceptions.h>
 #include <pcl/features/normal_3d.h>
+#include <pcl/io/pcd_io.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <vector>
 
 #include "pcl_ddg/search/organized_grid_search.h"
 #include "range_images.h"
+#include "test_data.h"
 
 namespace pcl_ddg {
 namespace {
@@ -111,6 +116,79 @@ TEST(OrganizedGridSearch, NeverReturnsPixelsAcrossADepthJumpOrWithoutAPoint) {
     if (!std::isfinite((*holes.cloud)[i].x)) continue;
     search->nearestKSearch(static_cast<pcl::index_t>(i), 9, indices, distances);
     for (const pcl::index_t n : indices) EXPECT_TRUE(std::isfinite((*holes.cloud)[n].x));
+  }
+}
+
+// windowSearch against the test's own flood fill of the header's rule (test::WindowReachOracle):
+// the same pixels, the query first, each with its squared distance. On the synthetic frames every
+// pixel (the box's 5 % step and the sphere's limb cut windows), the scene 1e5 from the origin
+// (ranges are measured from the sensor origin, not the coordinates' origin: from there the box's
+// step would be 0.1 % of the range, and no window would be cut), and every 5th pixel of a Kinect
+// frame (holes and steps everywhere).
+TEST(OrganizedGridSearch, WindowSearchReachesExactlyThePixelsOfABruteForceFloodFill) {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr office(new pcl::PointCloud<pcl::PointXYZ>);
+  ASSERT_EQ(pcl::io::loadPCDFile(test::sharedData("clouds/office1.pcd"), *office), 0);
+  const struct {
+    const char* name;
+    pcl::PointCloud<pcl::PointXYZ>::ConstPtr cloud;
+    int every;
+  } frames[] = {
+      {"box on wall", renderRangeImage(RangeScene::BoxOnWall, PinholeCamera{}).cloud, 1},
+      {"sphere", renderRangeImage(RangeScene::Sphere, PinholeCamera{}, 2e-3, 7).cloud, 1},
+      {"box on wall far from the origin",
+       renderRangeImage(RangeScene::BoxOnWall, PinholeCamera{}, 0.0, 1, {1e5, -1e5, 1e5}).cloud, 1},
+      {"office1.pcd", office, 5}};
+  for (const auto& frame : frames) {
+    SCOPED_TRACE(frame.name);
+    Search search;
+    search.setInputCloud(frame.cloud);
+    const test::WindowReachOracle oracle(*frame.cloud, search.maxDepthJump());
+    pcl::Indices found;
+    std::vector<float> distances;
+    for (const int radius : {1, 3, 5}) {
+      SCOPED_TRACE(radius);
+      int compared = 0, cut = 0, ambiguous = 0;
+      for (std::size_t i = 0; i < frame.cloud->size(); i += frame.every) {
+        bool near_threshold = false;
+        const std::vector<int> expected =
+            oracle.reach(static_cast<int>(i), radius, &near_threshold);
+        if (near_threshold) {
+          ++ambiguous;
+          continue;
+        }
+        const int n = search.windowSearch(static_cast<pcl::index_t>(i), radius, found, distances);
+        ASSERT_EQ(n, static_cast<int>(expected.size())) << "pixel " << i;
+        ASSERT_EQ(found.size(), expected.size()) << "pixel " << i;
+        ASSERT_EQ(distances.size(), expected.size()) << "pixel " << i;
+        ASSERT_EQ(search.windowReach(static_cast<pcl::index_t>(i), radius), n) << "pixel " << i;
+        if (expected.empty()) continue;
+        ++compared;
+        EXPECT_EQ(found[0], static_cast<pcl::index_t>(i));
+        std::vector<int> sorted(found.begin(), found.end());
+        std::sort(sorted.begin(), sorted.end());
+        ASSERT_EQ(sorted, expected) << "pixel " << i;
+        const auto& cloud = *frame.cloud;
+        for (std::size_t k = 0; k < found.size(); ++k) {
+          EXPECT_FLOAT_EQ(
+              distances[k],
+              (cloud[found[k]].getVector3fMap() - cloud[i].getVector3fMap()).squaredNorm());
+        }
+        // A cut window: fewer pixels reached than the window holds with finite points.
+        const int u = static_cast<int>(i % cloud.width), v = static_cast<int>(i / cloud.width);
+        int finite = 0;
+        for (int y = std::max(0, v - radius); y <= std::min<int>(cloud.height - 1, v + radius); ++y)
+          for (int x = std::max(0, u - radius); x <= std::min<int>(cloud.width - 1, u + radius);
+               ++x)
+            finite += pcl::isXYZFinite(cloud(x, y));
+        cut += n < finite;
+      }
+      std::printf("%s, radius %d: %d windows, %d cut, %d with a step at the threshold\n",
+                  frame.name, radius, compared, cut, ambiguous);
+      EXPECT_GT(compared, 1000);
+      EXPECT_GT(cut, 50) << "no depth jump cut a window";
+      // A step at the threshold leaves out every window holding it (up to (2r + 1)^2 / 5 here).
+      EXPECT_LE(ambiguous, compared / 200);
+    }
   }
 }
 

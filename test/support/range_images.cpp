@@ -1,5 +1,6 @@
 #include "range_images.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -90,9 +91,9 @@ RangeImage renderRangeImage(RangeScene scene, const PinholeCamera& camera, doubl
   RangeImage image;
   image.cloud.reset(new pcl::PointCloud<pcl::PointXYZ>(camera.width, camera.height));
   image.cloud->is_dense = false;
-  image.cloud->sensor_origin_ = Eigen::Vector4f(static_cast<float>(offset.x()),
-                                                static_cast<float>(offset.y()),
-                                                static_cast<float>(offset.z()), 0.0f);
+  image.cloud->sensor_origin_ =
+      Eigen::Vector4f(static_cast<float>(offset.x()), static_cast<float>(offset.y()),
+                      static_cast<float>(offset.z()), 0.0f);
   image.normals.resize(image.cloud->size());
   std::vector<int> surface(image.cloud->size(), -1);
   const double cx = 0.5 * (camera.width - 1), cy = 0.5 * (camera.height - 1);
@@ -137,6 +138,53 @@ RangeImage renderRangeImage(RangeScene scene, const PinholeCamera& camera, doubl
     }
   }
   return image;
+}
+
+WindowReachOracle::WindowReachOracle(const pcl::PointCloud<pcl::PointXYZ>& cloud,
+                                     double max_depth_jump)
+    : width_(static_cast<int>(cloud.width)),
+      height_(static_cast<int>(cloud.height)),
+      max_depth_jump_(max_depth_jump),
+      range_(cloud.size(), kNaN) {
+  const Eigen::Vector3d origin = cloud.sensor_origin_.head<3>().cast<double>();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const pcl::PointXYZ& p = cloud[i];
+    if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z))
+      range_[i] = (Eigen::Vector3d(p.x, p.y, p.z) - origin).norm();
+  }
+}
+
+std::vector<int> WindowReachOracle::reach(int index, int radius, bool* ambiguous) const {
+  std::vector<int> reached;
+  if (!std::isfinite(range_[index])) return reached;
+  const int u0 = index % width_, v0 = index / width_, side = 2 * radius + 1;
+  std::vector<char> seen(static_cast<std::size_t>(side) * side, 0);
+  std::vector<int> stack = {index};
+  seen[static_cast<std::size_t>(radius) * side + radius] = 1;
+  while (!stack.empty()) {
+    const int pixel = stack.back();
+    stack.pop_back();
+    reached.push_back(pixel);
+    const int u = pixel % width_, v = pixel / width_;
+    for (int dv = -1; dv <= 1; ++dv) {
+      for (int du = -1; du <= 1; ++du) {
+        const int nu = u + du, nv = v + dv;
+        if ((du == 0 && dv == 0) || nu < 0 || nv < 0 || nu >= width_ || nv >= height_) continue;
+        if (std::abs(nu - u0) > radius || std::abs(nv - v0) > radius) continue;
+        char& mark = seen[static_cast<std::size_t>(nv - v0 + radius) * side + (nu - u0 + radius)];
+        if (mark) continue;
+        const double a = range_[pixel], b = range_[nv * width_ + nu];
+        if (!std::isfinite(b)) continue;
+        const double jump = std::abs(a - b), limit = max_depth_jump_ * std::min(a, b);
+        if (ambiguous && std::abs(jump - limit) <= 1e-6 * std::min(a, b)) *ambiguous = true;
+        if (jump > limit) continue;
+        mark = 1;
+        stack.push_back(nv * width_ + nu);
+      }
+    }
+  }
+  std::sort(reached.begin(), reached.end());
+  return reached;
 }
 
 }  // namespace test

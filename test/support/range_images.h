@@ -38,5 +38,24 @@ RangeImage renderRangeImage(RangeScene scene, const PinholeCamera& camera,
                             double relative_noise = 0.0, unsigned seed = 1,
                             const Eigen::Vector3d& offset = Eigen::Vector3d::Zero());
 
+/** Which pixels of an organized cloud's (2r + 1)^2 window a walk from its centre reaches, by the
+ *  rule of organized_grid_search.h written out here (a flood fill over the window, no code shared
+ *  with the search): a step joins two 8-adjacent pixels of the window when both hold finite
+ *  points and their ranges (distances from the cloud's sensor origin, here in double) differ by
+ *  at most max_depth_jump times the smaller one. */
+class WindowReachOracle {
+ public:
+  WindowReachOracle(const pcl::PointCloud<pcl::PointXYZ>& cloud, double max_depth_jump);
+  /** The reached pixel indices, sorted (empty where the centre has no finite point). ambiguous
+   *  (if given) is set when a step tested lies within 1e-6 of the rule's threshold, where the
+   *  search's float ranges could fall on the other side. */
+  std::vector<int> reach(int index, int radius, bool* ambiguous = nullptr) const;
+
+ private:
+  int width_, height_;
+  double max_depth_jump_;
+  std::vector<double> range_;  ///< NaN without a finite point
+};
+
 }  // namespace test
 }  // namespace pcl_ddg

@@ -27,7 +27,8 @@ constexpr bool kUnderAddressSanitizer = false;
 /** Path of a file under the shared data folder; fails the test loudly if the folder is missing. */
 std::string sharedData(const std::string& relative_path);
 
-/** A fresh empty folder for a test's files. */
+/** A fresh empty folder for a test's files (its name holds the process id), removed when the test
+ *  program ends unless a test failed (then its path is printed). */
 std::string scratchFolder(const std::string& name);
 
 /** Writes text to a file (for hand-made inputs). */

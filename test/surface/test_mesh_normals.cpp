@@ -21,6 +21,7 @@
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/operators/curvature.h"
 #include "pcl_ddg/surface/mesh_normals.h"
+#include "reference_operators.h"
 #include "test_data.h"
 
 namespace pcl_ddg {
@@ -192,15 +193,17 @@ const char* name(NormalWeighting w) {
 }
 
 TEST(MeshNormals, EveryWeightingMatchesTheExactNormalOnRegularMeshes) {
-  // Bounds about twice the errors measured per surface and weighting (uniform, area, angle, mean
+  // Bounds about twice the measured error, per surface and weighting (uniform, area, angle, mean
   // curvature), so that a wrong weighting cannot hide under a bound for the worst surface.
+  // Measured: torus 0.023 0.044 0.044 0.092, icosphere 0.249 0.338 0.149 0.239, saddle 0.537
+  // 0.538 0.451 0.538 degrees.
   const struct {
     const char* name;
     SurfaceSample surface;
     double bound_degrees[4];
-  } cases[] = {{"torus", makeTorus({128, 0.0, 1}).rotateAndShiftFar(), {1, 1, 1, 1}},
-               {"icosphere", makeIcosphere(4), {1, 1, 1, 1}},
-               {"saddle", makeSaddle({64, 0.0, 1}), {1, 1, 1, 1}}};
+  } cases[] = {{"torus", makeTorus({128, 0.0, 1}).rotateAndShiftFar(), {0.05, 0.09, 0.09, 0.18}},
+               {"icosphere", makeIcosphere(4), {0.5, 0.7, 0.3, 0.5}},
+               {"saddle", makeSaddle({64, 0.0, 1}), {1.1, 1.1, 0.9, 1.1}}};
   for (const auto& c : cases) {
     const MeshTopology t = topologyOf(c.surface);
     for (int i = 0; i < 4; ++i) {
@@ -220,8 +223,8 @@ TEST(MeshNormals, EveryWeightingMatchesTheExactNormalOnRegularMeshes) {
 TEST(MeshNormals, JitteredMeshesFaceWeightingsStayCloseMeanCurvatureDoesNot) {
   const SurfaceSample s = makeTorus({128, 0.1, 1}).rotateAndShiftFar();
   const MeshTopology t = topologyOf(s);
-  // About twice the measured errors (uniform, area, angle).
-  const double bound_degrees[] = {3, 3, 3};
+  // About twice the measured error (uniform, area, angle): measured 1.73, 2.62, 1.57 degrees.
+  const double bound_degrees[] = {3.5, 5.2, 3.1};
   for (int i = 0; i < 3; ++i) {
     const MeshNormals n = computeMeshNormals(t, s.points, {kAll[i]});
     EXPECT_EQ(n.invalid_vertices, 0);
@@ -231,11 +234,49 @@ TEST(MeshNormals, JitteredMeshesFaceWeightingsStayCloseMeanCurvatureDoesNot) {
     EXPECT_EQ(error.nonfinite, 0);
     EXPECT_LT(error.max_degrees, bound_degrees[i]) << name(kAll[i]);
   }
-  const AngleStats mean_curvature_error = maxAngle(
-      computeMeshNormals(t, s.points, {NormalWeighting::MeanCurvature}).normals, s.normals);
+  const MeshNormals mean_curvature =
+      computeMeshNormals(t, s.points, {NormalWeighting::MeanCurvature});
+  const AngleStats mean_curvature_error = maxAngle(mean_curvature.normals, s.normals);
   std::printf("jittered torus, mean-curvature normals: max error %.1f deg\n",
               mean_curvature_error.max_degrees);
   EXPECT_EQ(mean_curvature_error.nonfinite, 0);
+  // Why the error must exceed 5 degrees: the mean-curvature normal is the direction of
+  // -M^-1 L x (the header), checked here against the reference cotangent Laplacian and mass
+  // (reference_operators.h) wherever |M^-1 L x| is clear of the flatness threshold; and on this
+  // mesh that vector itself, computed here, leaves the exact normal by more than 5 degrees at some
+  // vertex: the jitter gives L x a tangential part of order jitter x cotangent weights, against a
+  // normal part 2 |H| times the vertex area, which does not vanish as the mesh is refined.
+  const Eigen::SparseMatrix<double> l = referenceCotangentLaplacian(t, s.points);
+  const Eigen::VectorXd mass = referenceMass(t, s.points);
+  const Eigen::Matrix3Xd relative = s.points.colwise() - s.points.col(0);  // L 1 = 0
+  const Eigen::Matrix3Xd lx = (l * relative.transpose()).transpose();
+  const Eigen::Matrix3Xd area_normals = computeMeshNormals(t, s.points, {}).normals;
+  const double epsilon = 0.02 / meanEdgeLength(t, s.points);
+  Eigen::Matrix3Xd reference = Eigen::Matrix3Xd::Constant(3, t.numVertices(), 0.0);
+  Eigen::Matrix3Xd ours = reference, exact = reference;
+  int compared = 0;
+  for (int v = 0; v < t.numVertices(); ++v) {
+    if (lx.col(v).norm() / mass[v] < 1.1 * epsilon) continue;  // flat: the area normal is used
+    Eigen::Vector3d direction = -lx.col(v);
+    if (direction.dot(area_normals.col(v)) < 0.0) direction = -direction;
+    reference.col(compared) = direction;
+    ours.col(compared) = mean_curvature.normals.col(v);
+    exact.col(compared) = s.normals.col(v);
+    ++compared;
+  }
+  reference.conservativeResize(3, compared);
+  ours.conservativeResize(3, compared);
+  exact.conservativeResize(3, compared);
+  const AngleStats to_reference = maxAngle(ours, reference);
+  const AngleStats reference_error = maxAngle(reference, exact);
+  std::printf(
+      "%d of %d vertices off the threshold: %.1e deg from -M^-1 L x, which is %.1f deg "
+      "from the exact normal\n",
+      compared, t.numVertices(), to_reference.max_degrees, reference_error.max_degrees);
+  EXPECT_GT(compared, t.numVertices() / 2);
+  EXPECT_EQ(to_reference.nonfinite, 0);
+  EXPECT_LT(to_reference.max_degrees, 1e-4);
+  EXPECT_GT(reference_error.max_degrees, 5.0);
   EXPECT_GT(mean_curvature_error.max_degrees, 5.0);
   EXPECT_LT(mean_curvature_error.max_degrees, 45.0);
 }

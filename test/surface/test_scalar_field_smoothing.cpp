@@ -12,6 +12,8 @@
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/operators/curvature.h"
 #include "pcl_ddg/surface/scalar_field_smoothing.h"
+#include "reference_operators.h"
+#include "smoothing_support.h"
 
 namespace pcl_ddg {
 namespace test {
@@ -78,6 +80,67 @@ TEST(ScalarFieldSmoothing, AFirstSphericalHarmonicDecaysAtItsEigenvalue) {
   }
   // Two levels are h / 4: the eigenvalue is second-order accurate.
   EXPECT_GT(std::log(errors[0] / errors[1]) / std::log(4.0), 1.8);
+}
+
+// HeatFlowParameters::mass chooses M in both schemes: each type's flow against backward and
+// forward Euler on the reference operators (reference_operators.h: L and that type's M assembled
+// triangle by triangle, solved by Eigen's SimplicialLLT), and the three types' results differ on a
+// jittered sphere, whose obtuse triangles make the Voronoi, mixed and barycentric cells differ.
+TEST(ScalarFieldSmoothing, TheMassParameterIsTheMassOfBothSchemes) {
+  const SurfaceSample sphere = makeIcosphere(3, 1.0, 0.2, 3);
+  const MeshTopology topology = topologyOf(sphere);
+  const Eigen::VectorXd field = noise(sphere.points.cols(), 8).array() + 2.0;
+  const double h = meanEdgeLength(topology, sphere.points);
+  const Eigen::VectorXd mixed = referenceMass(topology, sphere.points, MassType::MixedVoronoi);
+  const Eigen::VectorXd voronoi = referenceMass(topology, sphere.points, MassType::Voronoi);
+  const Eigen::VectorXd barycentric = referenceMass(topology, sphere.points, MassType::Barycentric);
+  // The premises: every Voronoi cell is positive (the implicit system stays definite), and the
+  // types differ.
+  ASSERT_GT(voronoi.minCoeff(), 0.0);
+  ASSERT_GT((voronoi - mixed).cwiseAbs().maxCoeff(), 1e-3 * mixed.mean());
+  ASSERT_GT((barycentric - mixed).cwiseAbs().maxCoeff(), 1e-3 * mixed.mean());
+  const Eigen::SparseMatrix<double> l = referenceCotangentLaplacian(topology, sphere.points);
+  const double stable_step = 0.5 * explicitStabilityLimit(topology, sphere.points);
+  Eigen::VectorXd results[2][3];
+  for (const SmoothingScheme scheme : {SmoothingScheme::Implicit, SmoothingScheme::Explicit}) {
+    const bool implicit = scheme == SmoothingScheme::Implicit;
+    int t = 0;
+    for (const MassType type : {MassType::Barycentric, MassType::Voronoi, MassType::MixedVoronoi}) {
+      SCOPED_TRACE(testing::Message() << (implicit ? "implicit" : "explicit") << ", mass type "
+                                      << static_cast<int>(type));
+      HeatFlowParameters p;
+      p.scheme = scheme;
+      p.mass = type;
+      p.iterations = implicit ? 3 : 10;
+      // Half the mixed mass's stability limit: below the other types' too (checked by the
+      // reference not blowing up, and by agreeing with it).
+      const double tau = implicit ? h * h : 0.5 * stable_step;
+      p.diffusion_time = p.iterations * tau;
+      p.implicit_solver = ImplicitSolver::Cholesky;
+      const Eigen::VectorXd ours = smoothScalarField(topology, sphere.points, field, p);
+      Eigen::VectorXd expected;
+      const Eigen::VectorXd m = referenceMass(topology, sphere.points, type);
+      if (implicit) {
+        expected = referenceBackwardEuler(topology, sphere.points, field, tau, p.iterations, type);
+      } else {
+        expected = field;
+        for (int i = 0; i < p.iterations; ++i) {
+          const Eigen::VectorXd lf = l * expected;
+          expected += tau * lf.cwiseQuotient(m);
+        }
+      }
+      EXPECT_LT((ours - expected).cwiseAbs().maxCoeff(), 1e-10 * field.cwiseAbs().maxCoeff());
+      // and the flow conserves that type's mass-weighted sum (1^T L = 0)
+      EXPECT_NEAR(m.dot(ours) / m.dot(field), 1.0, 1e-12);
+      results[implicit ? 0 : 1][t++] = ours;
+    }
+  }
+  for (int scheme = 0; scheme < 2; ++scheme) {
+    for (int t = 0; t < 2; ++t) {
+      EXPECT_GT((results[scheme][t] - results[scheme][2]).cwiseAbs().maxCoeff(), 1e-4)
+          << "scheme " << scheme << ", type " << t << " gives the mixed mass's result";
+    }
+  }
 }
 
 TEST(ScalarFieldSmoothing, InsulatedOrFixedBoundary) {

@@ -11,6 +11,8 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "data_catalogue.h"
 #include "pcl_ddg/io/mesh_io.h"
@@ -139,7 +141,37 @@ TEST(LasTools, ClassesArgumentErrors) {
   EXPECT_FALSE(std::filesystem::exists(folder + "/o.las"));
   const ToolRun quadric = runTool(
       PCL_DDG_CURVATURE_TOOL, sharedData(kSurvey) + " " + folder + "/q.las -radius 5 -classes 2,6");
-  EXPECT_EQ(quadric.exit_code, 0) << quadric.err;
+  ASSERT_EQ(quadric.exit_code, 0) << quadric.err;
+  // Two classes at once: the points of either are fitted (counted here from the input; this
+  // trimmed survey has no class 6, so they are the ground's 26107), every point is written where it
+  // was, the others have NaN curvatures, and so do the fitted points the run reports as without
+  // an estimate or with NaN curvatures.
+  const MeshFile las = readMeshFile(sharedData(kSurvey));
+  const Eigen::VectorXd classes = vertexScalarField(las.mesh.cloud, "classification");
+  const long selected = (classes.array() == 2.0 || classes.array() == 6.0).count();
+  EXPECT_EQ(selected, 26107);
+  EXPECT_NE(quadric.err.find("fitting " + std::to_string(selected) + " of 110000 points"),
+            std::string::npos)
+      << quadric.err;
+  const auto reported = [&](const std::string& what) {
+    const std::size_t at = quadric.err.find(what);
+    if (at == std::string::npos) return 0L;
+    const std::size_t start = quadric.err.rfind("warning: ", at) + std::strlen("warning: ");
+    return std::stol(quadric.err.substr(start, at - start));
+  };
+  const long without = reported(" points without an estimate");
+  const long no_curvature = reported(" points with too few neighbours or an ill-conditioned");
+  const MeshFile q = readMeshFile(folder + "/q.las");
+  ASSERT_EQ(q.positions, las.positions);
+  const Eigen::VectorXd mean = vertexScalarField(q.mesh.cloud, "mean_curvature");
+  long finite_elsewhere = 0, finite_selected = 0;
+  for (Eigen::Index i = 0; i < mean.size(); ++i) {
+    const bool chosen = classes[i] == 2.0 || classes[i] == 6.0;
+    (chosen ? finite_selected : finite_elsewhere) += std::isfinite(mean[i]);
+  }
+  EXPECT_EQ(finite_elsewhere, 0);
+  EXPECT_EQ(finite_selected, selected - without - no_curvature) << quadric.err;
+  EXPECT_GT(finite_selected, selected / 2);
 }
 
 TEST(LasTools, BatchModeReadsAndWritesLas) {
@@ -150,6 +182,15 @@ TEST(LasTools, BatchModeReadsAndWritesLas) {
   const ToolRun run = runTool(PCL_DDG_NORMALS_TOOL, "-input_dir " + folder + "/in -output_dir " +
                                                         folder + "/out -method pca -k 8");
   ASSERT_EQ(run.exit_code, 0) << run.err;
+  // The batch takes the files of the extensions it reads (.las, not .laz): the LAZ file is left
+  // out, so one file is done and nothing is written for it.
+  EXPECT_NE(run.err.find("pcl_ddg_normals: 1 files, 1 done, 0 failed\n"), std::string::npos)
+      << run.err;
+  EXPECT_EQ(run.err.find("b.laz"), std::string::npos) << run.err;
+  std::vector<std::string> written;
+  for (const auto& entry : std::filesystem::directory_iterator(folder + "/out"))
+    written.push_back(entry.path().filename().string());
+  EXPECT_EQ(written, std::vector<std::string>{"a.las"});
   const MeshFile out = readMeshFile(folder + "/out/a.las");
   EXPECT_EQ(out.las->version_minor, 4);
   EXPECT_EQ(out.las->point_format, 6);

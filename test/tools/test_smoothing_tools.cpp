@@ -133,6 +133,8 @@ TEST_F(SmoothingTools, ExplicitStepsAboveTheStabilityBoundAreRefusedUnlessAllowe
   const ToolRun allowed = runTool(PCL_DDG_SMOOTH_TOOL, cow + " " + path("c.ply") +
                                                            " -method explicit -lambda_dt 1.5 "
                                                            "-iterations 2 -allow_unstable");
+  EXPECT_EQ(allowed.exit_code, 0) << allowed.err;
+  EXPECT_TRUE(std::filesystem::exists(path("c.ply")));
   EXPECT_NE(allowed.err.find("warning: the steps exceed the stability bound"), std::string::npos)
       << allowed.err;
 }
