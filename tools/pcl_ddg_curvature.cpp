@@ -9,6 +9,7 @@
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/operators/curvature.h"
 #include "pcl_ddg/render/color_map.h"
+#include "pcl_ddg/result_warnings.h"
 #include "pcl_ddg/surface/scalar_field_smoothing.h"
 
 namespace {
@@ -121,20 +122,7 @@ int run(int argc, char** argv) {
           tools::Timer timer("Computing curvatures");
           const VertexCurvatures c = computeCurvatures(*in.topology, in.positions, mass);
           timer.done(static_cast<std::size_t>(in.positions.cols()));
-          if (c.invalid_vertices > c.unoriented_vertices) {
-            tools::warn(kName, std::to_string(c.invalid_vertices - c.unoriented_vertices) +
-                                   " vertices without area (NaN)");
-          }
-          if (c.unoriented_vertices > 0) {
-            tools::warn(kName,
-                        std::to_string(c.unoriented_vertices) +
-                            " vertices whose face normals cancel (reversed duplicate faces?): "
-                            "H, k1, k2 NaN there");
-          }
-          if (c.clamped_vertices > 0) {
-            tools::warn(kName, std::to_string(c.clamped_vertices) +
-                                   " vertices with H^2 < K (umbilic or noisy): k1 = k2 = H there");
-          }
+          for (const std::string& message : curvatureWarnings(c)) tools::warn(kName, message);
           curvatures = {c.mean_curvature, c.gauss_curvature, c.k1, c.k2};
           setVertexField(in.mesh.cloud, "vertex_area", c.vertex_area, precision);
         } else {

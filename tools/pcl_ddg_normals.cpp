@@ -8,6 +8,7 @@
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/render/mesh_render.h"
+#include "pcl_ddg/result_warnings.h"
 #include "pcl_ddg/surface/mesh_normals.h"
 #include "pcl_ddg/tiling/out_of_core_fit.h"
 
@@ -176,17 +177,8 @@ int run(int argc, char** argv) {
           tools::Timer timer("Computing " + method + " normals");
           const MeshNormals normals = computeMeshNormals(*in.topology, positions, options);
           timer.done(static_cast<std::size_t>(positions.cols()));
-          if (normals.invalid_vertices > 0) {
-            tools::warn(kName, std::to_string(normals.invalid_vertices) +
-                                   " vertices without a normal (NaN), " +
-                                   std::to_string(normals.cancelled_vertices) +
-                                   " of them because their face normals cancel (reversed duplicate "
-                                   "faces?)");
-          }
-          if (options.weighting == NormalWeighting::MeanCurvature) {
-            tools::warn(kName, std::to_string(normals.fallback_vertices) +
-                                   " flat or boundary vertices took the area-weighted normal");
-          }
+          for (const std::string& message : meshNormalWarnings(normals, options.weighting))
+            tools::warn(kName, message);
           tools::setNormalTriple(in.mesh.cloud, output, normals.normals, precision);
           if (fileExtension(output) == "pcd") {
             // What pcl::PointNormal expects beside the normal: PCL's surface variation, over the

@@ -37,9 +37,27 @@ import numpy as np
 from . import _pcl_ddg
 from ._pcl_ddg import InvalidMeshError, SurfaceCollapseError
 
+
+class PclDdgWarning(UserWarning):
+    """What the tools warn about a result (rounded coordinates, a viewpoint too far to orient by,
+    points left without an estimate, ...): ``warnings.simplefilter("error", PclDdgWarning)``
+    turns them into errors, ``"ignore"`` silences them."""
+
+
+def _warn(messages: Sequence[str]) -> None:
+    """Each message as a PclDdgWarning at the caller's line outside this package."""
+    import sys
+
+    level, frame = 2, sys._getframe(1)  # stacklevel 2: _warn's caller
+    while frame is not None and frame.f_globals.get("__name__", "").startswith("pcl_ddg"):
+        level, frame = level + 1, frame.f_back  # type: ignore[assignment]
+    for message in messages:
+        warnings.warn(message, PclDdgWarning, stacklevel=level)
+
 __version__: str = _pcl_ddg.__version__
 
 __all__ = [
+    "PclDdgWarning",
     "InvalidMeshError",
     "SurfaceCollapseError",
     "VertexNormals",
@@ -214,10 +232,11 @@ def vertex_normals(
     ``valid=False``.
     """
     weights = _renamed(weighting, "weighting", "weights", weights, "area")
-    normals, valid, _ = _pcl_ddg.vertex_normals(
+    normals, valid, counts = _pcl_ddg.vertex_normals(
         _array(V, "V"), _faces(F), _text(weights, "weights"), _real(epsilon, "epsilon"),
         _text(mass, "mass"),
     )
+    _warn(counts["warnings"])
     return VertexNormals(normals, valid)
 
 
@@ -300,7 +319,10 @@ def curvatures(V: ArrayLike, F: Optional[Faces], mass: str = "mixed") -> Curvatu
     that ``sum(gauss * area) = 2 pi chi`` (Gauss-Bonnet). ``mass`` (the ``-area`` flag): ``"mixed"``,
     ``"voronoi"``, ``"barycentric"``.
     """
-    mean, gauss, k1, k2, area, _, _ = _pcl_ddg.curvatures(_array(V, "V"), _faces(F), _text(mass, "mass"))
+    mean, gauss, k1, k2, area, _, counts = _pcl_ddg.curvatures(
+        _array(V, "V"), _faces(F), _text(mass, "mass")
+    )
+    _warn(counts["warnings"])
     return Curvatures(mean, gauss, k1, k2, area)
 
 
@@ -509,7 +531,7 @@ def _fitted_normals(
     """The binding's fit with the arguments checked and converted (estimate_normals' order):
     normals, curvature, valid, counts, and robust's scale and confidence (else None)."""
     points, faces, viewpoint, orient = _file_defaults(points, faces, viewpoint, orient)
-    return _pcl_ddg.estimate_normals(
+    result = _pcl_ddg.estimate_normals(
         _array(points, "points"),
         _text(method, "method"),
         _integer(k, "k"),
@@ -524,6 +546,8 @@ def _fitted_normals(
         _real(max_depth_jump, "max_depth_jump"),
         _integer(threads, "threads"),
     )
+    _warn(result[3]["warnings"])
+    return result
 
 
 class RobustNormals(NamedTuple):
@@ -585,7 +609,7 @@ def principal_curvatures(
     Mean curvature is ``(k1 + k2) / 2``, Gaussian ``k1 * k2``.
     """
     points, faces, viewpoint, orient = _file_defaults(points, faces, viewpoint, orient)
-    k1, k2, direction, normals, valid, _ = _pcl_ddg.principal_curvatures(
+    k1, k2, direction, normals, valid, counts = _pcl_ddg.principal_curvatures(
         _array(points, "points"),
         _integer(k, "k"),
         _real(radius, "radius"),
@@ -598,6 +622,7 @@ def principal_curvatures(
         _vector(up, "up"),
         _integer(threads, "threads"),
     )
+    _warn(counts["warnings"])
     return PrincipalCurvatures(k1, k2, direction, normals, valid)
 
 
@@ -803,7 +828,7 @@ def write(
     format, scale/offset, VLRs), so that unchanged records round-trip bit for bit; None: LAS 1.4
     format 6 (7 with ``"rgb"``), scale and offset chosen from the points, and no VLR but the
     fields' Extra Bytes: an input's CRS (its projection VLRs) and its other VLRs are not carried,
-    which a ``UserWarning`` says. To keep them, pass the input's layout::
+    which a :class:`PclDdgWarning` says. To keep them, pass the input's layout::
 
         cloud = pcl_ddg.read("survey.las")
         pcl_ddg.write("out.las", cloud.points, fields=..., las=cloud.las)
@@ -825,9 +850,7 @@ def write(
         las,
     )
     if las is None and path.lower().endswith(".las"):
-        warnings.warn(
+        _warn([
             f"{path}: written without las=, so it carries no CRS and no VLR of any input; pass "
-            "las=pcl_ddg.read(input).las to keep the input's projection, VLRs, scale and offset",
-            UserWarning,
-            stacklevel=2,
-        )
+            "las=pcl_ddg.read(input).las to keep the input's projection, VLRs, scale and offset"
+        ])

@@ -930,6 +930,14 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
                 cluster.close()
     seconds = time.perf_counter() - start
     computed = sum(r["points"] for r in tiles)
+    # What the tool would warn about on the merged cloud (the points' sampling is not measured
+    # here: the tiles never hold the whole cloud).
+    world = [b + plan.origin[i % 3] for i, b in enumerate(plan.bounds)]  # bounds: local frame
+    warnings = _pcl_ddg._result_warnings(
+        world, options["orient"], list(options["viewpoint"]),
+        sum(r["failed"] for r in tiles), sum(r["fallback"] for r in tiles))
+    for message in warnings:
+        stream.write(f"pcl_ddg.distributed: warning: {message}\n")
     return {
         "points": total, "finite_points": plan.finite_points, "tiles": len(plan.tiles),
         "orientation": options["orient"] + (" (a LAS input's default)" if las_up else ""),
@@ -945,6 +953,7 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
         "seconds_write": seconds_write,
         "points_per_tile": points_per_tile, "grid": list(plan.dims), "outputs": outputs,
         "dashboard": dashboard, "tile_reports": sorted(tiles, key=lambda r: r["tile"]),
+        "warnings": warnings,
     }
 
 

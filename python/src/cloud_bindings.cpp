@@ -16,6 +16,7 @@
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
 #include "pcl_ddg/features/robust_normal_estimation.h"
+#include "pcl_ddg/result_warnings.h"
 
 namespace pcl_ddg {
 namespace python {
@@ -207,11 +208,39 @@ LocalFitOptions fitOptions(const FitArguments& a, const Cloud& cloud,
   return options;
 }
 
-py::dict fitCounts(const LocalFitResult& result) {
+// What pcl_ddg_normals warns about this fit (fit_warnings.h), with the options spelled as
+// Python's: the sampling of a cloud (a mesh's faces orient it, its edges are its spacing), and
+// the points left without an estimate.
+std::vector<std::string> fitWarnings(const LocalCloud& local, bool mesh,
+                                     const LocalFitOptions& options, const LocalFitResult& result) {
+  std::vector<std::string> messages;
+  if (!mesh) {
+    if (auto message = quantisationWarning(measurePointSpacing(*local.points)))
+      messages.push_back(std::move(*message));
+    Eigen::Vector3d min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector3d max = -min;
+    for (Eigen::Index i = 0; i < static_cast<Eigen::Index>(local.points->size()); ++i) {
+      const Eigen::Vector3d p = local.positions
+                                    ? Eigen::Vector3d(local.positions->col(i))
+                                    : (*local.points)[i].getVector3fMap().cast<double>();
+      if (!p.allFinite()) continue;
+      min = min.cwiseMin(p);
+      max = max.cwiseMax(p);
+    }
+    if (auto message = farViewpointWarning(min + local.origin, max + local.origin, options, {}))
+      messages.push_back(std::move(*message));
+  }
+  for (std::string& message : fitResultWarnings(result.failed_points, result.fallback_points))
+    messages.push_back(std::move(message));
+  return messages;
+}
+
+py::dict fitCounts(const LocalFitResult& result, const std::vector<std::string>& warnings) {
   py::dict counts;
   counts["failed_points"] = result.failed_points;
   counts["fallback_points"] = result.fallback_points;
   counts["flipped_points"] = result.orientation.flipped_points;
+  counts["warnings"] = warnings;
   return counts;
 }
 
@@ -223,8 +252,12 @@ void bindClouds(py::module_& m) {
     const Cloud::ConstPtr& cloud = local.points;
     std::shared_ptr<const MeshTopology> topology;
     const LocalFitOptions options = fitOptions(arguments, *cloud, topology);
-    const LocalFitResult result =
-        compute([&] { return fitLocalSurfaces(local, topology, options); });
+    std::vector<std::string> warnings;
+    const LocalFitResult result = compute([&] {
+      LocalFitResult fitted = fitLocalSurfaces(local, topology, options);
+      warnings = fitWarnings(local, topology != nullptr, options, fitted);
+      return fitted;
+    });
     py::array_t<double> normals = normalsArray(*cloud, result.normals);
     py::array_t<bool> valid(shapeOf(*cloud, 0));
     bool* ok = valid.mutable_data();
@@ -236,11 +269,13 @@ void bindClouds(py::module_& m) {
       double* c = curvature.mutable_data();
       for (std::size_t i = 0; i < cloud->size(); ++i) c[i] = result.normals[i].curvature;
       if (result.scales.empty())
-        return py::make_tuple(normals, curvature, valid, fitCounts(result), py::none(), py::none());
+        return py::make_tuple(normals, curvature, valid, fitCounts(result, warnings), py::none(),
+                              py::none());
       py::array_t<double> scale(shapeOf(*cloud, 0)), confidence(shapeOf(*cloud, 0));
       std::copy(result.scales.begin(), result.scales.end(), scale.mutable_data());
       std::copy(result.confidences.begin(), result.confidences.end(), confidence.mutable_data());
-      return py::make_tuple(normals, curvature, valid, fitCounts(result), scale, confidence);
+      return py::make_tuple(normals, curvature, valid, fitCounts(result, warnings), scale,
+                            confidence);
     }
     py::array_t<double> k1(shapeOf(*cloud, 0)), k2(shapeOf(*cloud, 0));
     py::array_t<double> direction(shapeOf(*cloud, 3));
@@ -254,7 +289,7 @@ void bindClouds(py::module_& m) {
       dir[3 * i + 2] = p.principal_curvature_z;
       ok[i] = ok[i] && std::isfinite(pc1[i]) && std::isfinite(pc2[i]);
     }
-    return py::make_tuple(k1, k2, direction, normals, valid, fitCounts(result));
+    return py::make_tuple(k1, k2, direction, normals, valid, fitCounts(result, warnings));
   };
 
   m.def(

@@ -25,6 +25,7 @@
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/result_warnings.h"
 #include "pcl_ddg/search/kd_tree_search.h"
 
 namespace pcl_ddg {
@@ -489,6 +490,30 @@ void bindDistributed(py::module_& m) {
       py::arg("bounds"),
       "The local origin of points within these bounds (local_cloud.h): what the tools centre "
       "a cloud on before its floats are searched.");
+  m.def(
+      "_result_warnings",
+      [](const std::vector<double>& bounds, const std::string& orient,
+         const std::vector<double>& viewpoint, std::int64_t failed, std::int64_t fallback) {
+        if (bounds.size() != 6 || viewpoint.size() != 3)
+          throw py::value_error("bounds are 6 numbers, the viewpoint 3");
+        LocalFitOptions options;
+        options.orientation = choice("orient", orient, {"viewpoint", "up"}) == "up"
+                                  ? NormalOrientation::Up
+                                  : NormalOrientation::Viewpoint;
+        options.viewpoint = Eigen::Vector3d(viewpoint[0], viewpoint[1], viewpoint[2]);
+        std::vector<std::string> messages;
+        if (auto message = farViewpointWarning(Eigen::Vector3d(bounds[0], bounds[1], bounds[2]),
+                                               Eigen::Vector3d(bounds[3], bounds[4], bounds[5]),
+                                               options, {"-viewpoint x,y,z", "-orient up"}))
+          messages.push_back(std::move(*message));
+        for (std::string& message : fitResultWarnings(failed, fallback))
+          messages.push_back(std::move(message));
+        return messages;
+      },
+      py::arg("bounds"), py::arg("orient"), py::arg("viewpoint"), py::arg("failed"),
+      py::arg("fallback"),
+      "What pcl_ddg_normals warns about a run on the merged cloud within bounds "
+      "(result_warnings.h): a viewpoint too far to orient by, points without an estimate.");
   m.def("_gather_chunk", &gatherChunk, py::arg("path"), py::arg("first"), py::arg("count"),
         py::arg("lo"), py::arg("hi"), py::arg("origin"), py::arg("size"), py::arg("dims"),
         py::arg("tile"), py::arg("local_origin"),

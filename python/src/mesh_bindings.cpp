@@ -15,6 +15,7 @@
 #include "pcl_ddg/operators/curvature.h"
 #include "pcl_ddg/operators/laplacian.h"
 #include "pcl_ddg/operators/mass_matrix.h"
+#include "pcl_ddg/result_warnings.h"
 #include "pcl_ddg/surface/mesh_normals.h"
 #include "pcl_ddg/surface/mesh_smoothing.h"
 #include "pcl_ddg/surface/scalar_field_smoothing.h"
@@ -112,6 +113,7 @@ void bindMeshes(py::module_& m) {
         counts["invalid_vertices"] = normals.invalid_vertices;
         counts["cancelled_vertices"] = normals.cancelled_vertices;
         counts["fallback_vertices"] = normals.fallback_vertices;
+        counts["warnings"] = meshNormalWarnings(normals, options.weighting);
         return py::make_tuple(rowsArray(std::move(normals.normals)), maskArray(normals.valid),
                               counts);
       },
@@ -166,6 +168,7 @@ void bindMeshes(py::module_& m) {
         counts["clamped_vertices"] = c.clamped_vertices;
         counts["invalid_vertices"] = c.invalid_vertices;
         counts["unoriented_vertices"] = c.unoriented_vertices;
+        counts["warnings"] = curvatureWarnings(c);
         return py::make_tuple(vectorArray(std::move(c.mean_curvature)),
                               vectorArray(std::move(c.gauss_curvature)),
                               vectorArray(std::move(c.k1)), vectorArray(std::move(c.k2)),

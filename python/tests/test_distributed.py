@@ -693,6 +693,14 @@ def test_worker_peak_memory_stays_under_the_limit(tmp_path):
         (summary["worker_peak_bytes"], peaks)
     run_tool("pcl_ddg_normals", survey, tmp_path / "tool.pcd", "-k", "16")
     assert (out / "survey.pcd").read_bytes() == (tmp_path / "tool.pcd").read_bytes()
+    # and they are the height field's normals: z = 2 sin(u/40) cos(v/55) has a slope of at most
+    # sqrt(0.05^2 + 0.036^2) = 0.062, so its exact normal has |nz| = 1/sqrt(1 + slope^2) >= 0.9981;
+    # a plane fitted to 16 points a unit apart where the curvature is at most 2/40^2 tilts by
+    # ~1e-3 rad at most: |nz| > 0.997 everywhere.
+    fields = pcl_ddg.read(out / "survey.pcd").fields
+    nz = fields["normal_z"] if "normal_z" in fields else fields["nz"]
+    assert len(nz) == len(points) and np.isfinite(nz).all()
+    assert np.abs(nz).min() > 0.997, np.abs(nz).min()
 
 
 def test_starting_a_local_cluster_leaves_the_callers_environment_alone():
@@ -714,3 +722,28 @@ def test_starting_a_local_cluster_leaves_the_callers_environment_alone():
         cluster = c.cluster
         c.close()
         cluster.close()
+
+
+def test_the_runs_warnings_are_the_tools(tmp_path, client, las_scene):
+    """A viewpoint too far to orient by: the summary lists the tool's own warning (the same
+    words, result_warnings.h) and the log prints it."""
+    import io
+    import subprocess
+
+    from conftest import tools_dir
+
+    paths, merged = las_scene
+    tool = subprocess.run([str(tools_dir() / "pcl_ddg_normals"), str(merged),
+                           str(tmp_path / "tool.ply"), "-viewpoint", "0,0,0"],
+                          capture_output=True, text=True, timeout=300)
+    assert tool.returncode == 0, tool.stderr
+    log = io.StringIO()
+    out = tmp_path / "out"
+    summary = dd.estimate_normals(paths, out, client=client, merge=str(out / "m.ply"),
+                                  viewpoint=(0.0, 0.0, 0.0), memory_per_worker=memory(client),
+                                  stream=log)
+    assert len(summary["warnings"]) == 1, (summary["warnings"], tool.stderr)
+    message = summary["warnings"][0]
+    assert message.startswith("the viewpoint (0, 0, 0) is ") and "-orient up" in message
+    assert "pcl_ddg_normals: warning: " + message in tool.stderr, (message, tool.stderr)
+    assert "pcl_ddg.distributed: warning: " + message in log.getvalue()

@@ -16,6 +16,7 @@
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
+#include "pcl_ddg/result_warnings.h"
 #include "pcl_ddg/search/point_spacing.h"
 
 namespace pcl_ddg {
@@ -24,6 +25,7 @@ namespace tools {
 namespace {
 
 constexpr int kDefaultMaxNeighbours = 64;
+const OptionSpelling kToolSpelling{"-viewpoint x,y,z", "-orient up"};
 
 // -radius as written: a length, or a multiple of the input's spacing like "2.5h".
 struct RadiusArgument {
@@ -184,12 +186,7 @@ std::string number(double value) {
 PointSpacing warnAboutQuantisation(const char* tool_name,
                                    const pcl::PointCloud<pcl::PointXYZ>& points) {
   const PointSpacing spacing = measurePointSpacing(points);
-  if (spacing.quantised()) {
-    warn(tool_name, "the coordinates are rounded to " + number(spacing.quantum) +
-                        " while the points are " + number(spacing.median_spacing) +
-                        " apart (median): neighbourhoods tie and normals snap to the lattice "
-                        "(store the coordinates in double, or relative to an offset)");
-  }
+  if (const auto message = quantisationWarning(spacing)) warn(tool_name, *message);
   return spacing;
 }
 
@@ -199,24 +196,9 @@ SamplingCheck checkSampling(const char* tool_name, ToolInput& input,
   if (input.topology) return check;  // a mesh's faces orient it; its edges are its spacing
   const pcl::PointCloud<pcl::PointXYZ>& points = *input.points();
   warnAboutQuantisation(tool_name, points);
-  const bool by_viewpoint =
-      options.orientation == NormalOrientation::Viewpoint ||
-      options.orientation == NormalOrientation::MeshFaces ||
-      (options.orientation == NormalOrientation::SpanningTree && options.seed_facing_viewpoint);
   const BoundingBox box = boundingBox(input.positions);
-  const Eigen::Vector3d viewpoint = options.viewpoint.value_or(Eigen::Vector3d::Zero());
-  const double diagonal = (box.max - box.min).norm();
-  const double distance =
-      (viewpoint - viewpoint.cwiseMax(box.min).cwiseMin(box.max)).norm();  // to the box
-  if (by_viewpoint && distance > 10.0 * diagonal) {
-    char where[128];
-    std::snprintf(where, sizeof where, "(%.6g, %.6g, %.6g)", viewpoint.x(), viewpoint.y(),
-                  viewpoint.z());
-    warn(tool_name, std::string("the viewpoint ") + where + " is " + number(distance / diagonal) +
-                        " times the data's extent away: normals facing it are oriented almost "
-                        "at random (give the sensor position with -viewpoint x,y,z, or use "
-                        "-orient up for aerial data)");
-  }
+  if (const auto message = farViewpointWarning(box.min, box.max, options, kToolSpelling))
+    warn(tool_name, *message);
   if (options.radius > 0.0) {
     const int wanted = options.min_neighbours > 0 ? static_cast<int>(options.min_neighbours) : 3;
     check.radius_counts = countRadiusNeighbours(points, options.radius, wanted);
@@ -401,15 +383,8 @@ QuietPCLWarnings::~QuietPCLWarnings() {
 }
 
 void warnAboutLocalFit(const char* tool_name, const LocalFitResult& result) {
-  if (result.failed_points > 0) {
-    warn(tool_name, std::to_string(result.failed_points) +
-                        " points without an estimate (non-finite, or too few neighbours): NaN");
-  }
-  if (result.fallback_points > 0) {
-    warn(tool_name, std::to_string(result.fallback_points) +
-                        " points with too few neighbours or an ill-conditioned quadric: PCA "
-                        "normal, NaN curvatures");
-  }
+  for (const std::string& message : fitResultWarnings(result.failed_points, result.fallback_points))
+    warn(tool_name, message);
 }
 
 }  // namespace tools
