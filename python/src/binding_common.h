@@ -54,6 +54,12 @@ std::uintptr_t& lastPositionsAddress();
 
 /** A mesh's topology from F: an (m, 3) integer array or a sequence of polygons. Indices are
  *  checked against num_vertices (ValueError naming the face). */
+/** A face index as an int, or ValueError naming the face when it is outside 0..num_vertices-1. */
+int checkedIndex(long long index, int num_vertices, std::size_t face);
+
+/** An (m, k) integer face array (k >= 3; else ValueError) as C-contiguous int64 rows. */
+py::array_t<long long, py::array::c_style> faceRows(const py::array& faces);
+
 MeshTopology topologyOf(int num_vertices, const py::object& faces,
                         OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw);
 

@@ -108,26 +108,38 @@ FieldPrecision precisionOf(const std::optional<std::string>& precision, const py
 std::vector<pcl::Vertices> polygonsOf(int n, const py::object& faces) {
   std::vector<pcl::Vertices> polygons;
   if (faces.is_none()) return polygons;
-  // topologyOf checks every index (ValueError); the polygons themselves are written as given.
-  topologyOf(n, faces);
-  const auto read = [&](const py::handle& polygon) {
-    const auto p = py::array_t<long long, py::array::forcecast>::ensure(polygon);
-    pcl::Vertices v;
-    for (py::ssize_t c = 0; c < p.size(); ++c)
-      v.vertices.push_back(static_cast<std::uint32_t>(p.data()[c]));
-    polygons.push_back(std::move(v));
-  };
-  if (py::isinstance<py::array>(faces)) {
-    const auto f = py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(faces);
-    for (py::ssize_t t = 0; t < f.shape(0); ++t) {
-      pcl::Vertices v;
-      for (py::ssize_t c = 0; c < f.shape(1); ++c)
-        v.vertices.push_back(static_cast<std::uint32_t>(f.at(t, c)));
-      polygons.push_back(std::move(v));
+  if (!py::isinstance<py::array>(faces)) {
+    // A list of polygons: checked as every mesh function checks it, then written as given.
+    topologyOf(n, faces);
+    for (const py::handle polygon : faces) {
+      const auto p = py::array_t<long long, py::array::forcecast>::ensure(polygon);
+      polygons.emplace_back();
+      polygons.back().vertices.assign(p.data(), p.data() + p.size());
     }
-  } else {
-    for (const py::handle polygon : faces) read(polygon);
+    return polygons;
   }
+  // An (m, k) array: its indices checked and copied without the GIL (no topology is built: the
+  // file holds the faces as given).
+  const auto indices = faceRows(faces.cast<py::array>());
+  const auto rows = static_cast<std::size_t>(indices.shape(0));
+  const auto corners = static_cast<std::size_t>(indices.shape(1));
+  const long long* data = indices.data();
+  std::size_t bad = rows * corners;
+  {
+    py::gil_scoped_release release;
+    for (std::size_t j = 0; j < rows * corners; ++j) {
+      if (data[j] < 0 || data[j] >= n) {
+        bad = j;
+        break;
+      }
+    }
+    if (bad == rows * corners) {
+      polygons.resize(rows);
+      for (std::size_t t = 0; t < rows; ++t)
+        polygons[t].vertices.assign(data + corners * t, data + corners * (t + 1));
+    }
+  }
+  if (bad < rows * corners) checkedIndex(data[bad], n, bad / corners);  // throws ValueError
   return polygons;
 }
 

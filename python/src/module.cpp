@@ -109,9 +109,6 @@ std::uintptr_t& lastPositionsAddress() {
   return address;
 }
 
-namespace {
-
-// A face index as an int, checked against the vertex count.
 int checkedIndex(long long index, int num_vertices, std::size_t face) {
   if (index < 0 || index >= num_vertices) {
     throw py::value_error("face " + std::to_string(face) + " names vertex " +
@@ -121,6 +118,8 @@ int checkedIndex(long long index, int num_vertices, std::size_t face) {
   }
   return static_cast<int>(index);
 }
+
+namespace {
 
 // Policy Drop: an out-of-range index (negative ones too) as one the library drops.
 int droppableIndex(long long index, int num_vertices) {
@@ -145,16 +144,29 @@ MeshTopology buildTopology(int num_vertices, const Polygons& polygons,
 
 }  // namespace
 
+namespace {
+
+void checkFaceArray(const py::array& f) {
+  const char kind = f.dtype().kind();
+  if (kind != 'i' && kind != 'u')
+    throw py::value_error("F must hold integers (int32 or int64), not " +
+                          std::string(py::str(f.dtype())));
+  if (f.ndim() != 2 || (f.shape(1) < 3 && f.shape(0) > 0))
+    throw py::value_error("F must have shape (m, 3) (or (m, k) polygons, or a list of them)");
+}
+
+}  // namespace
+
+py::array_t<long long, py::array::c_style> faceRows(const py::array& faces) {
+  checkFaceArray(faces);
+  return py::array_t<long long, py::array::c_style | py::array::forcecast>::ensure(faces);
+}
+
 MeshTopology topologyOf(int num_vertices, const py::object& faces, OutOfRangeFacePolicy policy) {
   const bool check = policy == OutOfRangeFacePolicy::Throw;
   if (py::isinstance<py::array>(faces)) {
     const py::array f = faces.cast<py::array>();
-    const char kind = f.dtype().kind();
-    if (kind != 'i' && kind != 'u')
-      throw py::value_error("F must hold integers (int32 or int64), not " +
-                            std::string(py::str(f.dtype())));
-    if (f.ndim() != 2 || (f.shape(1) < 3 && f.shape(0) > 0))
-      throw py::value_error("F must have shape (m, 3) (or (m, k) polygons, or a list of them)");
+    checkFaceArray(f);
     const auto rows = static_cast<std::size_t>(f.shape(0));
     const auto corners = static_cast<std::size_t>(f.ndim() == 2 ? f.shape(1) : 0);
     if (corners == 3 && f.dtype().kind() == 'i' && f.dtype().itemsize() == 4 &&
@@ -281,8 +293,8 @@ bool pythonSignalRaised() {
 void setError(PyObject* type, const std::exception& e) {
   // A message may quote a file's bytes: what is not UTF-8 is escaped (\\xff), never lost.
   const std::string text = pcl_ddg::errorDescription(e);
-  PyObject* message = PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()),
-                                           "backslashreplace");
+  PyObject* message =
+      PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()), "backslashreplace");
   if (message == nullptr) return;  // MemoryError is set
   PyErr_SetObject(type, message);
   Py_DECREF(message);
