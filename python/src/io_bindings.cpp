@@ -105,41 +105,39 @@ FieldPrecision precisionOf(const std::optional<std::string>& precision, const py
                                                                             : FieldPrecision::Float;
 }
 
-std::vector<pcl::Vertices> polygonsOf(int n, const py::object& faces) {
-  std::vector<pcl::Vertices> polygons;
-  if (faces.is_none()) return polygons;
-  if (!py::isinstance<py::array>(faces)) {
-    // A list of polygons: checked as every mesh function checks it, then written as given.
-    topologyOf(n, faces);
-    for (const py::handle polygon : faces) {
-      const auto p = py::array_t<long long, py::array::forcecast>::ensure(polygon);
-      polygons.emplace_back();
-      polygons.back().vertices.assign(p.data(), p.data() + p.size());
-    }
-    return polygons;
-  }
-  // An (m, k) array: its indices checked and copied without the GIL (no topology is built: the
-  // file holds the faces as given).
-  const auto indices = faceRows(faces.cast<py::array>());
-  const auto rows = static_cast<std::size_t>(indices.shape(0));
-  const auto corners = static_cast<std::size_t>(indices.shape(1));
+// An (m, k) face array as one block of rows, its indices checked without the GIL (no topology
+// is built: the file holds the faces as given).
+std::shared_ptr<const FaceRows> faceRowsOf(int n, const py::array& faces) {
+  const auto indices = faceRows(faces);
+  auto rows = std::make_shared<FaceRows>();
+  rows->corners = static_cast<std::size_t>(indices.shape(1));
+  const std::size_t size = static_cast<std::size_t>(indices.shape(0)) * rows->corners;
   const long long* data = indices.data();
-  std::size_t bad = rows * corners;
+  std::size_t bad = size;
   {
     py::gil_scoped_release release;
-    for (std::size_t j = 0; j < rows * corners; ++j) {
+    rows->indices.resize(size);
+    for (std::size_t j = 0; j < size; ++j) {
       if (data[j] < 0 || data[j] >= n) {
         bad = j;
         break;
       }
-    }
-    if (bad == rows * corners) {
-      polygons.resize(rows);
-      for (std::size_t t = 0; t < rows; ++t)
-        polygons[t].vertices.assign(data + corners * t, data + corners * (t + 1));
+      rows->indices[j] = static_cast<std::int32_t>(data[j]);
     }
   }
-  if (bad < rows * corners) checkedIndex(data[bad], n, bad / corners);  // throws ValueError
+  if (bad < size) checkedIndex(data[bad], n, bad / rows->corners);  // throws ValueError
+  return rows;
+}
+
+// A list of polygons, checked as every mesh function checks it, then written as given.
+std::vector<pcl::Vertices> polygonsOf(int n, const py::object& faces) {
+  topologyOf(n, faces);
+  std::vector<pcl::Vertices> polygons;
+  for (const py::handle polygon : faces) {
+    const auto p = py::array_t<long long, py::array::forcecast>::ensure(polygon);
+    polygons.emplace_back();
+    polygons.back().vertices.assign(p.data(), p.data() + p.size());
+  }
   return polygons;
 }
 
@@ -405,8 +403,11 @@ void bindIO(py::module_& m) {
         if (!typed.empty() && mesh.cloud.height != 1)
           throw py::value_error("a .las file holds no organized cloud");
         appendTypedFields(mesh.cloud, typed);
-        mesh.polygons = polygonsOf(n, faces);
         MeshWriteOptions options;
+        if (py::isinstance<py::array>(faces))
+          options.faces = faceRowsOf(n, faces.cast<py::array>());
+        else if (!faces.is_none())
+          mesh.polygons = polygonsOf(n, faces);
         options.las = las;
         options.ply_encoding = choice("encoding", encoding, {"binary", "ascii"}) == "ascii"
                                    ? PlyEncoding::Ascii

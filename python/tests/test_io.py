@@ -82,3 +82,23 @@ def test_file_errors_are_oserrors(tmp_path):
         pcl_ddg.read(tmp_path / "x.xyz2")
     with pytest.raises(OSError):
         pcl_ddg.write(tmp_path / "no_such_folder" / "a.ply", np.zeros((3, 3)))
+
+
+@pytest.mark.parametrize("encoding", ["binary", "ascii"])
+def test_faces_as_an_array_write_the_bytes_of_the_same_faces_as_polygons(tmp_path, encoding):
+    """An (m, k) array is written from its block (no pcl::Vertices per face): the same file as
+    the same faces given as a list of polygons, which goes through PCL's polygons."""
+    V, F = icosphere(2)
+    quads = np.array([[0, 1, 2, 3], [4, 5, 6, 7]])
+    for faces in (F, F.astype(np.uint16), quads):
+        a, b = tmp_path / "array.ply", tmp_path / "list.ply"
+        pcl_ddg.write(a, V, faces, encoding=encoding)
+        pcl_ddg.write(b, V, [list(map(int, f)) for f in faces], encoding=encoding)
+        assert a.read_bytes() == b.read_bytes()
+        back = pcl_ddg.read(a)
+        np.testing.assert_array_equal(np.asarray(back.faces), faces)
+    with pytest.raises(ValueError, match="face 7 names vertex 162, outside 0..161"):
+        bad = F.copy()
+        bad[7, 1] = len(V)
+        pcl_ddg.write(tmp_path / "bad.ply", V, bad)
+    assert not (tmp_path / "bad.ply").exists()

@@ -100,7 +100,9 @@ BinaryCloudLayout pcdBinaryLayout(std::string_view head);
  *  empty (no faces) and no range grid; FileFormatException for any other. */
 BinaryCloudLayout plyBinaryLayout(std::string_view head);
 
-void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding);
+/** The faces are rows when given (mesh.polygons is then empty), else mesh.polygons. */
+void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding,
+              const FaceRows* rows = nullptr);
 /** A cloud as a binary_compressed PCD file (padding fields left out). */
 std::string encodePCD(const pcl::PCLPointCloud2& cloud, const SensorPose& sensor_pose);
 /** The header of a binary (uncompressed) PCD file of `points` points with the cloud's fields

@@ -35,10 +35,11 @@ void savePCD(const std::string& path, const pcl::PolygonMesh& mesh, const Sensor
                                      pose));
 }
 
-void savePLY(const std::string& path, const pcl::PolygonMesh& mesh, PlyEncoding encoding) {
+void savePLY(const std::string& path, const pcl::PolygonMesh& mesh, PlyEncoding encoding,
+             const FaceRows* rows) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   pcl::PolygonMesh converted;
-  detail::writePLY(out, withColorLayout(mesh, ColorLayout::Channels, converted), encoding);
+  detail::writePLY(out, withColorLayout(mesh, ColorLayout::Channels, converted), encoding, rows);
   out.close();
   if (!out) throw FileFormatException(std::string("write failed: ") + std::strerror(errno));
 }
@@ -140,11 +141,13 @@ void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh,
     if (ext != "ply" && ext != "pcd" && ext != "las") {
       throw FileFormatException("cannot write '." + ext + "' files (use .ply, .pcd or .las)");
     }
+    if (options.faces && !mesh.polygons.empty())
+      throw pcl::BadArgumentException("faces given twice: as polygons and as rows");
     AtomicFile file(path);
     if (ext == "las") {
       detail::writeLAS(file.temporaryPath(), mesh.cloud, options.las.get());
     } else if (ext == "ply") {
-      savePLY(file.temporaryPath(), mesh, options.ply_encoding);
+      savePLY(file.temporaryPath(), mesh, options.ply_encoding, options.faces.get());
     } else {
       savePCD(file.temporaryPath(), mesh, options.sensor_pose);
     }

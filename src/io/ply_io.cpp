@@ -625,7 +625,8 @@ class BlockWriter {
 
 // Little-endian: the byte order of every platform PCL supports.
 void writeBinaryBody(std::ostream& out, const pcl::PolygonMesh& mesh,
-                     const std::vector<OutputProperty>& properties, bool wide_counts) {
+                     const std::vector<OutputProperty>& properties, bool wide_counts,
+                     const FaceRows* rows) {
   const pcl::PCLPointCloud2& cloud = mesh.cloud;
   const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
   BlockWriter writer(out);
@@ -633,14 +634,24 @@ void writeBinaryBody(std::ostream& out, const pcl::PolygonMesh& mesh,
     const std::uint8_t* point = cloud.data.data() + i * cloud.point_step;
     for (const auto& p : properties) writer.append(point + p.offset, pcl::getFieldSize(p.datatype));
   }
-  for (const auto& polygon : mesh.polygons) {
-    const auto corners = static_cast<std::int32_t>(polygon.vertices.size());
+  const auto writeCount = [&](std::size_t count) {
+    const auto corners = static_cast<std::int32_t>(count);
     if (wide_counts) {
       writer.append(&corners, 4);
     } else {
       const auto narrow = static_cast<std::uint8_t>(corners);
       writer.append(&narrow, 1);
     }
+  };
+  if (rows != nullptr) {
+    for (std::size_t r = 0; r < rows->rows(); ++r) {
+      writeCount(rows->corners);
+      writer.append(rows->indices.data() + r * rows->corners, 4 * rows->corners);
+    }
+    return;
+  }
+  for (const auto& polygon : mesh.polygons) {
+    writeCount(polygon.vertices.size());
     static_assert(sizeof(pcl::index_t) == 4, "PLY indices are written as int32");
     writer.append(polygon.vertices.data(), 4 * polygon.vertices.size());
   }
@@ -648,7 +659,8 @@ void writeBinaryBody(std::ostream& out, const pcl::PolygonMesh& mesh,
 
 }  // namespace
 
-void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding) {
+void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding,
+              const FaceRows* rows) {
   const pcl::PCLPointCloud2& cloud = mesh.cloud;
   const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
   const std::vector<OutputProperty> properties = outputProperties(cloud);
@@ -659,17 +671,17 @@ void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encod
   for (const auto& p : properties)
     out << "property " << plyTypeName(p.datatype) << " " << p.name << "\n";
   // The usual uchar corner count, or int when a face has more than 255 corners.
-  std::size_t most_corners = 0;
+  std::size_t most_corners = rows != nullptr ? rows->corners : 0;
   for (const auto& polygon : mesh.polygons)
     most_corners = std::max(most_corners, polygon.vertices.size());
   if (most_corners > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max())) {
     throw FileFormatException("a face has too many corners for PLY");
   }
   const bool wide_counts = most_corners > 255;
-  out << "element face " << mesh.polygons.size() << "\n"
+  out << "element face " << (rows != nullptr ? rows->rows() : mesh.polygons.size()) << "\n"
       << "property list " << (wide_counts ? "int" : "uchar") << " int vertex_indices\nend_header\n";
   if (binary) {
-    writeBinaryBody(out, mesh, properties, wide_counts);
+    writeBinaryBody(out, mesh, properties, wide_counts, rows);
     return;
   }
   for (std::size_t i = 0; i < n; ++i) {
@@ -679,6 +691,15 @@ void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encod
       printScalar(out, point + properties[k].offset, properties[k].datatype);
     }
     out << '\n';
+  }
+  if (rows != nullptr) {
+    for (std::size_t r = 0; r < rows->rows(); ++r) {
+      out << rows->corners;
+      for (std::size_t c = 0; c < rows->corners; ++c)
+        out << ' ' << rows->indices[r * rows->corners + c];
+      out << '\n';
+    }
+    return;
   }
   for (const auto& polygon : mesh.polygons) {
     out << polygon.vertices.size();

@@ -35,8 +35,19 @@ struct SensorPose {
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 };
 
+/** A mesh's faces as one block, row after row, each of `corners` corners (NumPy's (m, k) layout):
+ *  a .ply output writes them as they are, without a pcl::Vertices per face. */
+struct FaceRows {
+  std::vector<std::int32_t> indices;  ///< rows() * corners vertex indices
+  std::size_t corners = 3;
+  std::size_t rows() const { return corners > 0 ? indices.size() / corners : 0; }
+};
+
 struct MeshWriteOptions {
   PlyEncoding ply_encoding = PlyEncoding::Binary;
+  /** The faces, when the mesh's polygons are empty and its faces are one block (a .pcd or .las
+   *  output stores no faces, as with polygons). */
+  std::shared_ptr<const FaceRows> faces;
   SensorPose sensor_pose;  ///< written as a PCD's VIEWPOINT
   /** A .las output keeps this layout (a LAS input's MeshFile::las): version, point format, scale,
    *  offset and every VLR. Null: LAS 1.4 format 6 (7 with colours), scale and offset chosen. */
