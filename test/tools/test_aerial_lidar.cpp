@@ -47,9 +47,9 @@ UpShare upShare(const std::string& path, const Eigen::Vector3d& up = Eigen::Vect
   return share;
 }
 
-/** A viewpoint 2 km above the middle of the terrain's box. */
-std::string viewpointAbove() {
-  const MeshFile file = readMeshFile(sharedData(kTerrain));
+/** A viewpoint 2 km above the middle of a survey's box (default: the terrain's). */
+std::string viewpointAbove(const std::string& survey = kTerrain) {
+  const MeshFile file = readMeshFile(sharedData(survey));
   const BoundingBox box = boundingBox(file.positions);
   const Eigen::Vector3d centre = 0.5 * (box.min + box.max);
   return std::to_string(centre.x()) + "," + std::to_string(centre.y()) + "," +
@@ -107,20 +107,34 @@ TEST_F(AerialLidar, AFarViewpointIsSaidOnceAndNamesTheRemedies) {
 
 TEST_F(AerialLidar, TheSpanningTreeKeepsWhatTheReferenceDecides) {
   // Seeded by a viewpoint 2 km above (or by up), the tree may only fill in the points the
-  // reference cannot sign: as good as the viewpoint alone (99.3 % up), not the 84 % that
-  // propagating across trees and walls gave.
-  ASSERT_EQ(normals("-viewpoint " + viewpointAbove()).exit_code, 0);
-  const double by_viewpoint = upShare(path("out.ply")).up;
-  for (const std::string reference : {"-viewpoint " + viewpointAbove(), std::string("-up 0,0,1")}) {
-    SCOPED_TRACE(reference);
-    const ToolRun run = normals("-orient mst " + reference);
-    ASSERT_EQ(run.exit_code, 0) << run.err;
-    const UpShare share = upShare(path("out.ply"));
-    EXPECT_GE(share.up, 0.99);
-    EXPECT_GE(share.up, by_viewpoint - 0.001);
-    EXPECT_EQ(share.steep_down, 0);
-    EXPECT_NE(run.err.find("signed by the reference"), std::string::npos) << run.err;
-    EXPECT_NE(run.err.find("turned by propagation in"), std::string::npos) << run.err;
+  // reference cannot sign (|n . d| < 0.1: walls, seen edge-on from above, whose sign up or down
+  // is a matter of a fraction of a degree): as good as the viewpoint alone to 0.1 % of the points
+  // (terrain 99.31 % up, autzen 99.43 %, mvk 99.63 %), never a normal pointing steeply down, not
+  // the 84 % that propagating across trees and walls gave.
+  for (const std::string& survey :
+       {kTerrain, std::string("las/autzen_trim.las"), std::string("las/mvk-thin.las")}) {
+    SCOPED_TRACE(survey);
+    const auto run16 = [&](const std::string& options) {
+      return runTool(PCL_DDG_NORMALS_TOOL,
+                     sharedData(survey) + " " + path("out.ply") + " -k 16 " + options);
+    };
+    ASSERT_EQ(run16("-viewpoint " + viewpointAbove(survey)).exit_code, 0);
+    const UpShare by_viewpoint = upShare(path("out.ply"));
+    for (const std::string reference :
+         {"-viewpoint " + viewpointAbove(survey), std::string("-up 0,0,1")}) {
+      SCOPED_TRACE(reference);
+      const ToolRun run = run16("-orient mst " + reference);
+      ASSERT_EQ(run.exit_code, 0) << run.err;
+      const UpShare share = upShare(path("out.ply"));
+      EXPECT_GE(share.up, 0.99);
+      EXPECT_GE(share.up, by_viewpoint.up - 0.001);
+      // Up signs every normal steeper than 5.7 degrees; a viewpoint over mvk's 5 km sees its
+      // edges 50 degrees off vertical, and itself turns 4 normals steeply down there.
+      if (reference == "-up 0,0,1") EXPECT_EQ(share.steep_down, 0);
+      EXPECT_LE(share.steep_down, by_viewpoint.steep_down + share.valid / 1000);
+      EXPECT_NE(run.err.find("signed by the reference"), std::string::npos) << run.err;
+      EXPECT_NE(run.err.find("turned by propagation in"), std::string::npos) << run.err;
+    }
   }
   EXPECT_EQ(normals("-orient mst -up 0,0,1 -viewpoint 0,0,0").exit_code, 2) << "one reference";
   EXPECT_EQ(normals("-orient viewpoint -up 0,0,1").exit_code, 2);
