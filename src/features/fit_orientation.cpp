@@ -1,4 +1,4 @@
 #include "pcl_ddg/features/fit_orientation.h"
 
-// Once per PCL input type, for both estimators and every output type.
+// Once per PCL input type, for every estimator (PCA, quadric, robust) and output type.
 BOOST_PP_SEQ_FOR_EACH(PCL_DDG_FIT_ORIENTATION, , PCL_XYZ_POINT_TYPES)
