@@ -27,6 +27,7 @@
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
 #include "pcl_ddg/features/normal_orientation.h"
+#include "pcl_ddg/features/robust_normal_estimation.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
@@ -289,6 +290,8 @@ TEST_F(ToolOptions, NormalsEqualTheLibraryForEveryMethodAndNeighbourhood) {
   const auto pca16 = once(fitted(pca(K::MeshRings, 16)));
   const auto ball = once(fitted(withRadius(pca(K::MeshRings, 16), 2.5 * h)));
   const auto quadric20 = once(fitted(quadric(K::MeshRings, 20)));
+  const auto robust96 =
+      once(fitted(meshFit(LocalFitMethod::Robust, K::MeshRings, kRobustNormalNeighbours)));
   const std::vector<OptionCase> table = {
       {"", area, {}},  // a mesh's default: area weighting
       {"-method uniform", uniform, area},
@@ -308,6 +311,9 @@ TEST_F(ToolOptions, NormalsEqualTheLibraryForEveryMethodAndNeighbourhood) {
        fitted(withRadius(pca(K::KdTree, 16), 0.7 * h))},
       {"-method quadric", quadric20, pca16},
       {"-method quadric -k 30", fitted(quadric(K::MeshRings, 30)), quadric20},
+      // robust's own default neighbourhood (kRobustNormalNeighbours), the tool's as the library's
+      {"-method robust", robust96, pca16},
+      {"-method robust -k 40", fitted(meshFit(LocalFitMethod::Robust, K::MeshRings, 40)), robust96},
   };
   checkOptionTable(PCL_DDG_NORMALS_TOOL, file, path("n.ply"), "-precision double", Match::Exact,
                    table);
@@ -451,7 +457,7 @@ TEST_F(ToolOptions, SmoothEqualsTheLibraryForEveryScheme) {
   const P implicit;
   P explicit_scheme, explicit5, uniform, voronoi, barycentric, explicit_barycentric, three,
       mass_follows, rebuilt, volume, area, fixed, umbrella, umbrella5, degree, taubin, taubin5,
-      explicit_cotan, explicit_cotan5;
+      explicit_cotan, explicit_cotan5, no_limit, limit2, explicit_cotan_tight;
   explicit_cotan.scheme = explicit_cotan5.scheme = explicit_barycentric.scheme =
       SmoothingScheme::Explicit;
   explicit_cotan5.iterations = 5;
@@ -476,6 +482,11 @@ TEST_F(ToolOptions, SmoothEqualsTheLibraryForEveryScheme) {
   volume.shrinkage = ShrinkageCorrection::PreserveVolume;
   area.shrinkage = ShrinkageCorrection::PreserveArea;
   fixed.boundary = BoundaryCondition::Fixed;
+  // The thickness limit's value as the library takes it (its meaning: test_thickness_limit).
+  no_limit.thickness_limit = 0.0;
+  explicit_cotan_tight.thickness_limit = 0.01;  // the explicit step is short: a tight limit
+  limit2.thickness_limit = 2.0;
+  explicit_cotan_tight.scheme = SmoothingScheme::Explicit;
   const auto cow_default = on(cow, implicit), cow_three = on(cow, three);
   std::printf("cow.off: h^2 = %.3g\n", cow.h * cow.h);
   const std::vector<OptionCase> table = {
@@ -511,6 +522,10 @@ TEST_F(ToolOptions, SmoothEqualsTheLibraryForEveryScheme) {
       {"-iterations 3 -rebuild_weights", on(cow, rebuilt), cow_three},
       {"-preserve volume", on(cow, volume), cow_default},
       {"-preserve area", on(cow, area), cow_default},
+      {"-thickness_limit 0", on(cow, no_limit), cow_default},
+      {"-thickness_limit 2", on(cow, limit2), cow_default},
+      {"-method explicit -weights cotan -thickness_limit 0.01", on(cow, explicit_cotan_tight),
+       on(cow, explicit_cotan)},
       {"", on(open, implicit), {}, open_file},
       {"-fix_boundary", on(open, fixed), on(open, implicit), open_file},
   };
