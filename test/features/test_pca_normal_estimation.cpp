@@ -1,9 +1,11 @@
 // PCA normals: first-order convergence on analytic surfaces, exactness far from the origin,
 // parity with pcl::NormalEstimation, orientation, and bad input.
 #include <gtest/gtest.h>
+
 #include <pcl/features/normal_3d.h>
 #include <pcl/io/pcd_io.h>
 #include <pcl/search/kdtree.h>
+#include <functional>
 
 #include <Eigen/Eigenvalues>
 #include <atomic>
@@ -191,6 +193,39 @@ TEST(PCANormals, MeshInputIsOrientedLikeTheFacesAndCloudsTowardsTheViewpoint) {
   estimator.compute(normals);
   EXPECT_EQ(estimator.getOrientation(), NormalOrientation::Viewpoint);
   EXPECT_LT(angleErrors(normalsOf(normals), -sphere.normals, SignMode::Signed).max, 20.0);
+}
+
+TEST(PCANormals, SettersOnlyStoreTheOrientationIsFixedAtComputeWhateverTheirOrder) {
+  // A mesh's rings orient like the faces unless told otherwise; a viewpoint given tells it to
+  // face the viewpoint, and an explicit setOrientation* wins over both, in either order.
+  const SurfaceSample torus = makeTorus({64, 0.25, 2}).rotateAndShiftFar();
+  const auto cloud = toCloud(torus.points);
+  const auto mesh = topologyPtrOf(torus);
+  const auto run =
+      [&](const std::vector<std::function<void(PCANormalEstimation<pcl::PointXYZ, pcl::Normal>&)>>&
+              setters) {
+        PCANormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+        estimator.setInputCloud(cloud);
+        estimator.setSearchMethod(std::make_shared<MeshRingSearch<pcl::PointXYZ>>(mesh));
+        estimator.setKSearch(16);
+        for (const auto& set : setters) set(estimator);
+        Normals normals;
+        estimator.compute(normals);
+        return std::make_pair(estimator.getOrientation(), normalsOf(normals));
+      };
+  using E = PCANormalEstimation<pcl::PointXYZ, pcl::Normal>;
+  const auto viewpoint = [](E& e) { e.setViewPoint(1.0f, 2.0f, 3.0f); };
+  const auto faces = [&](E& e) { e.setOrientationMesh(mesh); };
+  const auto up = [](E& e) { e.setOrientationUp(); };
+  EXPECT_EQ(run({}).first, NormalOrientation::MeshFaces);
+  EXPECT_EQ(run({viewpoint}).first, NormalOrientation::Viewpoint);
+  const auto mesh_then_viewpoint = run({faces, viewpoint}),
+             viewpoint_then_mesh = run({viewpoint, faces});
+  EXPECT_EQ(mesh_then_viewpoint.first, NormalOrientation::MeshFaces);
+  EXPECT_EQ(viewpoint_then_mesh.first, NormalOrientation::MeshFaces);
+  EXPECT_EQ(mesh_then_viewpoint.second, viewpoint_then_mesh.second);
+  EXPECT_EQ(run({up, viewpoint}).first, NormalOrientation::Up);
+  EXPECT_EQ(run({viewpoint, up}).first, NormalOrientation::Up);
 }
 
 TEST(PCANormals, NonFinitePointsGetNaNAndAreCountedDuplicatesDoNoHarm) {

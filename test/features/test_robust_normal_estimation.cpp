@@ -156,6 +156,31 @@ TEST(RobustNormals, OnANoiseFreeCubeEachPointGetsTheNormalOfItsOwnFaceUpToTheEdg
   EXPECT_LT(pca_near_exact, 0.5 * near) << pca_near_exact << " of " << near;
 }
 
+TEST(RobustNormals, TheDefaultKIsAppliedNotStoredSoARadiusCanFollow) {
+  // PCL refuses a k and a radius together: a default k written into k_ would make a later
+  // setRadiusSearch fail ("both radius and K"), every output then missing.
+  const CubeSample cube = sampleCube(500, 5);
+  Robust estimator;
+  estimator.setInputCloud(toCloud(cube.points));
+  estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  Normals by_default, by_radius;
+  estimator.compute(by_default);
+  EXPECT_EQ(estimator.getKSearch(), 0);
+  EXPECT_EQ(by_default.size(), cube.points.cols());
+  estimator.setRadiusSearch(0.2);
+  estimator.compute(by_radius);
+  ASSERT_EQ(by_radius.size(), cube.points.cols());
+  EXPECT_EQ(estimator.getFailedPoints(), 0);
+  Robust with_k;  // the default is kRobustNormalNeighbours, as if set
+  with_k.setInputCloud(toCloud(cube.points));
+  with_k.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  with_k.setKSearch(kRobustNormalNeighbours);
+  Normals with_k_normals;
+  with_k.compute(with_k_normals);
+  for (std::size_t i = 0; i < by_default.size(); ++i)
+    ASSERT_EQ(by_default[i].getNormalVector3fMap(), with_k_normals[i].getNormalVector3fMap()) << i;
+}
+
 TEST(RobustNormals, OnSmoothNoiseFreeSurfacesTheyAreAsAccurateAsPCA) {
   // A sphere of 10242 and a torus of 8192 samples: the robust fit chooses a small scale there
   // (the plane's residual is curvature, not noise), so its error is PCA's at a small k.
@@ -274,8 +299,8 @@ TEST(RobustNormals, WithoutKTheNeighbourhoodIsTheDefaultAndARadiusSearchWorksToo
   estimator.setInputCloud(toCloud(s.points));
   estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
   Normals normals;
-  estimator.compute(normals);  // no setKSearch: the default
-  EXPECT_EQ(estimator.getKSearch(), kRobustNormalNeighbours);
+  estimator.compute(normals);            // no setKSearch: the default
+  EXPECT_EQ(estimator.getKSearch(), 0);  // applied, not stored (TheDefaultKIsAppliedNotStored...)
   EXPECT_EQ(estimator.getFailedPoints(), 0);
   const auto largest =
       *std::max_element(estimator.getScales().begin(), estimator.getScales().end());

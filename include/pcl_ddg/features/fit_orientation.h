@@ -29,7 +29,8 @@ class FitOrientation {
 
   // The choice, set by LocalFitEstimation's setters.
   NormalOrientation policy = NormalOrientation::Viewpoint;
-  bool chosen = false;  ///< false: by the search method (MeshFaces for a MeshRingSearch)
+  bool chosen = false;           ///< false: Viewpoint if viewpoint_given, else by the search method
+  bool viewpoint_given = false;  ///< setViewPoint or useSensorOriginAsViewPoint was called
   std::optional<Eigen::Vector3d> up;
   std::shared_ptr<const MeshTopology> mesh;  ///< MeshFaces' mesh (a MeshRingSearch's if unset)
   int tree_neighbours = 10;

@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "pcl_ddg/features/consistent_orientation.h"
-#include "pcl_ddg/mesh/local_cloud.h"
 #include "pcl_ddg/features/normal_orientation.h"
+#include "pcl_ddg/mesh/local_cloud.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 
 namespace pcl_ddg {

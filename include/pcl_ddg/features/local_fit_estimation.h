@@ -14,7 +14,10 @@
  * Orientation (see normal_orientation.h): by the viewpoint, as PCL does, unless the search method
  * is a MeshRingSearch (or setOrientationMesh was called), in which case by the mesh's faces.
  * The viewpoint is the input cloud's sensor_origin_, copied when the cloud is set, as in
- * pcl::NormalEstimation, unless setViewPoint chooses one. setOrientationSpanningTree makes the
+ * pcl::NormalEstimation, unless setViewPoint chooses one. Setters only store, as PCL's: the
+ * policy is fixed at compute(), whatever the order they were called in: the one a setOrientation*
+ * chose, else Viewpoint if setViewPoint or useSensorOriginAsViewPoint was called, else by the
+ * search method. setOrientationSpanningTree makes the
  * normals consistent along a minimum spanning tree of each point's nearest neighbours from the
  * search method (mesh rings, pixel grid or kd-tree: the graph follows the neighbourhood), for
  * clouds without a single viewpoint; the quadric's curvatures change sign with their normals.
@@ -29,6 +32,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <limits>
 #include <memory>
 
 #include "pcl_ddg/features/consistent_orientation.h"
@@ -61,7 +65,7 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
     vpy_ = vy;
     vpz_ = vz;
     use_sensor_origin_ = false;
-    choose(NormalOrientation::Viewpoint);
+    orientation_.viewpoint_given = true;
   }
   /** The viewpoint: the one set, or the input cloud's sensor_origin_ (PCL's default; the origin
    *  before a cloud is set). */
@@ -75,7 +79,7 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   void useSensorOriginAsViewPoint() {
     use_sensor_origin_ = true;
     copySensorOrigin();
-    choose(NormalOrientation::Viewpoint);
+    orientation_.viewpoint_given = true;
   }
 
   /**
@@ -108,7 +112,7 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   }
   /** Orients normals consistently along a minimum spanning tree over each point's `neighbours`
    *  nearest (consistent_orientation.h) from `graph` (a search over the same input; null: the
-   *  search method); each tree is seeded facing the viewpoint (setViewPoint before this) if
+   *  search method); each tree is seeded facing the viewpoint (setViewPoint) if
    *  seed_facing_viewpoint, else by the up direction where it decides (setUpDirection), else up
    *  at its highest point. Only the points being estimated (the
    *  indices) join the graph. */
@@ -179,8 +183,19 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   template <typename OnTurn>
   void makeOrientationConsistent(PointCloudOut& output, OnTurn&& on_turn);
 
-  /** Sets every field of a point that cannot be estimated to NaN. */
-  virtual void setInvalid(PointOutT& point) const = 0;
+  /** Sets the normal and curvature of a point that cannot be estimated to NaN. */
+  void setInvalid(PointOutT& point) const {
+    point.normal_x = point.normal_y = point.normal_z = point.curvature =
+        std::numeric_limits<float>::quiet_NaN();
+  }
+
+  /** The k of the last initCompute: pcl::Feature's k_, or defaultK() when neither setKSearch nor
+   *  setRadiusSearch was called; 0 with a radius. */
+  int searchK() const { return search_k_; }
+  /** The k used when neither setKSearch nor setRadiusSearch was called; 0: none (PCL's
+   *  "neither radius nor k set" error). Applied at each compute, never stored in k_, so that a
+   *  later setRadiusSearch still works. */
+  virtual int defaultK() const { return 0; }
 
   /** threads_, with 0 meaning every core. */
   int threadCount() const;
@@ -220,6 +235,7 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
 
   std::shared_ptr<const Eigen::Matrix3Xd> input_positions_;
   detail::FitOrientation<PointInT> orientation_;
+  int search_k_ = 0;
   std::int64_t failed_points_ = 0;
 };
 

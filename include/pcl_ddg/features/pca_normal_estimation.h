@@ -34,7 +34,6 @@ class PCANormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
 
  protected:
   void computeFeature(PointCloudOut& output) override;
-  void setInvalid(PointOutT& point) const override;
 };
 
 }  // namespace pcl_ddg

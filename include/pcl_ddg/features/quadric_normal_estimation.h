@@ -49,7 +49,6 @@ class QuadricNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
 
  protected:
   void computeFeature(PointCloudOut& output) override;
-  void setInvalid(PointOutT& point) const override;
 
  private:
   CurvatureCloud* curvatures_ = nullptr;  ///< set during computeWithCurvatures only

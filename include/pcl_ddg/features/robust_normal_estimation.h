@@ -63,12 +63,8 @@ class RobustNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
 
  protected:
   /** Neither setKSearch nor setRadiusSearch: k = kRobustNormalNeighbours. */
-  bool initCompute() override {
-    if (this->k_ == 0 && this->search_radius_ == 0.0) this->k_ = kRobustNormalNeighbours;
-    return LocalFitEstimation<PointInT, PointOutT>::initCompute();
-  }
+  int defaultK() const override { return kRobustNormalNeighbours; }
   void computeFeature(PointCloudOut& output) override;
-  void setInvalid(PointOutT& point) const override;
 
  private:
   /** Orients normal (for query point index at position) into out's normal fields. */

@@ -20,7 +20,8 @@ bool FitOrientation<PointInT>::prepare(const typename Cloud::ConstPtr& input,
   viewpoint_ = viewpoint;
   std::shared_ptr<const MeshTopology> faces = mesh;
   used_ = policy;
-  if (!chosen) {
+  if (!chosen && viewpoint_given) used_ = NormalOrientation::Viewpoint;
+  if (!chosen && !viewpoint_given) {
     const auto ring_search = std::dynamic_pointer_cast<MeshRingSearch<PointInT>>(search);
     used_ = ring_search ? NormalOrientation::MeshFaces : NormalOrientation::Viewpoint;
     if (ring_search) faces = ring_search->topologyPtr();

@@ -58,7 +58,12 @@ bool LocalFitEstimation<PointInT, PointOutT>::computePointNormal(
 
 template <typename PointInT, typename PointOutT>
 bool LocalFitEstimation<PointInT, PointOutT>::initCompute() {
-  if (!pcl::Feature<PointInT, PointOutT>::initCompute()) return false;
+  const bool defaulted = this->k_ == 0 && this->search_radius_ == 0.0 && defaultK() > 0;
+  if (defaulted) this->k_ = defaultK();
+  const bool initialised = pcl::Feature<PointInT, PointOutT>::initCompute();
+  search_k_ = this->k_;
+  if (defaulted) this->k_ = 0;  // applied, not stored (PCL's search reads search_parameter_)
+  if (!initialised) return false;
   if (input_positions_ &&
       (this->surface_ != this->input_ ||
        input_positions_->cols() != static_cast<Eigen::Index>(this->input_->size()))) {
@@ -115,7 +120,7 @@ void LocalFitEstimation<PointInT, PointOutT>::fitEachNeighbourhood(
   queries.search = &this->search_method_surface_;
   queries.search_parameter = this->search_parameter_;
   queries.radius = this->search_radius_;
-  queries.k = this->k_;
+  queries.k = searchK();
   queries.max_neighbours = max_neighbours_;
   queries.min_neighbours = min_neighbours_;
   queries.threads = threadCount();

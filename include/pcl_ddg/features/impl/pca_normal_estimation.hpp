@@ -26,12 +26,6 @@ void PCANormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& out
   this->makeOrientationConsistent(output, [](std::size_t) {});
 }
 
-template <typename PointInT, typename PointOutT>
-void PCANormalEstimation<PointInT, PointOutT>::setInvalid(PointOutT& point) const {
-  point.normal_x = point.normal_y = point.normal_z = point.curvature =
-      std::numeric_limits<float>::quiet_NaN();
-}
-
 }  // namespace pcl_ddg
 
 #define PCL_DDG_INSTANTIATE_PCANormalEstimation(T, NT) \

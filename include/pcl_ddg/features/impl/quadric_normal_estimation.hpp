@@ -80,12 +80,6 @@ void QuadricNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut&
   });
 }
 
-template <typename PointInT, typename PointOutT>
-void QuadricNormalEstimation<PointInT, PointOutT>::setInvalid(PointOutT& point) const {
-  point.normal_x = point.normal_y = point.normal_z = point.curvature =
-      std::numeric_limits<float>::quiet_NaN();
-}
-
 }  // namespace pcl_ddg
 
 #define PCL_DDG_INSTANTIATE_QuadricNormalEstimation(T, NT) \

@@ -21,7 +21,7 @@ void RobustNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& 
   std::vector<double> largest_reference(output.size(), -1.0);  // none: no wider plane
   // Planes widen from a k-nearest search (not a radius) along a graph whose rows are each
   // query's first kWideGraphWidth neighbours found.
-  const bool widening = this->search_radius_ == 0.0 && this->k_ >= kWideGraphWidth;
+  const bool widening = this->search_radius_ == 0.0 && this->searchK() >= kWideGraphWidth;
   NeighbourGraph rows;
   rows.width = kWideGraphWidth;
   if (widening) rows.neighbours.assign(output.size() * kWideGraphWidth, -1);
@@ -134,12 +134,6 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
     scales_[i] = static_cast<float>(std::min(kWideGraphWidth * (planes[i].level + 1), finite));
     confidences_[i] = 1.0f;
   }
-}
-
-template <typename PointInT, typename PointOutT>
-void RobustNormalEstimation<PointInT, PointOutT>::setInvalid(PointOutT& point) const {
-  point.normal_x = point.normal_y = point.normal_z = point.curvature =
-      std::numeric_limits<float>::quiet_NaN();
 }
 
 }  // namespace pcl_ddg
