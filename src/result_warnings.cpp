@@ -83,10 +83,6 @@ std::vector<std::string> curvatureWarnings(const VertexCurvatures& c) {
                        " vertices whose face normals cancel (reversed duplicate faces?): H, k1, "
                        "k2 NaN there");
   }
-  if (c.clamped_vertices > 0) {
-    warnings.push_back(std::to_string(c.clamped_vertices) +
-                       " vertices with H^2 < K (umbilic or noisy): k1 = k2 = H there");
-  }
   return warnings;
 }
 

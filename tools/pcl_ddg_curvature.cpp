@@ -1,6 +1,8 @@
 // pcl_ddg_curvature: curvatures of a mesh (discrete: cotangent Laplacian and angle defect) or of a
 // mesh or point cloud (fitted: a quadric through each point's neighbours), as vertex properties
 // and optionally as colours.
+#include <cstdio>
+
 #include "common/fit_steps.h"
 #include "common/operator_options.h"
 #include "common/tool_common.h"
@@ -123,6 +125,10 @@ int run(int argc, char** argv) {
           const VertexCurvatures c = computeCurvatures(*in.topology, in.positions, mass);
           timer.done(static_cast<std::size_t>(in.positions.cols()));
           for (const std::string& message : curvatureWarnings(c)) tools::warn(kName, message);
+          if (c.clamped_vertices > 0) {
+            std::fprintf(stderr, "%s: %lld vertices with H^2 < K (umbilic or noisy): k1 = k2 = H\n",
+                         kName, static_cast<long long>(c.clamped_vertices));
+          }
           curvatures = {c.mean_curvature, c.gauss_curvature, c.k1, c.k2};
           setVertexField(in.mesh.cloud, "vertex_area", c.vertex_area, precision);
         } else {

@@ -4,7 +4,8 @@
  * check for its own thread for the duration of a call (InterruptionScope); the library's long
  * loops run it from that thread about every 0.1 s of work and, once it returns true, every thread
  * of the loop skips the points left and the call throws InterruptedException. Without a scope
- * nothing is checked and the loops cost one relaxed atomic load per point more.
+ * nothing is checked and the loops cost one relaxed atomic load per point more. The check runs
+ * inside OpenMP regions: it must not throw.
  */
 #include <pcl/exceptions.h>
 

@@ -11,7 +11,10 @@
  *  - points left without an estimate (NaN), or with a quadric fallen back to a PCA normal;
  *  - mesh vertices without a normal (their face normals cancel: reversed duplicate faces?), or
  *    that took the area normal where the mean-curvature normal is undefined;
- *  - mesh vertices without a curvature (no area; face normals that cancel), or with H^2 < K.
+ *  - mesh vertices without a curvature (no area; face normals that cancel).
+ *
+ * (Vertices with H^2 < K, where k1 = k2 = H, are normal on spheres and noise: counted, not
+ * warned about.)
  *
  * The remedies name the options as the caller spells them (OptionSpelling).
  */

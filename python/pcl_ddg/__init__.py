@@ -49,7 +49,7 @@ def _warn(messages: Sequence[str]) -> None:
     import sys
 
     level, frame = 2, sys._getframe(1)  # stacklevel 2: _warn's caller
-    while frame is not None and frame.f_globals.get("__name__", "").startswith("pcl_ddg"):
+    while frame is not None and (frame.f_globals.get("__name__", "") + ".").startswith("pcl_ddg."):
         level, frame = level + 1, frame.f_back  # type: ignore[assignment]
     for message in messages:
         warnings.warn(message, PclDdgWarning, stacklevel=level)
@@ -97,32 +97,48 @@ def _shown(value: Any) -> str:
     return text if len(text) <= 40 else text[:37] + "..."
 
 
-def _integer(value: Any, name: str, minimum: int = 0) -> Any:
-    """An integer option as an int (None stays None), or ValueError naming it: bools and floats
-    are refused, as are values the library cannot index."""
-    if value is None:
+_THREADS_MAX = 1024  # OpenMP cannot start many more threads than that on any machine
+
+
+def _integer(value: Any, name: str, minimum: int = 0, maximum: int = _INDEX_MAX,
+             required: bool = False) -> Any:
+    """An integer option as an int (None stays None unless required), or ValueError naming it:
+    bools and floats are refused, as are values outside [minimum, maximum]."""
+    if value is None and not required:
         return None
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
         raise ValueError(f"{name} must be a whole number, not {_shown(value)}")
-    if not minimum <= int(value) <= _INDEX_MAX:
-        raise ValueError(f"{name} must be from {minimum} to {_INDEX_MAX}, not {int(value)}")
+    if not minimum <= int(value) <= maximum:
+        raise ValueError(f"{name} must be from {minimum} to {maximum}, not {int(value)}")
     return int(value)
 
 
-def _real(value: Any, name: str) -> Any:
-    """A real option as a float (None stays None), or ValueError naming it."""
-    if value is None:
+def _threads(value: Any) -> int:
+    """threads= (0: every core)."""
+    return int(_integer(value, "threads", 0, _THREADS_MAX, required=True))
+
+
+def _real(value: Any, name: str, required: bool = False) -> Any:
+    """A real option as a float (None stays None unless required), or ValueError naming it."""
+    if value is None and not required:
         return None
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise ValueError(f"{name} must be a number, not {_shown(value)}")
     return float(value)
 
 
-def _text(value: Any, name: str) -> Any:
-    """A named choice as a str (None stays None), or ValueError naming it."""
-    if value is None or isinstance(value, str):
+def _text(value: Any, name: str, required: bool = False) -> Any:
+    """A named choice as a str (None stays None unless required), or ValueError naming it."""
+    if (value is None and not required) or isinstance(value, str):
         return value
     raise ValueError(f"{name} must be a name (str), not {_shown(value)}")
+
+
+def _flag(value: Any, name: str) -> bool:
+    """A yes/no option: a bool (NumPy's too), or ValueError naming it."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    raise ValueError(f"{name} must be True or False, not {_shown(value)}")
 
 
 def _renamed(old_value: Any, old: str, new: str, value: Any, default: Any) -> Any:
@@ -233,8 +249,8 @@ def vertex_normals(
     """
     weights = _renamed(weighting, "weighting", "weights", weights, "area")
     normals, valid, counts = _pcl_ddg.vertex_normals(
-        _array(V, "V"), _faces(F), _text(weights, "weights"), _real(epsilon, "epsilon"),
-        _text(mass, "mass"),
+        _array(V, "V"), _faces(F), _text(weights, "weights", True), _real(epsilon, "epsilon"),
+        _text(mass, "mass", True),
     )
     _warn(counts["warnings"])
     return VertexNormals(normals, valid)
@@ -268,8 +284,8 @@ def laplacian(
         M of the averaged form: ``"mixed"``, ``"voronoi"`` or ``"barycentric"``.
     """
     data, indices, indptr = _pcl_ddg.laplacian(
-        _array(V, "V"), _faces(F), _text(weights, "weights"), _text(form, "form"),
-        _text(mass, "mass"),
+        _array(V, "V"), _faces(F), _text(weights, "weights", True), _text(form, "form", True),
+        _text(mass, "mass", True),
     )
     return _csr(data, indices, indptr)
 
@@ -290,7 +306,7 @@ def mass_matrix(
     The masses sum to the total area for every kind.
     """
     mass = _renamed(kind, "kind", "mass", mass, "mixed")
-    area = _pcl_ddg.mass_matrix(_array(V, "V"), _faces(F), _text(mass, "mass"))
+    area = _pcl_ddg.mass_matrix(_array(V, "V"), _faces(F), _text(mass, "mass", True))
     n = area.shape[0]
     index = np.arange(n, dtype=np.int32)
     return _csr(area, index, np.arange(n + 1, dtype=np.int32))
@@ -320,7 +336,7 @@ def curvatures(V: ArrayLike, F: Optional[Faces], mass: str = "mixed") -> Curvatu
     ``"voronoi"``, ``"barycentric"``.
     """
     mean, gauss, k1, k2, area, _, counts = _pcl_ddg.curvatures(
-        _array(V, "V"), _faces(F), _text(mass, "mass")
+        _array(V, "V"), _faces(F), _text(mass, "mass", True)
     )
     _warn(counts["warnings"])
     return Curvatures(mean, gauss, k1, k2, area)
@@ -399,23 +415,23 @@ def smooth(
     return _pcl_ddg.smooth(
         _array(V, "V"),
         _faces(F),
-        _text(method, "method"),
+        _text(method, "method", True),
         _text(weights, "weights"),
         _text(average, "average"),
         _text(mass, "mass"),
         _real(lambda_dt, "lambda_dt"),
         _real(lambda_, "lambda_"),
         _real(mu, "mu"),
-        _integer(iterations, "iterations"),
-        bool(absolute_time),
-        bool(freeze_weights),
-        bool(update_mass),
-        bool(rebuild_weights),
+        _integer(iterations, "iterations", required=True),
+        _flag(absolute_time, "absolute_time"),
+        _flag(freeze_weights, "freeze_weights"),
+        _flag(update_mass, "update_mass"),
+        _flag(rebuild_weights, "rebuild_weights"),
         _real(thickness_limit, "thickness_limit"),
-        bool(fix_boundary),
-        bool(allow_unstable),
-        _text(preserve, "preserve"),
-        _text(solver, "solver"),
+        _flag(fix_boundary, "fix_boundary"),
+        _flag(allow_unstable, "allow_unstable"),
+        _text(preserve, "preserve", True),
+        _text(solver, "solver", True),
     )
 
 
@@ -439,20 +455,18 @@ def smooth_field(
     below a wavelength of about 2 pi sqrt(time) is gone. The mass-weighted sum is conserved on a
     closed mesh; a free boundary is insulated, a fixed one (``fix_boundary``) keeps its values.
     """
-    if time is None:
-        raise ValueError("time must be a number (the diffusion time), not None")
     return _pcl_ddg.smooth_field(
         _array(V, "V"),
         _faces(F),
         _array(values, "values"),
-        _real(time, "time"),
-        _text(method, "method"),
-        _text(weights, "weights"),
-        _text(mass, "mass"),
-        _integer(iterations, "iterations"),
-        bool(absolute_time),
-        bool(fix_boundary),
-        _text(solver, "solver"),
+        _real(time, "time", required=True),
+        _text(method, "method", True),
+        _text(weights, "weights", True),
+        _text(mass, "mass", True),
+        _integer(iterations, "iterations", required=True),
+        _flag(absolute_time, "absolute_time"),
+        _flag(fix_boundary, "fix_boundary"),
+        _text(solver, "solver", True),
     )
 
 
@@ -533,7 +547,7 @@ def _fitted_normals(
     points, faces, viewpoint, orient = _file_defaults(points, faces, viewpoint, orient)
     result = _pcl_ddg.estimate_normals(
         _array(points, "points"),
-        _text(method, "method"),
+        _text(method, "method", True),
         _integer(k, "k"),
         _real(radius, "radius"),
         _integer(max_nn, "max_nn"),
@@ -544,7 +558,7 @@ def _fitted_normals(
         _text(orient, "orient"),
         _vector(up, "up"),
         _real(max_depth_jump, "max_depth_jump"),
-        _integer(threads, "threads"),
+        _threads(threads),
     )
     _warn(result[3]["warnings"])
     return result
@@ -620,7 +634,7 @@ def principal_curvatures(
         _vector(viewpoint, "viewpoint"),
         _text(orient, "orient"),
         _vector(up, "up"),
-        _integer(threads, "threads"),
+        _threads(threads),
     )
     _warn(counts["warnings"])
     return PrincipalCurvatures(k1, k2, direction, normals, valid)
@@ -681,10 +695,10 @@ def orient_normals(
     out, flipped = _pcl_ddg.orient_normals(
         _array(points, "points"),
         _array(normals, "normals"),
-        _text(method, "method"),
+        _text(method, "method", True),
         _vector(viewpoint, "viewpoint"),
         _vector(up, "up"),
-        _integer(k, "k"),
+        _integer(k, "k", required=True),
         None if faces is None else _faces(faces),
     )
     return OrientedNormals(out, flipped)
@@ -711,11 +725,11 @@ def compare_neighbourhoods(
     angle, overlap, summary = _pcl_ddg.compare_neighbourhoods(
         _array(V, "V"),
         None if F is None else _faces(F),
-        _text(method, "method"),
+        _text(method, "method", True),
         _integer(k, "k"),
         _real(radius, "radius"),
         _integer(max_nn, "max_nn"),
-        _integer(threads, "threads"),
+        _threads(threads),
     )
     return NeighbourhoodComparison(angle, overlap, summary)
 
@@ -775,8 +789,8 @@ class MeshFile:
         )
 
 
-def _path(path: Union[str, "os.PathLike[str]"]) -> str:
-    return os.fspath(path)
+def _path(path: Union[str, bytes, "os.PathLike[str]"]) -> str:
+    return os.fsdecode(os.fspath(path))
 
 
 def read(path: Union[str, "os.PathLike[str]"]) -> MeshFile:
@@ -844,8 +858,8 @@ def write(
         None if faces is None else _faces(faces),
         None if fields is None else dict(fields),
         _vector(viewpoint, "viewpoint"),
-        precision,
-        encoding,
+        _text(precision, "precision"),
+        _text(encoding, "encoding", True),
         None if organized_shape is None else (int(organized_shape[0]), int(organized_shape[1])),
         las,
     )

@@ -933,9 +933,12 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
     # What the tool would warn about on the merged cloud (the points' sampling is not measured
     # here: the tiles never hold the whole cloud).
     world = [b + plan.origin[i % 3] for i, b in enumerate(plan.bounds)]  # bounds: local frame
+    # Non-finite points are left out of the tiles; the tool counts them among the points without
+    # an estimate. Resumed tiles' counts are not kept: those of this run's tiles.
     warnings = _pcl_ddg._result_warnings(
         world, options["orient"], list(options["viewpoint"]),
-        sum(r["failed"] for r in tiles), sum(r["fallback"] for r in tiles))
+        sum(r["failed"] for r in tiles) + total - plan.finite_points,
+        sum(r["fallback"] for r in tiles))
     for message in warnings:
         stream.write(f"pcl_ddg.distributed: warning: {message}\n")
     return {

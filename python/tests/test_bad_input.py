@@ -146,6 +146,14 @@ OPTION_CASES = {
                          "epsilon"),
     "weights a number": ("pcl_ddg.laplacian(V, F, weights=1)", "weights"),
     "mass a number": ("pcl_ddg.mass_matrix(V, F, mass=2)", "mass"),
+    "threads beyond OpenMP": ("pcl_ddg.estimate_normals(P, threads=100000)", "threads"),
+    "threads None": ("pcl_ddg.estimate_normals(P, threads=None)", "threads"),
+    "iterations None": ("pcl_ddg.smooth(V, F, iterations=None)", "iterations"),
+    "weights None": ("pcl_ddg.vertex_normals(V, F, weights=None)", "weights"),
+    "mass None": ("pcl_ddg.mass_matrix(V, F, mass=None)", "mass"),
+    "k None for orientation": ("pcl_ddg.orient_normals(P, P, k=None)", "k"),
+    "a flag not a bool": ("pcl_ddg.smooth(V, F, absolute_time='no')", "absolute_time"),
+    "encoding a number": ("pcl_ddg.write('x.ply', V, encoding=1)", "encoding"),
 }
 
 

@@ -102,3 +102,10 @@ def test_faces_as_an_array_write_the_bytes_of_the_same_faces_as_polygons(tmp_pat
         bad[7, 1] = len(V)
         pcl_ddg.write(tmp_path / "bad.ply", V, bad)
     assert not (tmp_path / "bad.ply").exists()
+
+
+def test_paths_as_bytes_and_path_objects(tmp_path):
+    V, F = icosphere(1)
+    for path in (bytes(tmp_path / "a.ply"), tmp_path / "b.ply", str(tmp_path / "c.ply")):
+        pcl_ddg.write(path, V, F)
+        np.testing.assert_array_equal(pcl_ddg.read(path).points, V)

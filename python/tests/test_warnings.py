@@ -104,3 +104,16 @@ def test_the_tool_says_the_same_words(tmp_path):
             'orient="up"', "-orient up")
         assert "pcl_ddg_normals: warning: " + text in run.stderr, (text, run.stderr)
     assert len(seen) == 2
+
+
+def test_a_user_module_named_like_the_package_gets_its_own_warnings(tmp_path, monkeypatch):
+    """Only pcl_ddg and pcl_ddg.* are skipped to find the caller: pcl_ddg_helpers is the user's."""
+    (tmp_path / "pcl_ddg_helpers.py").write_text(
+        "import pcl_ddg\n"
+        "def fit(points):\n"
+        "    return pcl_ddg.estimate_normals(points)\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import pcl_ddg_helpers
+
+    _, seen = caught(lambda: pcl_ddg_helpers.fit(terrain(offset=(5e3, 5e3, 100.0))))
+    assert len(seen) == 1 and seen[0].filename == str(tmp_path / "pcl_ddg_helpers.py")

@@ -226,6 +226,8 @@ TEST(PCANormals, SettersOnlyStoreTheOrientationIsFixedAtComputeWhateverTheirOrde
   EXPECT_EQ(mesh_then_viewpoint.second, viewpoint_then_mesh.second);
   EXPECT_EQ(run({up, viewpoint}).first, NormalOrientation::Up);
   EXPECT_EQ(run({viewpoint, up}).first, NormalOrientation::Up);
+  const auto towards_viewpoint = [](E& e) { e.setOrientationViewpoint(); };
+  EXPECT_EQ(run({up, towards_viewpoint}).first, NormalOrientation::Viewpoint);
 }
 
 TEST(PCANormals, NonFinitePointsGetNaNAndAreCountedDuplicatesDoNoHarm) {

@@ -98,6 +98,9 @@ class LocalFitEstimation : public pcl::Feature<PointInT, PointOutT> {
   bool computePointNormal(const pcl::PointCloud<PointInT>& cloud, const pcl::Indices& indices,
                           float& nx, float& ny, float& nz, float& curvature) const;
 
+  /** Orients normals towards the viewpoint (setViewPoint's, else the sensor origin) whatever
+   *  the search method or an earlier setOrientation* chose. */
+  void setOrientationViewpoint() { choose(NormalOrientation::Viewpoint); }
   /** Orients normals up: n . up >= 0, up = (ux, uy, uz) (setUpDirection; default +z). */
   void setOrientationUp() { choose(NormalOrientation::Up); }
   /** The up direction of setOrientationUp, and the reference of a spanning tree not seeded
