@@ -503,11 +503,12 @@ def test_a_changed_input_redoes_the_tiles_that_read_it(tmp_path, client):
     folder = tmp_path / "in"
     left, right, merged = side_by_side(folder, 1.0)
     out = tmp_path / "out"
-    limit = memory(client, 8000)
 
     def run():
+        # sized anew each run: the workers grow from run to run (the tiles are kept whatever it)
         summary = dd.estimate_normals([left, right], out, client=client, k=16,
-                                      merge=str(out / "m.ply"), memory_per_worker=limit)
+                                      merge=str(out / "m.ply"),
+                                      memory_per_worker=memory(client, 8000))
         run_tool("pcl_ddg_normals", merged, tmp_path / "tool.ply", "-k", "16")
         assert (out / "m.ply").read_bytes() == (tmp_path / "tool.ply").read_bytes()
         return summary
