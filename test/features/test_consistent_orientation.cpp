@@ -215,19 +215,16 @@ TEST(ConsistentOrientation, AReferenceSignsWhatItCanAndTheTreeOnlyTheRest) {
   EXPECT_EQ(report.ambiguous_regions, 0);
 }
 
-TEST(ConsistentOrientation, AnAmbiguousRegionTakesTheMajoritySignOfItsConfidentNeighbours) {
-  // A cylinder's side (normals horizontal: ambiguous for up, scrambled) under a cap whose
-  // normals lean outwards (confident): the side is one region, signed by its tree edges to the
-  // cap, so it comes out outward.
+/** A cylinder's side, normals (cos t, sin t, rise) with every other one turned around, under a
+ *  cap whose normals lean outwards by lean (inwards when negative), oriented with up = +z. Out:
+ *  how many of the side's normals come out as (cos t, sin t, rise). */
+int outwardSideUnderACap(double rise, double lean) {
   OrientedCloud cylinder;
   for (int k = 0; k < 40; ++k) {
     for (int a = 0; a < 60; ++a) {
       const double t = 2 * M_PI * a / 60;
-      const Eigen::Vector3d n(std::cos(t), std::sin(t), 0.0);
-      cylinder.points.push_back(
-          pcl::PointXYZ(static_cast<float>(n.x()), static_cast<float>(n.y()), 0.1f * k));
-      cylinder.normals.push_back(
-          pcl::Normal(static_cast<float>(n.x()), static_cast<float>(n.y()), 0.0f));
+      add(cylinder, Eigen::Vector3d(std::cos(t), std::sin(t), 0.1 * k),
+          Eigen::Vector3d(std::cos(t), std::sin(t), rise));
     }
   }
   const int side = static_cast<int>(cylinder.points.size());
@@ -235,25 +232,34 @@ TEST(ConsistentOrientation, AnAmbiguousRegionTakesTheMajoritySignOfItsConfidentN
     for (int a = 0; a < 6 * r; ++a) {
       const double t = 2 * M_PI * a / (6 * r), radius = 0.1 * r;
       add(cylinder, Eigen::Vector3d(radius * std::cos(t), radius * std::sin(t), 3.95),
-          Eigen::Vector3d(0.3 * std::cos(t), 0.3 * std::sin(t), 1.0));
+          Eigen::Vector3d(lean * std::cos(t), lean * std::sin(t), 1.0));
     }
   }
   pcl::PointCloud<pcl::Normal> normals = cylinder.normals;
-  for (int i = 0; i < side; i += 2) {
-    normals[i].normal_x = -normals[i].normal_x;
-    normals[i].normal_y = -normals[i].normal_y;
-  }
+  for (int i = 0; i < side; i += 2) normals[i].getNormalVector3fMap() *= -1.0f;
   ConsistentOrientationOptions options;
   options.up = Eigen::Vector3d::UnitZ();
   const ConsistentOrientationReport report =
       orientNormalsConsistently(cylinder.points, normals, options);
   EXPECT_EQ(report.confident_points, static_cast<std::int64_t>(normals.size()) - side);
-  // The cap's normals lean outwards: the side, joined to them, comes out outward.
   int outward = 0;
   for (int i = 0; i < side; ++i)
     outward +=
         normals[i].getNormalVector3fMap().dot(cylinder.normals[i].getNormalVector3fMap()) > 0.0f;
-  EXPECT_EQ(outward, side);
+  return outward;
+}
+
+TEST(ConsistentOrientation, AnAmbiguousRegionFacesTheReferenceOnTheWhole) {
+  // The side rises 3 degrees (n . up = 0.05 < 0.1: ambiguous) and the cap leans inwards, so its
+  // tree edges to the side say "inwards": the side's sum of n . up says outwards, and decides.
+  EXPECT_EQ(outwardSideUnderACap(0.05, -0.3), 40 * 60);
+  EXPECT_EQ(outwardSideUnderACap(-0.05, -0.3), 0) << "falling 3 degrees: inwards";
+}
+
+TEST(ConsistentOrientation, ATieIsBrokenByTheConfidentNeighbours) {
+  // Horizontal normals: the side's sum of n . up is 0; the cap's lean decides through the tree.
+  EXPECT_EQ(outwardSideUnderACap(0.0, 0.3), 40 * 60);
+  EXPECT_EQ(outwardSideUnderACap(0.0, -0.3), 0);
 }
 
 TEST(ConsistentOrientation, GridGraphOfARangeImage) {

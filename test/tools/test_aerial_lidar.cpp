@@ -5,6 +5,7 @@
 // says how many neighbours its ball holds.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <string>
 
 #include "pcl_ddg/io/mesh_io.h"
@@ -105,33 +106,65 @@ TEST_F(AerialLidar, AFarViewpointIsSaidOnceAndNamesTheRemedies) {
   EXPECT_GT(upShare(path("out.ply")).up, 0.99);
 }
 
+/** The unit normals of a tool's output, and its points in double. */
+struct Oriented {
+  Eigen::Matrix3Xd points, normals;
+};
+
+Oriented readOriented(const std::string& path) {
+  const MeshFile file = readMeshFile(path);
+  Oriented out{file.positions, Eigen::Matrix3Xd(3, file.positions.cols())};
+  out.normals.row(0) = vertexScalarField(file.mesh.cloud, "nx").transpose();
+  out.normals.row(1) = vertexScalarField(file.mesh.cloud, "ny").transpose();
+  out.normals.row(2) = vertexScalarField(file.mesh.cloud, "nz").transpose();
+  return out;
+}
+
 TEST_F(AerialLidar, TheSpanningTreeKeepsWhatTheReferenceDecides) {
   // Seeded by a viewpoint 2 km above (or by up), the tree may only fill in the points the
-  // reference cannot sign (|n . d| < 0.1: walls, seen edge-on from above, whose sign up or down
-  // is a matter of a fraction of a degree): as good as the viewpoint alone to 0.1 % of the points
-  // (terrain 99.31 % up, autzen 99.43 %, mvk 99.63 %), never a normal pointing steeply down, not
-  // the 84 % that propagating across trees and walls gave.
+  // reference cannot sign (|n . d| < 0.1: walls, seen edge-on from above, and at a survey's edge
+  // slopes that a tilted line of sight grazes), each region of them taking the sign its sum of
+  // n . d gives. So: every point the viewpoint signs is signed as by the viewpoint alone, and the
+  // share up is the viewpoint's (autzen 99.43 %, mvk 99.63 %; terrain 99.30 % against 99.31 %:
+  // 102 grazed points differ, 58 up by the viewpoint, 44 by the tree, a coin toss either way)
+  // -- not the 84 % that propagating across trees and walls gave.
   for (const std::string& survey :
        {kTerrain, std::string("las/autzen_trim.las"), std::string("las/mvk-thin.las")}) {
     SCOPED_TRACE(survey);
-    const auto run16 = [&](const std::string& options) {
+    const auto run16 = [&](const std::string& options, const std::string& out) {
       return runTool(PCL_DDG_NORMALS_TOOL,
-                     sharedData(survey) + " " + path("out.ply") + " -k 16 " + options);
+                     sharedData(survey) + " " + path(out) + " -k 16 " + options);
     };
-    ASSERT_EQ(run16("-viewpoint " + viewpointAbove(survey)).exit_code, 0);
-    const UpShare by_viewpoint = upShare(path("out.ply"));
-    for (const std::string reference :
-         {"-viewpoint " + viewpointAbove(survey), std::string("-up 0,0,1")}) {
+    const std::string viewpoint = viewpointAbove(survey);
+    ASSERT_EQ(run16("-viewpoint " + viewpoint, "viewpoint.ply").exit_code, 0);
+    const UpShare by_viewpoint = upShare(path("viewpoint.ply"));
+    Eigen::Vector3d eye;
+    ASSERT_EQ(std::sscanf(viewpoint.c_str(), "%lf,%lf,%lf", &eye.x(), &eye.y(), &eye.z()), 3);
+    for (const std::string reference : {"-viewpoint " + viewpoint, std::string("-up 0,0,1")}) {
       SCOPED_TRACE(reference);
-      const ToolRun run = run16("-orient mst " + reference);
+      const ToolRun run = run16("-orient mst " + reference, "out.ply");
       ASSERT_EQ(run.exit_code, 0) << run.err;
       const UpShare share = upShare(path("out.ply"));
       EXPECT_GE(share.up, 0.99);
-      EXPECT_GE(share.up, by_viewpoint.up - 0.001);
+      EXPECT_GE(share.up, by_viewpoint.up - 0.0002);
+      const Oriented tree = readOriented(path("out.ply"));
+      long decided = 0, kept = 0;
+      for (Eigen::Index i = 0; i < tree.normals.cols(); ++i) {
+        if (!tree.normals.col(i).allFinite()) continue;
+        const Eigen::Vector3d d = reference == "-up 0,0,1"
+                                      ? Eigen::Vector3d::UnitZ()
+                                      : Eigen::Vector3d((eye - tree.points.col(i)).normalized());
+        // 0.105, not 0.1: the tool's n . d is of float normals before they are written.
+        if (std::abs(tree.normals.col(i).dot(d)) < 0.105) continue;
+        ++decided;
+        kept += tree.normals.col(i).dot(d) > 0.0;
+      }
+      EXPECT_EQ(kept, decided) << "every point the reference signs faces it";
+      EXPECT_GT(decided, share.valid * 9 / 10);
       // Up signs every normal steeper than 5.7 degrees; a viewpoint over mvk's 5 km sees its
       // edges 50 degrees off vertical, and itself turns 4 normals steeply down there.
       if (reference == "-up 0,0,1") EXPECT_EQ(share.steep_down, 0);
-      EXPECT_LE(share.steep_down, by_viewpoint.steep_down + share.valid / 1000);
+      EXPECT_LE(share.steep_down, by_viewpoint.steep_down);
       EXPECT_NE(run.err.find("signed by the reference"), std::string::npos) << run.err;
       EXPECT_NE(run.err.find("turned by propagation in"), std::string::npos) << run.err;
     }

@@ -11,8 +11,10 @@
  * viewpoint (or up), and its normal is turned to n . d >= 0 whatever the tree says, because
  * propagation over a tree flips whole regions across trees, walls and thin parts. The tree only
  * fills in the ambiguous points: each connected region of them (over tree edges) is made
- * consistent from its most confident point, and takes the sign that the majority of its tree
- * edges to confident points agree with (none: the sign of sum n . d over the region).
+ * consistent from its most confident point, and takes the sign that agrees with the reference
+ * most, sum over the region of n . d >= 0 (each point's own sign is a coin toss there, the sum is
+ * not); a tie goes to the majority of its tree edges to confident points. Confident points are
+ * signed as by the reference alone.
  *
  * The graph is the k nearest neighbours in space, or the mesh's edges, or an organized cloud's
  * jump-free pixel steps (OrganizedGridSearch), or one the caller gives. Points with a non-finite
