@@ -4,6 +4,7 @@
 #include "common/tool_common.h"
 #include "common/tool_output.h"
 #include "pcl_ddg/features/consistent_orientation.h"
+#include "pcl_ddg/features/fit_choices.h"
 #include "pcl_ddg/features/ring_surface_variation.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
@@ -62,14 +63,6 @@ constexpr const char* kSyntax =
     "         [-precision float|double]\n"
     "         [-memory SIZE (clouds larger than memory: fitted tile by tile within SIZE, like 2G;\n"
     "                  input binary PCD or PLY, output binary; the same values as in memory)]";
-
-pcl_ddg::NormalWeighting weightingOf(const std::string& method) {
-  using pcl_ddg::NormalWeighting;
-  return method == "uniform"          ? NormalWeighting::Uniform
-         : method == "angle"          ? NormalWeighting::Angle
-         : method == "mean_curvature" ? NormalWeighting::MeanCurvature
-                                      : NormalWeighting::Area;
-}
 
 /** Says how many normals the spanning tree turned. */
 void reportSpanningTree(const pcl_ddg::ConsistentOrientationReport& report) {
@@ -132,23 +125,20 @@ int run(int argc, char** argv) {
   if (args.has("epsilon") && !(args.number("epsilon", 0.0) >= 0.0))
     throw tools::UsageError("-epsilon must be >= 0");
   tools::checkLocalFitArguments(args);
-  const std::string orient =
-      args.has("orient") ? args.choice("orient", {"viewpoint", "up", "mst", "mesh"}, "mesh") : "";
-  if (args.has("up") && orient != "up" && orient != "mst")
-    throw tools::UsageError("-up applies to -orient up and -orient mst");
-  if (orient == "mst" && args.has("up") && args.has("viewpoint"))
-    throw tools::UsageError("-orient mst takes one reference: -viewpoint or -up");
+  const std::optional<NormalOrientation> orientation = tools::orientationArgument(args);
+  const bool spanning_tree = orientation == NormalOrientation::SpanningTree;
   if (args.has("memory")) {
     // A cloud larger than memory: fitted tile by tile from the file (pcl_ddg/tiling).
     if ((!requested.empty() && !fitted) || requested == "robust")
       throw tools::UsageError("-memory applies to pca and quadric on clouds");
-    if (!orient.empty() && orient != "viewpoint" && orient != "up")
-      throw tools::UsageError("-orient " + orient +
+    if (orientation && orientation != NormalOrientation::Viewpoint &&
+        orientation != NormalOrientation::Up)
+      throw tools::UsageError("-orient " + *args.value("orient") +
                               " needs the whole cloud; with -memory normals face the viewpoint "
                               "or up");
     LocalFitOptions options = tools::outOfCoreFitArguments(
         args, requested == "quadric" ? LocalFitMethod::Quadric : LocalFitMethod::PCA);
-    if (orient == "up") options.orientation = NormalOrientation::Up;
+    if (orientation == NormalOrientation::Up) options.orientation = NormalOrientation::Up;
     return tools::fitEachInputOutOfCore(
         kName, args, options, precision,
         [&](pcl::PCLPointCloud2& piece, const std::string& output, const LocalFitResult& fit) {
@@ -159,8 +149,10 @@ int run(int argc, char** argv) {
       args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
         if (args.has("normal_map")) tools::checkOutputFile(*args.value("normal_map"), {input});
         tools::ToolInput in(input, kName);
-        if (orient == "mesh" && !in.topology)
-          throw tools::UsageError("-orient mesh needs a mesh; this input is a point cloud");
+        if (orientation) {
+          tools::usage(
+              [&] { checkOrientationInput(*orientation, in.topology != nullptr, kToolStyle); });
+        }
         const std::string method =
             !requested.empty() ? requested : (in.topology && !neighbour_options ? "area" : "pca");
         if (method != "pca" && method != "quadric" && method != "robust") {
@@ -168,7 +160,7 @@ int run(int argc, char** argv) {
             throw tools::UsageError("-method " + method +
                                     " needs a mesh; this input is a point cloud");
           MeshNormalOptions options;
-          options.weighting = weightingOf(method);
+          options.weighting = chooseNormalWeighting(method, "method", kToolStyle);
           if (args.has("epsilon")) {
             options.epsilon = args.number("epsilon", -1.0);
             if (options.epsilon < 0.0) throw tools::UsageError("-epsilon must be >= 0");
@@ -188,14 +180,8 @@ int run(int argc, char** argv) {
           }
         } else {
           LocalFitOptions options =
-              tools::localFitArguments(args, in,
-                                       method == "pca"       ? LocalFitMethod::PCA
-                                       : method == "quadric" ? LocalFitMethod::Quadric
-                                                             : LocalFitMethod::Robust);
-          options.orientation = orient == "viewpoint" ? NormalOrientation::Viewpoint
-                                : orient == "up"      ? NormalOrientation::Up
-                                : orient == "mst"     ? NormalOrientation::SpanningTree
-                                                      : NormalOrientation::MeshFaces;
+              tools::localFitArguments(args, in, chooseFitMethod(method, kToolStyle));
+          options.orientation = orientation.value_or(NormalOrientation::MeshFaces);
           tools::orientLasUp(kName, args, in.las && !in.topology, options);
           // An organized frame has one sensor: it decides the tree's signs (unless -up does).
           options.seed_facing_viewpoint =
@@ -204,7 +190,7 @@ int run(int argc, char** argv) {
           const tools::SamplingCheck sampling = tools::checkSampling(kName, in, options);
           tools::Timer timer("Computing " + method + " normals (" +
                              tools::describeNeighbourhood(options) +
-                             (orient == "mst" ? ", oriented along a spanning tree)" : ")"));
+                             (spanning_tree ? ", oriented along a spanning tree)" : ")"));
           LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
             return fitLocalSurfaces(in.local(), in.topology, options);
@@ -213,7 +199,7 @@ int run(int argc, char** argv) {
           result.failed_points -= left_out;  // -classes: not fitted by request
           tools::warnAboutLocalFit(kName, result);
           tools::warnAboutRadius(kName, sampling, options, result);
-          if (orient == "mst") reportSpanningTree(result.orientation);
+          if (spanning_tree) reportSpanningTree(result.orientation);
           if (args.has("normal_map")) saveNormalMap(*args.value("normal_map"), result.normals);
           tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
           if (!result.scales.empty()) {  // robust: the neighbours it used, and its confidence

@@ -99,7 +99,7 @@ int run(int argc, char** argv) {
   p.shrinkage = preserve == "volume" ? ShrinkageCorrection::PreserveVolume
                 : preserve == "area" ? ShrinkageCorrection::PreserveArea
                                      : ShrinkageCorrection::None;
-  const tools::SolverChoice solver = tools::solverArgument(args);
+  const SolverChoice solver = tools::solverArgument(args);
   p.implicit_solver = solver.method;
   p.solver = solver.backend;
   const bool taubin = p.scheme == SmoothingScheme::Taubin;

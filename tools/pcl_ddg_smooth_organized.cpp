@@ -49,7 +49,7 @@ int run(int argc, char** argv) {
   if (!(p.time_step > 0.0)) throw tools::UsageError("-lambda_dt must be > 0");
   if (p.iterations < 1) throw tools::UsageError("-iterations must be at least 1");
   if (!(p.max_depth_jump > 0.0)) throw tools::UsageError(std::string("-") + jump + " must be > 0");
-  const tools::SolverChoice solver = tools::solverArgument(args);
+  const SolverChoice solver = tools::solverArgument(args);
   p.implicit_solver = solver.method;
   p.solver = solver.backend;
   if (p.scheme == SmoothingScheme::Explicit && p.time_step >= 0.25) {

@@ -522,7 +522,7 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
     bounds = plan.bounds
     core_lo, core_hi = plan.tile_box(tile)
     radius = options["radius"]
-    halo = radius * (1.0 + 1e-5) if radius > 0 else plan.halo_guess
+    halo = _pcl_ddg._radius_halo(radius) if radius > 0 else plan.halo_guess
     growths = 0
     # Every box gathered from, kept with the results: a later run with a changed input redoes
     # only the tiles whose boxes meet that input's chunks.
@@ -696,33 +696,22 @@ class _Progress:
 
 def _fit_options(method: str, k: Optional[int], radius: Optional[float], max_nn: Optional[int],
                  viewpoint, orient: Optional[str], up, threads: int) -> Dict[str, Any]:
+    # What only the runner refuses; the rest is checked, and defaulted, as the tools do.
     if method not in ("pca", "quadric"):
         raise ValueError(f"method must be 'pca' or 'quadric', not '{method}'")
-    if k is not None and radius is not None:
-        raise ValueError("-k and -radius exclude each other (use -radius r -max_nn N for both)")
-    if max_nn is not None and radius is None:
-        raise ValueError("-max_nn needs -radius")
     if isinstance(radius, str):
         if radius.endswith("h"):
             raise ValueError("-radius is a length here (a multiple of h needs the whole cloud)")
         radius = float(radius)
-    if radius is not None and not (radius > 0 and math.isfinite(radius)):
-        raise ValueError("-radius must be a positive length")
-    k = int(k) if k is not None else (20 if method == "quadric" else 16)
-    if k < 3:
-        raise ValueError("-k must be at least 3")
-    max_nn = int(max_nn) if max_nn is not None else 64
-    if max_nn < 3:
-        raise ValueError("-max_nn must be at least 3")
-    orient = orient or "viewpoint"
-    if orient not in ("viewpoint", "up"):
+    if orient is not None and orient not in ("viewpoint", "up"):
         raise ValueError(f"-orient {orient} needs the whole cloud; distributed normals face the "
                          "viewpoint or up")
-    if up is not None and orient != "up":
-        raise ValueError("-up applies to -orient up")
+    k, max_nn = _pcl_ddg._fit_request(
+        method, None if k is None else int(k), None if radius is None else float(radius),
+        None if max_nn is None else int(max_nn), orient, viewpoint is not None, up is not None)
     return {"method": method, "k": k, "radius": float(radius or 0.0), "max_nn": max_nn,
             "viewpoint": None if viewpoint is None else [float(v) for v in viewpoint],
-            "orient": orient, "up": None if up is None else [float(v) for v in up],
+            "orient": orient or "viewpoint", "up": None if up is None else [float(v) for v in up],
             "threads": int(threads)}
 
 

@@ -1,4 +1,4 @@
-// Point cloud functions: fitted normals and curvatures (pca, quadric) with kd-tree, mesh-ring or
+// Point cloud functions: fitted normals and curvatures (pca, quadric, robust) with kd-tree, mesh-ring or
 // pixel-grid neighbourhoods, orientation, and the neighbourhood comparison. The points are placed
 // about their local origin as the tools place a file's (local_cloud.h), so results equal the
 // tools'.
@@ -13,6 +13,7 @@
 
 #include "binding_common.h"
 #include "pcl_ddg/features/consistent_orientation.h"
+#include "pcl_ddg/features/fit_choices.h"
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/features/neighbourhood_comparison.h"
 #include "pcl_ddg/features/robust_normal_estimation.h"
@@ -132,22 +133,18 @@ struct FitArguments {
 // The options of pcl_ddg_normals' in-memory path (localFitArguments), checked the same way.
 LocalFitOptions fitOptions(const FitArguments& a, const Cloud& cloud,
                            std::shared_ptr<const MeshTopology>& topology) {
+  FitRequest request;
+  request.k = a.k;
+  request.max_nn = a.max_nn;
+  request.min_nn = a.min_nn;
+  request.radius = a.radius;
+  request.max_depth_jump = a.max_depth_jump;
+  request.orient = a.orient;
+  request.viewpoint = a.viewpoint.has_value();
+  request.up = a.up.has_value();
+  checkFitRequest(request, kPythonStyle);
   LocalFitOptions options;
-  const std::string method = choice("method", a.method, {"pca", "quadric", "robust"});
-  options.method = method == "quadric"  ? LocalFitMethod::Quadric
-                   : method == "robust" ? LocalFitMethod::Robust
-                                        : LocalFitMethod::PCA;
-  if (a.k && a.radius)
-    throw py::value_error("k and radius exclude each other (use radius with max_nn for both)");
-  if (a.max_nn && !a.radius) throw py::value_error("max_nn needs radius");
-  if (a.min_nn && !a.radius) throw py::value_error("min_nn needs radius");
-  if (a.k && *a.k < 3) throw py::value_error("k must be at least 3");
-  if (a.max_nn && *a.max_nn < 3) throw py::value_error("max_nn must be at least 3");
-  if (a.min_nn && *a.min_nn < 3) throw py::value_error("min_nn must be at least 3");
-  if (a.radius && (!(*a.radius > 0.0) || !std::isfinite(*a.radius)))
-    throw py::value_error("radius must be a positive length");
-  if (a.max_depth_jump && !(*a.max_depth_jump > 0.0))
-    throw py::value_error("max_depth_jump must be > 0 (a relative range change per pixel)");
+  options.method = chooseFitMethod(a.method, kPythonStyle);
   if (!a.faces.is_none()) {
     if (cloud.height > 1) throw py::value_error("faces need points of shape (n, 3)");
     for (const pcl::PointXYZ& p : cloud) {
@@ -158,48 +155,16 @@ LocalFitOptions fitOptions(const FitArguments& a, const Cloud& cloud,
         std::make_shared<const MeshTopology>(topologyOf(static_cast<int>(cloud.size()), a.faces));
   }
   const bool organized = !topology && cloud.height > 1;
-  // bfs and knn: the former spellings of rings and kdtree.
-  std::string requested = a.neighbours.value_or(topology ? "rings" : organized ? "grid" : "kdtree");
-  if (requested == "bfs") requested = "rings";
-  if (requested == "knn") requested = "kdtree";
-  const std::string neighbours = choice("neighbours", requested, {"kdtree", "rings", "grid"});
-  if (neighbours == "rings" && !topology)
-    throw py::value_error(
-        "neighbours='rings' needs faces; these points are a cloud (use 'kdtree')");
-  if (neighbours == "grid" && !organized)
-    throw py::value_error("neighbours='grid' needs an organized cloud of shape (h, w, 3)");
-  if (a.max_depth_jump && neighbours != "grid")
+  options.neighbourhood =
+      chooseNeighbourhood(a.neighbours, topology != nullptr, organized, kPythonStyle);
+  if (a.max_depth_jump && options.neighbourhood != NeighbourhoodKind::Grid)
     throw py::value_error("max_depth_jump applies to neighbours='grid'");
-  options.neighbourhood = neighbours == "rings"  ? NeighbourhoodKind::MeshRings
-                          : neighbours == "grid" ? NeighbourhoodKind::Grid
-                                                 : NeighbourhoodKind::KdTree;
   if (a.max_depth_jump) options.max_depth_jump = *a.max_depth_jump;
-  // As the tool: robust's default neighbourhood, capped by the points.
-  options.k = a.k.value_or(options.method == LocalFitMethod::Quadric ? 20
-                           : options.method == LocalFitMethod::Robust
-                               ? std::min<int>(kRobustNormalNeighbours, cloud.size())
-                               : 16);
-  if (!a.radius && options.k > static_cast<int>(cloud.size())) {
-    throw py::value_error("k " + std::to_string(options.k) + " is more than the " +
-                          std::to_string(cloud.size()) + " points of the input");
+  applyNeighbourCounts(request, static_cast<std::int64_t>(cloud.size()), kPythonStyle, options);
+  if (a.orient) {
+    options.orientation = chooseOrientation(*a.orient, kPythonStyle);
+    checkOrientationInput(options.orientation, topology != nullptr, kPythonStyle);
   }
-  if (a.radius) {
-    options.radius = *a.radius;
-    options.max_neighbours = static_cast<unsigned int>(a.max_nn.value_or(64));
-    options.min_neighbours = static_cast<unsigned int>(a.min_nn.value_or(0));
-  }
-  const std::string orient =
-      a.orient ? choice("orient", *a.orient, {"viewpoint", "up", "mst", "mesh"}) : "";
-  if (orient == "mesh" && !topology)
-    throw py::value_error("orient='mesh' needs faces; these points are a cloud");
-  if (a.up && orient != "up" && orient != "mst")
-    throw py::value_error("up applies to orient='up' and orient='mst'");
-  if (orient == "mst" && a.up && a.viewpoint)
-    throw py::value_error("orient='mst' takes one reference: viewpoint or up");
-  options.orientation = orient == "viewpoint" ? NormalOrientation::Viewpoint
-                        : orient == "up"      ? NormalOrientation::Up
-                        : orient == "mst"     ? NormalOrientation::SpanningTree
-                                              : NormalOrientation::MeshFaces;
   // As the tool: the viewpoint is the sensor's (a PCD's VIEWPOINT), the origin by default.
   options.viewpoint = vectorOf(a.viewpoint, "viewpoint").value_or(Eigen::Vector3d::Zero());
   options.up = directionOf(a.up);

@@ -19,6 +19,7 @@
 
 #include "binding_common.h"
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/features/fit_choices.h"
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/io/atomic_file.h"
 #include "pcl_ddg/io/cloud_pieces.h"
@@ -27,13 +28,11 @@
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/result_warnings.h"
 #include "pcl_ddg/search/kd_tree_search.h"
+#include "pcl_ddg/tiling/tile_certificate.h"
 
 namespace pcl_ddg {
 namespace python {
 namespace {
-
-// As tiled_local_fit.cpp: a point counts as inside the halo only with this relative margin.
-constexpr double kRoundingMargin = 1e-5;
 
 [[noreturn]] void failSystem(const std::string& what) {
   throw FileFormatException(what + ": " + std::strerror(errno));
@@ -143,47 +142,11 @@ Eigen::AlignedBox3d boxOf(const std::vector<double>& b) {
   return {Eigen::Vector3d(b[0], b[1], b[2]), Eigen::Vector3d(b[3], b[4], b[5])};
 }
 
-// tiled_local_fit.cpp's reach: how far the point may look before it could meet a point that was
-// not gathered (the nearest face of the halo box that does not lie beyond the cloud's bounds).
-double reach(const Eigen::Vector3d& q, const Eigen::AlignedBox3d& halo_box,
-             const Eigen::AlignedBox3d& bounds) {
-  double r = std::numeric_limits<double>::infinity();
-  for (int d = 0; d < 3; ++d) {
-    if (halo_box.min()[d] > bounds.min()[d]) r = std::min(r, q[d] - halo_box.min()[d]);
-    if (halo_box.max()[d] < bounds.max()[d]) r = std::min(r, halo_box.max()[d] - q[d]);
-  }
-  return r;
-}
-
-// The kd-tree of a tile's fit, which also keeps how far each index query for the fit's k looked:
-// the squared distance of its k-th neighbour (infinity with fewer than k). The estimator queries
-// in parallel, each point its own slot.
-class LookingKdTree : public KdTreeSearch<pcl::PointXYZ> {
- public:
-  LookingKdTree(std::size_t points, int k)
-      : k_(k), squared_kth_(points, std::numeric_limits<float>::infinity()) {}
-  using KdTreeSearch<pcl::PointXYZ>::nearestKSearch;
-  int nearestKSearch(const PointCloud& cloud, pcl::index_t index, int k, pcl::Indices& indices,
-                     std::vector<float>& squared) const override {
-    const int found =
-        KdTreeSearch<pcl::PointXYZ>::nearestKSearch(cloud, index, k, indices, squared);
-    const auto slot = static_cast<std::size_t>(index);
-    if (k == k_ && found >= k && slot < squared_kth_.size())
-      squared_kth_[slot] = squared[found - 1];
-    return found;
-  }
-  float squaredKth(std::size_t index) const { return squared_kth_[index]; }
-
- private:
-  int k_;
-  mutable std::vector<float> squared_kth_;
-};
-
 /**
  * Fits the `own` points of a gathered tile (points in the merged cloud's order, so that the
  * kd-tree's ties break as on the whole cloud). mode "certified": a point's fit counts only when
  * its k-th neighbour among the gathered points (widened by the rounding margin) is nearer than the
- * halo box's edge (`reach`), as the fit's own search finds it; the others come back uncertified,
+ * halo box's edge (haloReach, tile_certificate.h), as the fit's own search finds it; the others come back uncertified,
  * with how far they looked, for a wider gather. "all": every own point is fitted. Radius searches
  * are certified by a halo of the radius, so the check applies to k only.
  * Returns (records (n_own, 4 or 9) float32: nx ny nz curvature [pc1 pc2 k1 direction],
@@ -265,19 +228,15 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
     }
     auto indices = std::make_shared<pcl::Indices>(own_at, own_at + n_own);
     if (n_own > 0) fit = fitLocalSurfaces(local, nullptr, options, indices);
-    // tiled_local_fit.cpp's rule: the k-th neighbour among the gathered points (never nearer than
-    // the true one), widened by the rounding margin, within the reach.
+    // Certified by tile_certificate.h's rule, as fitTiles certifies.
     for (std::size_t j = 0; j < n_own; ++j) {
       ok[j] = true;
       look[j] = 0.0;
       reach_of[j] = std::numeric_limits<double>::infinity();
       if (!check) continue;
       const auto at = static_cast<std::size_t>(own_at[j]);
-      reach_of[j] = reach((*cloud)[at].getVector3fMap().cast<double>(), box, cloud_bounds);
-      const float squared = search->squaredKth(at);
-      look[j] = std::isfinite(squared)
-                    ? std::sqrt(static_cast<double>(squared)) * (1.0 + kRoundingMargin) + 1e-30
-                    : std::numeric_limits<double>::infinity();
+      reach_of[j] = haloReach((*cloud)[at].getVector3fMap().cast<double>(), box, cloud_bounds);
+      look[j] = lookingDistance(search->squaredKth(at));
       ok[j] = look[j] <= reach_of[j];
     }
     // Counted over the certified points only (the others are fitted again after a wider gather):
@@ -470,7 +429,34 @@ std::int64_t writeOutput(const std::vector<std::string>& inputs, const std::stri
 
 }  // namespace
 
+/**
+ * The runner's k and max_nn from what it was given, checked as the tools check them (their
+ * spelling: the runner's messages name the tools' options): (k, max_nn).
+ */
+py::tuple fitRequest(const std::string& method, std::optional<int> k, std::optional<double> radius,
+                     std::optional<int> max_nn, std::optional<std::string> orient, bool viewpoint,
+                     bool up) {
+  FitRequest request;
+  request.k = k;
+  request.radius = radius;
+  request.max_nn = max_nn;
+  request.orient = std::move(orient);
+  request.viewpoint = viewpoint;
+  request.up = up;
+  checkFitRequest(request, kToolStyle);
+  LocalFitOptions options;
+  options.method = chooseFitMethod(method, kToolStyle);
+  // Each tile checks k against its points; the runner against the whole input's.
+  applyNeighbourCounts(request, std::numeric_limits<std::int64_t>::max(), kToolStyle, options);
+  return py::make_tuple(options.k, max_nn.value_or(static_cast<int>(kDefaultMaxNeighbours)));
+}
+
 void bindDistributed(py::module_& m) {
+  m.def("_radius_halo", &radiusHalo, py::arg("radius"),
+        "The halo that certifies radius searches (tile_certificate.h).");
+  m.def("_fit_request", &fitRequest, py::arg("method"), py::arg("k"), py::arg("radius"),
+        py::arg("max_nn"), py::arg("orient"), py::arg("viewpoint"), py::arg("up"),
+        "The runner's (k, max_nn), checked as the tools check them.");
   m.def("_cloud_layout", &cloudLayout, py::arg("path"),
         "How a binary PCD/PLY cloud lies on disk (header only): points, header_bytes, "
         "point_bytes, width, height, viewpoint, orientation, fields.");

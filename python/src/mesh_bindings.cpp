@@ -46,10 +46,7 @@ Mesh meshOf(const py::array& vertices, const py::object& faces,
 }
 
 MassType massOf(const std::string& kind) {
-  const std::string k = choice("mass", kind, {"mixed", "voronoi", "barycentric"});
-  return k == "voronoi"       ? MassType::Voronoi
-         : k == "barycentric" ? MassType::Barycentric
-                              : MassType::MixedVoronoi;
+  return chooseMassType(kind, "mass", kPythonStyle);
 }
 
 LaplacianWeights weightsOf(const std::string& weights) {
@@ -58,18 +55,8 @@ LaplacianWeights weightsOf(const std::string& weights) {
              : LaplacianWeights::Cotangent;
 }
 
-struct SolverChoice {
-  ImplicitSolver method;
-  CholeskyBackend backend;
-};
-
-// -solver auto|cholmod|ldlt|cg, as the tools read it.
 SolverChoice solverOf(const std::string& solver) {
-  const std::string s = choice("solver", solver, {"auto", "cholmod", "ldlt", "cg"});
-  if (s == "cholmod") return {ImplicitSolver::Cholesky, CholeskyBackend::Cholmod};
-  if (s == "ldlt") return {ImplicitSolver::Cholesky, CholeskyBackend::SimplicialLDLT};
-  if (s == "cg") return {ImplicitSolver::ConjugateGradient, CholeskyBackend::Automatic};
-  return {ImplicitSolver::Automatic, CholeskyBackend::Automatic};
+  return chooseSolver(solver, kPythonStyle);
 }
 
 SmoothingScheme schemeOf(const std::string& method) {
@@ -92,14 +79,9 @@ void bindMeshes(py::module_& m) {
       [](const py::array& V, const py::object& F, const std::string& weights,
          std::optional<double> epsilon, const std::string& mass) {
         MeshNormalOptions options;
-        const std::string w =
-            choice("weights", weights, {"area", "uniform", "angle", "mean_curvature"});
-        options.weighting = w == "uniform"          ? NormalWeighting::Uniform
-                            : w == "angle"          ? NormalWeighting::Angle
-                            : w == "mean_curvature" ? NormalWeighting::MeanCurvature
-                                                    : NormalWeighting::Area;
+        options.weighting = chooseNormalWeighting(weights, "weights", kPythonStyle);
         if (epsilon) {
-          if (w != "mean_curvature")
+          if (options.weighting != NormalWeighting::MeanCurvature)
             throw py::value_error("epsilon applies to weights='mean_curvature' only");
           if (!(*epsilon >= 0.0) || !std::isfinite(*epsilon))
             throw py::value_error("epsilon must be >= 0");

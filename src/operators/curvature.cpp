@@ -6,34 +6,6 @@
 #include "triangle_geometry.h"
 
 namespace pcl_ddg {
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-// Everything one vertex needs, gathered from its own triangles in one pass.
-struct VertexSums {
-  double mass = 0.0;
-  double angle_sum = 0.0;
-  Eigen::Vector3d laplace = Eigen::Vector3d::Zero();      ///< (L x)_v, cotangent L
-  Eigen::Vector3d area_normal = Eigen::Vector3d::Zero();  ///< orientation reference
-  double area = 0.0;                                      ///< sum of |area vectors|
-};
-
-VertexSums gather(const MeshTopology& topology, const PositionsRef& positions, int v,
-                  MassType mass) {
-  VertexSums s;
-  detail::forEachCornerOf(topology, positions, v, [&](const detail::CornerView& c, int) {
-    s.mass += detail::cornerMass(c, mass);
-    s.angle_sum += c.angle();
-    s.laplace += detail::cotangentLaplacianPart(c);
-    s.area_normal += c.area_vector;
-    s.area += 0.5 * c.double_area;
-  });
-  return s;
-}
-
-}  // namespace
-
 Eigen::VectorXd angleDefect(const MeshTopology& topology, const PositionsRef& positions) {
   detail::requireMatchingPositions(topology, positions);
   Eigen::VectorXd defect(topology.numVertices());
@@ -46,7 +18,7 @@ Eigen::VectorXd angleDefect(const MeshTopology& topology, const PositionsRef& po
     double angle_sum = 0.0;
     detail::forEachCornerOf(topology, positions, v,
                             [&](const detail::CornerView& c, int) { angle_sum += c.angle(); });
-    defect[v] = (topology.isBoundary(v) ? kPi : 2.0 * kPi) - angle_sum;
+    defect[v] = detail::angleDefectAt(topology.isBoundary(v), angle_sum);
   }
   return defect;
 }
@@ -57,13 +29,8 @@ Eigen::Matrix3Xd meanCurvatureNormal(const MeshTopology& topology, const Positio
   Eigen::Matrix3Xd hn(3, topology.numVertices());
 #pragma omp parallel for schedule(static)
   for (int v = 0; v < topology.numVertices(); ++v) {
-    double m = 0.0;
-    Eigen::Vector3d laplace = Eigen::Vector3d::Zero();
-    detail::forEachCornerOf(topology, positions, v, [&](const detail::CornerView& c, int) {
-      m += detail::cornerMass(c, mass);
-      laplace += detail::cotangentLaplacianPart(c);
-    });
-    hn.col(v) = m > 0.0 ? Eigen::Vector3d(-0.5 * laplace / m) : Eigen::Vector3d::Zero();
+    const detail::VertexSums s = detail::gatherVertexSums<false>(topology, positions, v, mass);
+    hn.col(v) = s.mass > 0.0 ? Eigen::Vector3d(-0.5 * s.laplace / s.mass) : Eigen::Vector3d::Zero();
   }
   return hn;
 }
@@ -83,14 +50,14 @@ VertexCurvatures computeCurvatures(const MeshTopology& topology, const Positions
   std::int64_t clamped = 0, invalid = 0, unoriented = 0;
 #pragma omp parallel for schedule(static) reduction(+ : clamped, invalid, unoriented)
   for (int v = 0; v < n; ++v) {
-    const VertexSums s = gather(topology, positions, v, mass);
+    const detail::VertexSums s = detail::gatherVertexSums<true>(topology, positions, v, mass);
     c.vertex_area[v] = s.mass;
     if (!(s.mass > 0.0)) {
       c.mean_curvature[v] = c.gauss_curvature[v] = c.k1[v] = c.k2[v] = nan;
       ++invalid;
       continue;
     }
-    c.gauss_curvature[v] = ((topology.isBoundary(v) ? kPi : 2.0 * kPi) - s.angle_sum) / s.mass;
+    c.gauss_curvature[v] = detail::angleDefectAt(topology.isBoundary(v), s.angle_sum) / s.mass;
     if (detail::hasCancelled(s.area_normal, s.area)) {
       // No orientation to sign H by: only K, which needs none, is given.
       c.mean_curvature[v] = c.k1[v] = c.k2[v] = nan;

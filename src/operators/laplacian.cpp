@@ -112,17 +112,9 @@ void divideRows(Sparse<Storage>& matrix, const Eigen::VectorXd& mass) {
 
 }  // namespace
 
-Eigen::SparseMatrix<double> uniformLaplacian(const MeshTopology& topology) {
-  return uniform<Eigen::ColMajor>(topology);
-}
-
 Eigen::SparseMatrix<double> cotangentLaplacian(const MeshTopology& topology,
                                                const PositionsRef& positions) {
   return cotangent<Eigen::ColMajor>(topology, positions);
-}
-
-void divideRowsByMass(Eigen::SparseMatrix<double>& matrix, const Eigen::VectorXd& mass) {
-  divideRows(matrix, mass);
 }
 
 template <int Storage>

@@ -126,5 +126,37 @@ inline Eigen::Vector3d cotangentLaplacianPart(const CornerView& c) {
   return 0.5 * (c.cotangent(2) * (c.p1 - c.p0) + c.cotangent(1) * (c.p2 - c.p0));
 }
 
+/** What a vertex gathers from its own triangles in one pass: the curvatures, the mean-curvature
+ *  normal and the mean-curvature vertex normals all start from it. */
+struct VertexSums {
+  double mass = 0.0;                                      ///< the vertex's area (MassType)
+  double angle_sum = 0.0;                                 ///< with_angles only
+  Eigen::Vector3d laplace = Eigen::Vector3d::Zero();      ///< (L x)_v, cotangent L
+  Eigen::Vector3d area_normal = Eigen::Vector3d::Zero();  ///< sum of the area vectors
+  double area = 0.0;                                      ///< sum of |area vectors|
+};
+
+/** v's sums; with_angles also adds its corners' angles (an atan2 each, which normals skip). */
+template <bool with_angles>
+VertexSums gatherVertexSums(const MeshTopology& topology, const PositionsRef& positions, int v,
+                            MassType mass) {
+  VertexSums s;
+  forEachCornerOf(topology, positions, v, [&](const CornerView& c, int) {
+    s.mass += cornerMass(c, mass);
+    if constexpr (with_angles) s.angle_sum += c.angle();
+    s.laplace += cotangentLaplacianPart(c);
+    s.area_normal += c.area_vector;
+    s.area += 0.5 * c.double_area;
+  });
+  return s;
+}
+
+/** The angle defect of a vertex whose corners' angles sum to angle_sum: 2 pi minus that sum
+ *  inside, pi minus it on the boundary (the discrete Gauss curvature times the area). */
+inline double angleDefectAt(bool boundary, double angle_sum) {
+  constexpr double kPi = 3.14159265358979323846;
+  return (boundary ? kPi : 2.0 * kPi) - angle_sum;
+}
+
 }  // namespace detail
 }  // namespace pcl_ddg

@@ -90,19 +90,13 @@ NormalSums meanCurvatureDirections(const MeshTopology& topology, const Positions
   std::int64_t fallback_count = 0;
 #pragma omp parallel for schedule(static) reduction(+ : fallback_count)
   for (int v = 0; v < topology.numVertices(); ++v) {
-    Eigen::Vector3d area_normal = Eigen::Vector3d::Zero(), laplace = Eigen::Vector3d::Zero();
-    double mass = 0.0, area = 0.0;
-    detail::forEachCornerOf(topology, positions, v, [&](const detail::CornerView& c, int) {
-      area_normal += c.area_vector;
-      area += 0.5 * c.double_area;
-      laplace += detail::cotangentLaplacianPart(c);
-      mass += detail::cornerMass(c, mass_type);
-    });
+    const detail::VertexSums s = detail::gatherVertexSums<false>(topology, positions, v, mass_type);
+    const Eigen::Vector3d& area_normal = s.area_normal;
     const Eigen::Vector3d towards_normal =
-        mass > 0.0 ? Eigen::Vector3d(-laplace / mass) : Eigen::Vector3d::Zero();
+        s.mass > 0.0 ? Eigen::Vector3d(-s.laplace / s.mass) : Eigen::Vector3d::Zero();
     const double magnitude = towards_normal.norm();
-    result.lengths[v] = area;
-    if (detail::hasCancelled(area_normal, area)) {
+    result.lengths[v] = s.area;
+    if (detail::hasCancelled(area_normal, s.area)) {
       result.sums.col(v) = area_normal;
     } else if (!topology.isBoundary(v) && magnitude >= epsilon && magnitude > 0.0) {
       result.sums.col(v) =

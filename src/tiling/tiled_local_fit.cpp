@@ -8,36 +8,21 @@
 #include <limits>
 
 #include "pcl_ddg/search/kd_tree_search.h"
+#include "pcl_ddg/tiling/tile_certificate.h"
 
 namespace pcl_ddg {
 namespace {
 
-// Float squared distances of points that differ in their last bits can round either way: a point
-// counts as inside the halo only with this relative margin.
-constexpr double kRoundingMargin = 1e-5;
-
 Eigen::Vector3d position(const pcl::PointXYZ& p) {
   return p.getVector3fMap().cast<double>();
-}
-
-// How far the point may look before it could meet a point that is not gathered: the distance to
-// the nearest face of the halo box that does not lie beyond the cloud's bounds.
-double reach(const Eigen::Vector3d& q, const Eigen::AlignedBox3d& halo_box,
-             const Eigen::AlignedBox3d& bounds) {
-  double reach = std::numeric_limits<double>::infinity();
-  for (int d = 0; d < 3; ++d) {
-    if (halo_box.min()[d] > bounds.min()[d]) reach = std::min(reach, q[d] - halo_box.min()[d]);
-    if (halo_box.max()[d] < bounds.max()[d]) reach = std::min(reach, halo_box.max()[d] - q[d]);
-  }
-  return reach;
 }
 
 Eigen::AlignedBox3d grown(const Eigen::AlignedBox3d& box, double by) {
   return {box.min().array() - by, box.max().array() + by};
 }
 
-// For k nearest: how far each own point looks (its k-th neighbour among the gathered points, never
-// nearer than the true one, widened by the rounding margin; infinite when there are fewer than k).
+// For k nearest: how far each own point looks (tile_certificate.h), before its fit, to choose the
+// halo.
 std::vector<double> lookingDistances(const TilePoints& tile, int k) {
   KdTreeSearch<pcl::PointXYZ> search;
   search.setInputCloud(tile.points);
@@ -50,10 +35,8 @@ std::vector<double> lookingDistances(const TilePoints& tile, int k) {
     for (std::ptrdiff_t i = 0; i < static_cast<std::ptrdiff_t>(tile.own->size()); ++i) {
       const pcl::PointXYZ& q = (*tile.points)[(*tile.own)[i]];
       const int found = search.nearestKSearch(q, k, neighbours, squared_distances);
-      distance[i] = found < k ? std::numeric_limits<double>::infinity()
-                              : std::sqrt(static_cast<double>(squared_distances.back())) *
-                                        (1.0 + kRoundingMargin) +
-                                    1e-30;
+      distance[i] = lookingDistance(found < k ? std::numeric_limits<float>::infinity()
+                                              : squared_distances.back());
     }
   }
   return distance;
@@ -90,7 +73,7 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
   double guess = 0.0;
   for (int t = 0; t < static_cast<int>(plan.tiles.size()); ++t) {
     const Eigen::AlignedBox3d& box = plan.tiles[t].box;
-    double halo = options.radius > 0.0 ? options.radius * (1.0 + kRoundingMargin) : guess;
+    double halo = options.radius > 0.0 ? radiusHalo(options.radius) : guess;
     TilePoints points = gather(t, grown(box, halo));
     if (options.radius > 0.0) {
       local.widest_halo = std::max(local.widest_halo, halo);
@@ -104,7 +87,7 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
       std::vector<double> needed(looking.size());
       for (std::size_t i = 0; i < looking.size(); ++i) {
         const Eigen::Vector3d q = position((*points.points)[(*points.own)[i]]);
-        needed[i] = std::max(0.0, halo + looking[i] - reach(q, halo_box, bounds));
+        needed[i] = std::max(0.0, halo + looking[i] - haloReach(q, halo_box, bounds));
       }
       std::vector<double> sorted = needed;
       const std::size_t p99 = sorted.size() - 1 - sorted.size() / 100;

@@ -244,26 +244,7 @@ TEST(LocalFit, SurveyCloudNormalsEqualAnIndependentDoublePCA) {
   const Eigen::Matrix3Xd ours = normalsOf(fit.normals);
   double worst = 0.0, worst_truth = 0.0;
   for (Eigen::Index i = 0; i < world.cols(); i += 97) {
-    std::vector<std::pair<long double, Eigen::Index>> d;
-    for (Eigen::Index j = 0; j < world.cols(); ++j) {
-      long double s = 0.0L;
-      for (int c = 0; c < 3; ++c) {
-        const long double e = static_cast<long double>(world(c, j)) - world(c, i);
-        s += e * e;
-      }
-      d.emplace_back(s, j);
-    }
-    std::partial_sort(d.begin(), d.begin() + k, d.end());
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int n = 0; n < k; ++n) mean += world.col(d[n].second) - world.col(i);
-    mean /= k;
-    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-    for (int n = 0; n < k; ++n) {
-      const Eigen::Vector3d e = world.col(d[n].second) - world.col(i) - mean;
-      covariance += e * e.transpose();
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
-    worst = std::max(worst, angle(ours.col(i), eigen.eigenvectors().col(0)));
+    worst = std::max(worst, angle(ours.col(i), bruteForcePcaNormal(world, i, k)));
     worst_truth = std::max(worst_truth, angle(ours.col(i), scene.normals.col(i)));
   }
   EXPECT_LE(worst, 1e-6);

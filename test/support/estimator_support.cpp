@@ -1,7 +1,10 @@
 #include "estimator_support.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "test_data.h"
 
@@ -86,6 +89,28 @@ AngleErrors angleErrors(const Eigen::Matrix3Xd& estimated, const Eigen::Matrix3X
 
 double observedOrder(double error_coarse, double error_fine, double h_coarse, double h_fine) {
   return std::log(error_coarse / error_fine) / std::log(h_coarse / h_fine);
+}
+
+Eigen::Vector3d bruteForcePcaNormal(const Eigen::Matrix3Xd& points, Eigen::Index i, int k) {
+  std::vector<std::pair<long double, Eigen::Index>> d(static_cast<std::size_t>(points.cols()));
+  for (Eigen::Index j = 0; j < points.cols(); ++j) {
+    long double s = 0.0L;
+    for (int c = 0; c < 3; ++c) {
+      const long double e = static_cast<long double>(points(c, j)) - points(c, i);
+      s += e * e;
+    }
+    d[static_cast<std::size_t>(j)] = {s, j};
+  }
+  std::partial_sort(d.begin(), d.begin() + k, d.end());
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int n = 0; n < k; ++n) mean += points.col(d[n].second) - points.col(i);
+  mean /= k;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (int n = 0; n < k; ++n) {
+    const Eigen::Vector3d e = points.col(d[n].second) - points.col(i) - mean;
+    covariance += e * e.transpose();
+  }
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
 }
 
 }  // namespace test

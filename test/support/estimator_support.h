@@ -39,6 +39,11 @@ AngleErrors angleErrors(const Eigen::Matrix3Xd& estimated, const Eigen::Matrix3X
                         SignMode mode);
 
 /** log(e_coarse / e_fine) / log(h_coarse / h_fine). */
+/** An oracle independent of the library: point i's k nearest (itself included) by brute force in
+ *  long double on the coordinates given, their covariance about their mean in double, and Eigen's
+ *  eigenvector of its smallest eigenvalue (unoriented). */
+Eigen::Vector3d bruteForcePcaNormal(const Eigen::Matrix3Xd& points, Eigen::Index i, int k);
+
 double observedOrder(double error_coarse, double error_fine, double h_coarse, double h_fine);
 
 }  // namespace test

@@ -590,10 +590,10 @@ TEST_F(Viewer, RobustNormalsAreTheLibrarys) {
 TEST(ViewerActions, NeighboursByTheirNamesAndTheFormerSpellings) {
   const viewer::InputCapabilities mesh{true, 100, {}};
   ViewerState state = viewer::initialState(mesh);
-  for (const auto& [value, expected] : {std::pair{"kdtree", viewer::Neighbours::KdTree},
-                                        {"rings", viewer::Neighbours::MeshRings},
-                                        {"knn", viewer::Neighbours::KdTree},
-                                        {"bfs", viewer::Neighbours::MeshRings}}) {
+  for (const auto& [value, expected] : {std::pair{"kdtree", NeighbourhoodKind::KdTree},
+                                        {"rings", NeighbourhoodKind::MeshRings},
+                                        {"knn", NeighbourhoodKind::KdTree},
+                                        {"bfs", NeighbourhoodKind::MeshRings}}) {
     viewer::applyAction(state, mesh, std::string("neighbours=") + value);
     EXPECT_EQ(state.neighbours, expected) << value;
   }

@@ -12,6 +12,7 @@
 
 #include "common/tool_output.h"
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/features/fit_choices.h"
 #include "pcl_ddg/features/robust_normal_estimation.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
@@ -24,7 +25,6 @@ namespace tools {
 
 namespace {
 
-constexpr int kDefaultMaxNeighbours = 64;
 const OptionSpelling kToolSpelling{"-viewpoint x,y,z", "-orient up"};
 
 // -radius as written: a length, or a multiple of the input's spacing like "2.5h".
@@ -95,81 +95,72 @@ std::string describeNeighbourhood(const LocalFitOptions& options) {
                                : "k = " + std::to_string(options.k));
 }
 
-void checkLocalFitArguments(const ToolArguments& args) {
-  if (args.has("k") && args.has("radius"))
-    throw UsageError("-k and -radius exclude each other (use -radius r -max_nn N for both)");
-  if (args.has("max_nn") && !args.has("radius")) throw UsageError("-max_nn needs -radius");
-  if (args.integer("k", 16) < 3) throw UsageError("-k must be at least 3");
-  if (args.integer("max_nn", kDefaultMaxNeighbours) < 3)
-    throw UsageError("-max_nn must be at least 3");
-  radiusArgument(args);
-  viewpointArgument(args);
-  upArgument(args);
-  if (args.has("min_nn") && !args.has("radius")) throw UsageError("-min_nn needs -radius");
-  classesArgument(args);
-  if (args.has("min_nn") && args.integer("min_nn", 3) < 3)
-    throw UsageError("-min_nn must be at least 3");
-  neighboursArgument(args, "kdtree");
-  if (args.has("max_depth_jump") && !(args.number("max_depth_jump", 0.0) > 0.0))
-    throw UsageError("-max_depth_jump must be > 0 (a relative range change per pixel)");
+namespace {
+
+/** The request as the command line gives it: the radius in its own unit (a length, or h). */
+FitRequest fitRequest(const ToolArguments& args) {
+  FitRequest request;
+  if (args.has("k")) request.k = args.integer("k", 0);
+  if (args.has("max_nn")) request.max_nn = args.integer("max_nn", 0);
+  if (args.has("min_nn")) request.min_nn = args.integer("min_nn", 0);
+  const RadiusArgument radius = radiusArgument(args);
+  if (radius.value > 0.0) request.radius = radius.value;
+  if (args.has("max_depth_jump")) request.max_depth_jump = args.number("max_depth_jump", 0.0);
+  request.orient = args.value("orient");
+  request.viewpoint = viewpointArgument(args).has_value();
+  request.up = upArgument(args).has_value();
+  return request;
 }
 
-std::string neighboursArgument(const ToolArguments& args, const std::string& fallback) {
-  // The former spellings (the search's algorithm and query, not the neighbourhood) still work.
-  const std::optional<std::string> value = args.value("neighbours");
-  if (value == "bfs") return "rings";
-  if (value == "knn") return "kdtree";
-  return args.choice("neighbours", {"rings", "kdtree", "grid"}, fallback);
+}  // namespace
+
+void checkLocalFitArguments(const ToolArguments& args) {
+  usage([&] { checkFitRequest(fitRequest(args), kToolStyle); });
+  classesArgument(args);
+  requestedNeighbourhood(args);
+}
+
+std::optional<NormalOrientation> orientationArgument(const ToolArguments& args) {
+  if (!args.has("orient")) return std::nullopt;
+  return usage([&] { return chooseOrientation(*args.value("orient"), kToolStyle); });
+}
+
+std::optional<NeighbourhoodKind> requestedNeighbourhood(const ToolArguments& args) {
+  if (!args.has("neighbours")) return std::nullopt;
+  // The name only: whether the input has a mesh or a grid is checked when it is read.
+  return usage(
+      [&] { return chooseNeighbourhood(args.value("neighbours"), true, true, kToolStyle); });
 }
 
 LocalFitOptions localFitArguments(const ToolArguments& args, ToolInput& input,
                                   LocalFitMethod method) {
   checkLocalFitArguments(args);
+  FitRequest request = fitRequest(args);
   LocalFitOptions options;
   options.method = method;
   const bool organized = !input.topology && input.points()->height > 1;
-  const std::string neighbours = neighboursArgument(args, input.topology ? "rings"
-                                                          : organized    ? "grid"
-                                                                         : "kdtree");
-  if (neighbours == "rings" && !input.topology) {
-    throw UsageError("-neighbours rings needs a mesh; this input is a point cloud (use kdtree)");
-  }
-  if (neighbours == "grid" && !organized) {
-    throw UsageError("-neighbours grid needs an organized cloud (width x height pixels)");
-  }
-  if (args.has("max_depth_jump") && neighbours != "grid")
+  options.neighbourhood = usage([&] {
+    return chooseNeighbourhood(args.value("neighbours"), input.topology != nullptr, organized,
+                               kToolStyle);
+  });
+  if (request.max_depth_jump && options.neighbourhood != NeighbourhoodKind::Grid)
     throw UsageError("-max_depth_jump applies to -neighbours grid");
-  options.neighbourhood = neighbours == "rings"  ? NeighbourhoodKind::MeshRings
-                          : neighbours == "grid" ? NeighbourhoodKind::Grid
-                                                 : NeighbourhoodKind::KdTree;
-  options.max_depth_jump = args.number("max_depth_jump", options.max_depth_jump);
-  const auto points = static_cast<int>(input.positions.cols());
-  // Robust's default neighbourhood, or all points of a smaller input.
-  options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20
-                                : method == LocalFitMethod::Robust
-                                    ? std::min(kRobustNormalNeighbours, points)
-                                    : 16);
-  if (!args.has("radius") && options.k > points) {
-    throw std::runtime_error("-k " + std::to_string(options.k) + " is more than the " +
-                             std::to_string(points) + " points of the input");
-  }
+  options.max_depth_jump = request.max_depth_jump.value_or(options.max_depth_jump);
   options.viewpoint = viewpointArgument(args);
   if (!options.viewpoint) options.viewpoint = input.sensor_pose.origin;
   options.up = upArgument(args);
   const RadiusArgument radius = radiusArgument(args);
-  if (radius.value > 0.0) {
+  if (radius.value > 0.0 && radius.in_spacings) {
     double spacing = 1.0;
-    if (radius.in_spacings && input.topology) spacing = input.spacing();
-    if (radius.in_spacings && !input.topology) {
+    if (input.topology) spacing = input.spacing();
+    if (!input.topology) {
       Timer timer("Measuring the point spacing");
       spacing = input.spacing();
       timer.done(input.points()->size());
     }
-    options.radius = radius.value * spacing;
-    options.max_neighbours =
-        static_cast<unsigned int>(args.integer("max_nn", kDefaultMaxNeighbours));
-    options.min_neighbours = static_cast<unsigned int>(args.integer("min_nn", 0));
+    request.radius = radius.value * spacing;
   }
+  applyNeighbourCounts(request, input.positions.cols(), kToolStyle, options);
   return options;
 }
 
@@ -227,12 +218,11 @@ void warnAboutRadius(const char* tool_name, const SamplingCheck& check,
 
 LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod method) {
   checkLocalFitArguments(args);
-  if (neighboursArgument(args, "kdtree") != "kdtree")
+  if (requestedNeighbourhood(args).value_or(NeighbourhoodKind::KdTree) != NeighbourhoodKind::KdTree)
     throw UsageError("-memory fits clouds with kd-tree neighbourhoods (-neighbours kdtree)");
   LocalFitOptions options;
   options.method = method;
   options.neighbourhood = NeighbourhoodKind::KdTree;
-  options.k = args.integer("k", method == LocalFitMethod::Quadric ? 20 : 16);
   options.viewpoint = viewpointArgument(args);
   options.up = upArgument(args);
   if (args.has("classes")) throw UsageError("-classes is not available with -memory");
@@ -243,11 +233,9 @@ LocalFitOptions outOfCoreFitArguments(const ToolArguments& args, LocalFitMethod 
   const RadiusArgument radius = radiusArgument(args);
   if (radius.in_spacings)
     throw UsageError("with -memory, -radius is a length (a multiple of h needs the whole cloud)");
-  if (radius.value > 0.0) {
-    options.radius = radius.value;
-    options.max_neighbours =
-        static_cast<unsigned int>(args.integer("max_nn", kDefaultMaxNeighbours));
-  }
+  // The tiles check k against the points they hold.
+  applyNeighbourCounts(fitRequest(args), std::numeric_limits<std::int64_t>::max(), kToolStyle,
+                       options);
   return options;
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// The steps the fitting tools (pca, quadric) share: the neighbourhood options, the checks of the
+// The steps the fitting tools (pca, quadric, robust) share: the neighbourhood options, the checks of the
 // sampling before a fit, the out-of-core run (-memory) and the warnings after a fit.
 #include <pcl/PolygonMesh.h>
 #include <pcl/console/print.h>
@@ -13,6 +13,7 @@
 
 #include "common/tool_common.h"
 #include "common/tool_input.h"
+#include "pcl_ddg/features/fit_choices.h"
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
@@ -23,15 +24,19 @@
 namespace pcl_ddg {
 namespace tools {
 
-/** -neighbours rings|kdtree|grid, or fallback; the former bfs and knn are read as rings and
- *  kdtree. */
-std::string neighboursArgument(const ToolArguments& args, const std::string& fallback);
+/** -neighbours rings|kdtree|grid (bfs and knn: the former spellings), the name checked; none
+ *  when not given. */
+std::optional<NeighbourhoodKind> requestedNeighbourhood(const ToolArguments& args);
+
+/** -orient viewpoint|up|mst|mesh, the name checked; none when not given. */
+std::optional<NormalOrientation> orientationArgument(const ToolArguments& args);
 
 /** "mesh rings, k = 16", "pixel grid, 5 x 5 window", "kd-tree, radius 0.01", ... */
 std::string describeNeighbourhood(const LocalFitOptions& options);
 
-/** The syntax of -neighbours, -k, -radius, -max_nn and -viewpoint, checked before any file is
- *  read (UsageError): -k and -radius exclude each other, -max_nn needs -radius. */
+/** -neighbours, -k, -radius, -max_nn, -min_nn, -max_depth_jump, -viewpoint, -up, -orient and
+ *  -classes, checked before any file is read (UsageError): the library's checkFitRequest
+ *  (fit_choices.h) and the tools' own syntax (x,y,z, 2.5h, 2,6). */
 void checkLocalFitArguments(const ToolArguments& args);
 
 /** -neighbours rings|kdtree|grid (rings is the default on meshes and impossible on clouds, grid

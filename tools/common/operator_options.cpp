@@ -6,18 +6,12 @@ namespace tools {
 MassType vertexAreaArgument(const ToolArguments& args) {
   if (args.has("area") && args.has("mass")) throw UsageError("-mass is the former name of -area");
   const std::string option = args.has("mass") ? "mass" : "area";
-  const std::string area = args.choice(option, {"mixed", "voronoi", "barycentric"}, "mixed");
-  return area == "voronoi"       ? MassType::Voronoi
-         : area == "barycentric" ? MassType::Barycentric
-                                 : MassType::MixedVoronoi;
+  return usage(
+      [&] { return chooseMassType(args.value(option).value_or("mixed"), option, kToolStyle); });
 }
 
 SolverChoice solverArgument(const ToolArguments& args) {
-  const std::string solver = args.choice("solver", {"auto", "cholmod", "ldlt", "cg"}, "auto");
-  if (solver == "cholmod") return {ImplicitSolver::Cholesky, CholeskyBackend::Cholmod};
-  if (solver == "ldlt") return {ImplicitSolver::Cholesky, CholeskyBackend::SimplicialLDLT};
-  if (solver == "cg") return {ImplicitSolver::ConjugateGradient, CholeskyBackend::Automatic};
-  return {ImplicitSolver::Automatic, CholeskyBackend::Automatic};
+  return usage([&] { return chooseSolver(args.value("solver").value_or("auto"), kToolStyle); });
 }
 
 }  // namespace tools

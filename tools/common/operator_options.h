@@ -5,23 +5,16 @@
 
 #include "common/tool_common.h"
 #include "pcl_ddg/operators/mass_matrix.h"
-#include "pcl_ddg/operators/sparse_cholesky.h"
 #include "pcl_ddg/surface/implicit_solver.h"
 
 namespace pcl_ddg {
 namespace tools {
 
-/** -area mixed|voronoi|barycentric (the vertex areas, the mass matrix's diagonal), default
- *  mixed; pcl_ddg_smooth's former -mass is read as -area (both given: UsageError). */
+/** -area mixed|voronoi|barycentric (the vertex areas, the mass matrix's diagonal: chooseMassType),
+ *  default mixed; pcl_ddg_smooth's former -mass is read as -area (both given: UsageError). */
 MassType vertexAreaArgument(const ToolArguments& args);
 
-struct SolverChoice {
-  ImplicitSolver method;
-  CholeskyBackend backend;
-};
-
-/** -solver auto|cholmod|ldlt|cg: auto picks the cheaper of Cholesky and conjugate gradients for
- *  the run; cholmod and ldlt factorise with that backend; cg always iterates. */
+/** -solver auto|cholmod|ldlt|cg (chooseSolver), default auto. */
 SolverChoice solverArgument(const ToolArguments& args);
 
 }  // namespace tools

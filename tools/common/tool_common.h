@@ -2,6 +2,7 @@
 // What every pcl_ddg_* tool shares: PCL-style single-dash options (unknown ones rejected), one-line
 // errors ("pcl_ddg_x: error: ...") with exit codes 0 ok / 1 failure / 2 usage, and timing lines.
 #include <pcl/console/time.h>
+#include <pcl/exceptions.h>
 
 #include <condition_variable>
 #include <cstdint>
@@ -15,6 +16,8 @@
 #include <thread>
 #include <vector>
 
+#include "pcl_ddg/exceptions.h"
+
 namespace pcl_ddg {
 namespace tools {
 
@@ -23,6 +26,16 @@ class UsageError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/** check(), a library's pcl::BadArgumentException becoming a UsageError (exit 2, "see -help"). */
+template <typename Check>
+auto usage(Check&& check) {
+  try {
+    return check();
+  } catch (const pcl::BadArgumentException& e) {
+    throw UsageError(errorDescription(e));
+  }
+}
 
 /** -h or -help was given: print the description and syntax, exit 0. */
 class HelpRequested : public std::exception {};

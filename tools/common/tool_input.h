@@ -12,8 +12,8 @@
 #include <optional>
 #include <string>
 
-#include "pcl_ddg/mesh/local_cloud.h"
 #include "pcl_ddg/io/mesh_io.h"
+#include "pcl_ddg/mesh/local_cloud.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 
 namespace pcl_ddg {

@@ -86,14 +86,12 @@ ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingSt
 
   const SmoothingStep& step = steps.back();
   MeshSmoothingParameters parameters;
-  parameters.scheme = step.method == SmoothingMethod::Explicit ? SmoothingScheme::Explicit
-                      : step.method == SmoothingMethod::Taubin ? SmoothingScheme::Taubin
-                                                               : SmoothingScheme::Implicit;
+  parameters.scheme = step.method;
   parameters.weights = step.weights == SmoothingWeights::Cotan ? LaplacianWeights::Cotangent
                                                                : LaplacianWeights::Uniform;
   // Taubin's lambda 0.5 and mu -0.53 are steps of an operator averaged by degree.
   parameters.average =
-      step.weights == SmoothingWeights::Umbrella || step.method == SmoothingMethod::Taubin
+      step.weights == SmoothingWeights::Umbrella || step.method == SmoothingScheme::Taubin
           ? FlowAverage::Degree
           : FlowAverage::Area;
   // Frozen: the Laplacian of the surface where this run of frozen steps began, so a run of n
@@ -113,14 +111,14 @@ ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingSt
   const bool per_area = parameters.average == FlowAverage::Area;
   const double h2 = spacing_ * spacing_;
   RelativeSteps relative;
-  if (step.method != SmoothingMethod::Taubin)
+  if (step.method != SmoothingScheme::Taubin)
     relative.step = per_area ? step.time_step * h2 : step.time_step;
   relative.absolute_time = per_area;
   relative.allow_unstable = true;  // an explicit step is capped below
   try {
     const ResolvedSteps resolved = resolveSteps(*input_.topology, *from, relative, parameters);
     if (resolved.unstable) {
-      if (step.method == SmoothingMethod::Taubin)
+      if (step.method == SmoothingScheme::Taubin)
         throw std::runtime_error("Taubin's steps exceed the stability bound on this mesh");
       // Forward Euler beyond its stability bound blows up: the step is capped there, and said so.
       parameters.time_step = 0.9 * resolved.bound * resolved.unit;
@@ -145,8 +143,7 @@ LocalFitResult ViewerModel::fit(LocalFitMethod method, const ViewerState& state,
                                 const LocalCloud& cloud) const {
   LocalFitOptions options;
   options.method = method;
-  options.neighbourhood = state.neighbours == Neighbours::MeshRings ? NeighbourhoodKind::MeshRings
-                                                                    : NeighbourhoodKind::KdTree;
+  options.neighbourhood = state.neighbours;
   options.k = state.k;
   options.viewpoint = input_.sensor_pose.origin;
   // Aerial LiDAR has no single viewpoint: up, as the tools orient a LAS file by default.
@@ -169,8 +166,7 @@ std::shared_ptr<const Eigen::Matrix3Xd> ViewerModel::normalsOf(NormalMethod meth
   const bool fitted = !isMeshMethod(method);
   std::string key = version + methodName(method);
   if (fitted) {
-    key += (state.neighbours == Neighbours::MeshRings ? "/rings/" : "/kdtree/") +
-           std::to_string(state.k);
+    key += std::string("/") + neighbourhoodName(state.neighbours) + "/" + std::to_string(state.k);
   }
   if (const auto it = normals_.find(key); it != normals_.end()) return it->second;
 
@@ -178,19 +174,14 @@ std::shared_ptr<const Eigen::Matrix3Xd> ViewerModel::normalsOf(NormalMethod meth
   std::int64_t invalid = 0, fallback = 0;
   if (!fitted) {
     MeshNormalOptions options;
-    options.weighting = method == NormalMethod::Uniform         ? NormalWeighting::Uniform
-                        : method == NormalMethod::Angle         ? NormalWeighting::Angle
-                        : method == NormalMethod::MeanCurvature ? NormalWeighting::MeanCurvature
-                                                                : NormalWeighting::Area;
+    options.weighting = chooseNormalWeighting(methodName(method), "method", kToolStyle);
     MeshNormals result = computeMeshNormals(*input_.topology, *positions, options);
     invalid = result.invalid_vertices;
     if (method == NormalMethod::MeanCurvature) fallback = result.fallback_vertices;
     normals = std::make_shared<const Eigen::Matrix3Xd>(std::move(result.normals));
   } else {
-    const LocalFitResult result = fit(method == NormalMethod::PCA       ? LocalFitMethod::PCA
-                                      : method == NormalMethod::Quadric ? LocalFitMethod::Quadric
-                                                                        : LocalFitMethod::Robust,
-                                      state, cloudOf(version, positions));
+    const LocalFitResult result =
+        fit(chooseFitMethod(methodName(method), kToolStyle), state, cloudOf(version, positions));
     invalid = result.failed_points;
     fallback = result.fallback_points;
     normals = std::make_shared<const Eigen::Matrix3Xd>(tools::normalsOf(result.normals));
@@ -223,7 +214,7 @@ Eigen::VectorXd ViewerModel::fieldOf(const ViewerState& state, const std::string
         version + field +
         (cotan ? "/cotan"
                : "/quadric/" + std::to_string(state.k) +
-                     (state.neighbours == Neighbours::MeshRings ? "rings" : "kdtree"));
+                     (state.neighbours == NeighbourhoodKind::MeshRings ? "rings" : "kdtree"));
     if (const auto it = fields_.find(key); it != fields_.end()) return it->second;
     Eigen::VectorXd values[4];
     if (cotan) {

@@ -67,13 +67,13 @@ std::string describe(const ViewerState& s, bool is_mesh) {
   out << "normals: " << methodName(s.method);
   if (!isMeshMethod(s.method)) {
     out << ", k = " << s.k << ", "
-        << (s.neighbours == Neighbours::MeshRings ? "mesh rings" : "kd-tree");
+        << (s.neighbours == NeighbourhoodKind::MeshRings ? "mesh rings" : "kd-tree");
   }
   out << "   field: " << s.field;
   if (is_mesh) {
     int explicit_steps = 0;
     for (const SmoothingStep& step : s.steps)
-      explicit_steps += step.method != SmoothingMethod::Implicit;
+      explicit_steps += step.method != SmoothingScheme::Implicit;
     const bool umbrella = s.weights == SmoothingWeights::Umbrella;
     out << "\nsmoothing: " << s.steps.size() << " steps (" << explicit_steps
         << " explicit or Taubin), next " << s.time_step << (umbrella ? "" : " h^2") << ", "

@@ -1,9 +1,13 @@
 #include "viewer/viewer_state.h"
 
+#include <pcl/exceptions.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <sstream>
 #include <stdexcept>
+
+#include "pcl_ddg/features/fit_choices.h"
 
 namespace pcl_ddg {
 namespace viewer {
@@ -98,7 +102,7 @@ ViewerState initialState(const InputCapabilities& input) {
   ViewerState state;
   if (!input.is_mesh) {
     state.method = NormalMethod::PCA;
-    state.neighbours = Neighbours::KdTree;
+    state.neighbours = NeighbourhoodKind::KdTree;
   }
   state.k = std::min(ViewerState::kDefaultK, std::max(3, input.points - 1));
   if (input.has_colors) state.field = "rgb";
@@ -140,16 +144,20 @@ std::string applyAction(ViewerState& state, const InputCapabilities& input,
     state.k = std::clamp(k, 3, most);
     if (state.k != k) return "k limited to " + std::to_string(state.k) + " (the input's size)";
   } else if (action == "neighbours+" || name == "neighbours") {
-    Neighbours next =
-        state.neighbours == Neighbours::MeshRings ? Neighbours::KdTree : Neighbours::MeshRings;
+    NeighbourhoodKind next = state.neighbours == NeighbourhoodKind::MeshRings
+                                 ? NeighbourhoodKind::KdTree
+                                 : NeighbourhoodKind::MeshRings;
     if (name == "neighbours") {
       needValue();
-      // bfs and knn: the former spellings.
-      if (value != "rings" && value != "kdtree" && value != "bfs" && value != "knn")
+      // The tools' names (bfs and knn: the former spellings); no pixel grid here.
+      try {
+        next = chooseNeighbourhood(value, true, false, kToolStyle);
+      } catch (const pcl::BadArgumentException&) {
         refuse(action, "expected rings or kdtree");
-      next = value == "rings" || value == "bfs" ? Neighbours::MeshRings : Neighbours::KdTree;
+      }
     }
-    if (next == Neighbours::MeshRings && !input.is_mesh) refuse(action, "mesh rings need a mesh");
+    if (next == NeighbourhoodKind::MeshRings && !input.is_mesh)
+      refuse(action, "mesh rings need a mesh");
     state.neighbours = next;
   } else if (action == "field+" || name == "field") {
     const std::vector<std::string> fields = fieldsOf(input);
@@ -183,9 +191,9 @@ std::string applyAction(ViewerState& state, const InputCapabilities& input,
       refuse(action, "a Taubin step takes no size (lambda 0.5, mu -0.53)");
     if (colon != std::string::npos)
       state.time_step = positiveNumber(action, value.substr(colon + 1));
-    const SmoothingMethod method = scheme == "explicit" ? SmoothingMethod::Explicit
-                                   : scheme == "taubin" ? SmoothingMethod::Taubin
-                                                        : SmoothingMethod::Implicit;
+    const SmoothingScheme method = scheme == "explicit" ? SmoothingScheme::Explicit
+                                   : scheme == "taubin" ? SmoothingScheme::Taubin
+                                                        : SmoothingScheme::Implicit;
     state.steps.push_back({method, state.time_step, state.weights, state.frozen});
   } else if (action == "undo") {
     if (!state.steps.empty()) state.steps.pop_back();
@@ -255,7 +263,7 @@ const KeyBinding kKeys[] = {
     {"bracketright", "]", "k+", "more neighbours (k)"},
     {"bracketleft", "[", "k-", "fewer neighbours (k)"},
     {"backslash", "\\", "k=default", "k back to 16"},
-    {"n", "n", "neighbours+", "neighbourhood: mesh rings <-> kd-tree (pca, quadric)"},
+    {"n", "n", "neighbours+", "neighbourhood: mesh rings <-> kd-tree (pca, quadric, robust)"},
     {"v", "v", "field+",
      "next colour field (none rgb mean gauss k1 k2 angle compare, properties; rgb: the file's "
      "colours)"},

@@ -8,18 +8,18 @@
 #include <utility>
 #include <vector>
 
+#include "pcl_ddg/features/local_fit.h"
+#include "pcl_ddg/surface/mesh_smoothing.h"
+
 namespace pcl_ddg {
 namespace viewer {
 
 enum class NormalMethod { Uniform, Area, Angle, MeanCurvature, PCA, Quadric, Robust };
-enum class Neighbours { MeshRings, KdTree };
-
-enum class SmoothingMethod { Explicit, Implicit, Taubin };
 /** Umbrella: uniform weights averaged by degree (mesh_smoothing.h). */
 enum class SmoothingWeights { Cotan, Uniform, Umbrella };
 
 struct SmoothingStep {
-  SmoothingMethod method = SmoothingMethod::Implicit;
+  SmoothingScheme method = SmoothingScheme::Implicit;
   /** in h^2 (h: the mean edge length of the input); umbrella: without unit; Taubin: unused
    *  (lambda 0.5, mu -0.53, averaged by degree) */
   double time_step = 1.0;
@@ -36,7 +36,7 @@ struct ViewerState {
 
   NormalMethod method = NormalMethod::Area;  ///< PCA on clouds (set by the model)
   int k = kDefaultK;
-  Neighbours neighbours = Neighbours::MeshRings;
+  NeighbourhoodKind neighbours = NeighbourhoodKind::MeshRings;
   /** none, rgb (the file's colours), mean, gauss, k1, k2, angle (to the reference method's
    *  normals), compare (mesh rings vs kd-tree), or the name of a scalar property of the file. */
   std::string field = "none";

@@ -1,11 +1,11 @@
 #pragma once
 /** \file
- * What PCANormalEstimation and QuadricNormalEstimation share: a pcl::Feature that, for every
- * query point, gathers its neighbours (from whatever search method is set: a kd-tree, or
- * MeshRingSearch for topological neighbourhoods) in double relative to the query point, fits
- * something to them, and orients the resulting normal.
+ * What PCANormalEstimation, QuadricNormalEstimation and RobustNormalEstimation share: a
+ * pcl::Feature that, for every query point, gathers its neighbours (from whatever search method is
+ * set: a kd-tree, or MeshRingSearch for topological neighbourhoods) in double relative to the
+ * query point, fits something to them, and orients the resulting normal.
  *
- * The interface of pcl::NormalEstimationOMP, so either estimator replaces it (or
+ * The interface of pcl::NormalEstimationOMP, so any of the three estimators replaces it (or
  * pcl::NormalEstimation) in existing code: computePointNormal (both overloads), the viewpoint
  * setters and the protected vpx_, vpy_, vpz_, a constructor taking the number of threads and
  * setNumberOfThreads (0: every core; the default here, where PCL's NormalEstimation uses one),

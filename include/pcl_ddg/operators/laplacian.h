@@ -50,10 +50,4 @@ extern template Eigen::SparseMatrix<double, Eigen::RowMajor> laplacian<Eigen::Ro
 Eigen::SparseMatrix<double> cotangentLaplacian(const MeshTopology& topology,
                                                const PositionsRef& positions);
 
-/** The summed uniform Laplacian (positions are not needed). */
-Eigen::SparseMatrix<double> uniformLaplacian(const MeshTopology& topology);
-
-/** M^-1 L in place: row i divided by mass_i, zero where mass_i is zero. */
-void divideRowsByMass(Eigen::SparseMatrix<double>& matrix, const Eigen::VectorXd& mass);
-
 }  // namespace pcl_ddg

@@ -17,10 +17,21 @@
 
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/mesh/positions_ref.h"
+#include "pcl_ddg/option_style.h"
 
 namespace pcl_ddg {
 
 enum class MassType { Barycentric, Voronoi, MixedVoronoi };
+
+/** mixed | voronoi | barycentric, as option (the tools' -area, Python's mass=) names them. */
+inline MassType chooseMassType(const std::string& name, const std::string& option,
+                               const OptionStyle& style) {
+  return chooseNamed<MassType>(option, name,
+                               {{"mixed", MassType::MixedVoronoi},
+                                {"voronoi", MassType::Voronoi},
+                                {"barycentric", MassType::Barycentric}},
+                               style);
+}
 
 /** Vertex areas (the diagonal of M), gathered per vertex (OpenMP). Throws InvalidMeshException
  *  on non-finite or mismatched positions. */

@@ -23,10 +23,32 @@
  * spent at most that share of a Cholesky step. So one step of 1 h^2 iterates, a frozen operator
  * over many steps or steps of 10 h^2 and more factorise.
  */
+#include <string>
+
+#include "pcl_ddg/operators/sparse_cholesky.h"
+#include "pcl_ddg/option_style.h"
+
 namespace pcl_ddg {
 
 enum class ImplicitSolver { Automatic, Cholesky, ConjugateGradient };
 
 const char* toString(ImplicitSolver solver);
+
+struct SolverChoice {
+  ImplicitSolver method;
+  CholeskyBackend backend;
+};
+
+/** solver auto | cholmod | ldlt | cg: auto picks the cheaper of Cholesky and conjugate gradients
+ *  for the run; cholmod and ldlt factorise with that backend; cg always iterates. */
+inline SolverChoice chooseSolver(const std::string& name, const OptionStyle& style) {
+  return chooseNamed<SolverChoice>(
+      "solver", name,
+      {{"auto", {ImplicitSolver::Automatic, CholeskyBackend::Automatic}},
+       {"cholmod", {ImplicitSolver::Cholesky, CholeskyBackend::Cholmod}},
+       {"ldlt", {ImplicitSolver::Cholesky, CholeskyBackend::SimplicialLDLT}},
+       {"cg", {ImplicitSolver::ConjugateGradient, CholeskyBackend::Automatic}}},
+      style);
+}
 
 }  // namespace pcl_ddg

@@ -26,10 +26,23 @@
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "pcl_ddg/mesh/positions_ref.h"
 #include "pcl_ddg/operators/mass_matrix.h"
+#include "pcl_ddg/option_style.h"
 
 namespace pcl_ddg {
 
 enum class NormalWeighting { Uniform, Area, Angle, MeanCurvature };
+
+/** area | uniform | angle | mean_curvature, as option (the tools' -method, Python's weights=)
+ *  names them. */
+inline NormalWeighting chooseNormalWeighting(const std::string& name, const std::string& option,
+                                             const OptionStyle& style) {
+  return chooseNamed<NormalWeighting>(option, name,
+                                      {{"area", NormalWeighting::Area},
+                                       {"uniform", NormalWeighting::Uniform},
+                                       {"angle", NormalWeighting::Angle},
+                                       {"mean_curvature", NormalWeighting::MeanCurvature}},
+                                      style);
+}
 
 struct MeshNormalOptions {
   NormalWeighting weighting = NormalWeighting::Area;

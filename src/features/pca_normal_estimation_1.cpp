@@ -1,9 +1,0 @@
-#include "pcl_ddg/features/pca_normal_estimation.h"
-
-#include "estimator_instantiation.h"
-#include "pcl_ddg/features/impl/pca_normal_estimation.hpp"
-
-// Slice 1 of PCL's input types x every output type (estimator_instantiation.h); the other
-// slices are in the other pca_normal_estimation*.cpp files.
-#define PCL_DDG_INSTANTIATE_ESTIMATOR PCL_DDG_INSTANTIATE_PCANormalEstimation
-PCL_DDG_INSTANTIATE_ESTIMATOR_SLICE(1)
