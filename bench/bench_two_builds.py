@@ -7,7 +7,7 @@ grid, stored in no spatial order), once as float coordinates near the origin and
 coordinates at UTM-sized values (500,000 m east, 5,000,000 m north), each written once into a
 temporary folder. PCA, k = 16. The two builds alternate run after run, so that a load on a shared
 machine falls on both alike; medians of the repetitions (default 3) of the fit's own time (the
-tool's "Estimating"/"Fitting" lines) and of the whole process.
+tool's "Computing", "Estimating" and "Fitting" lines) and of the whole process.
 
     /usr/bin/python3 bench/bench_two_builds.py BEFORE_TOOL AFTER_TOOL [repetitions]
 """

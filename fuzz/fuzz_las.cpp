@@ -10,7 +10,7 @@
 #include <string>
 #include <string_view>
 
-#include "formats.h"
+#include "las_format.h"
 #include "pcl_ddg/exceptions.h"
 
 namespace {

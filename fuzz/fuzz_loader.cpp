@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "formats.h"
+#include "mesh_formats.h"
 #include "pcl_ddg/exceptions.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

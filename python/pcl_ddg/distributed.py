@@ -140,38 +140,15 @@ def expand_inputs(inputs: Sequence[str],
 
 
 def las_header(path: str) -> Dict[str, Any]:
-    """The public header block of a LAS file (and its CRS records): counts, bounds, scale,
-    offset, point format. No point is read."""
-    with open(path, "rb") as f:
-        head = f.read(375)
-        if len(head) < 227 or head[:4] != b"LASF":
-            raise OSError(f"{path}: not a LAS file (no LASF signature)")
-        major, minor = head[24], head[25]
-        header_size, = struct.unpack_from("<H", head, 94)
-        data_offset, vlr_count = struct.unpack_from("<II", head, 96)
-        point_format, record_length = struct.unpack_from("<BH", head, 104)
-        count, = struct.unpack_from("<I", head, 107)
-        scale = struct.unpack_from("<3d", head, 131)
-        offset = struct.unpack_from("<3d", head, 155)
-        maxx, minx, maxy, miny, maxz, minz = struct.unpack_from("<6d", head, 179)
-        if (major, minor) >= (1, 4) and len(head) >= 255:
-            count, = struct.unpack_from("<Q", head, 247)
-        crs = []
-        f.seek(header_size)
-        for _ in range(vlr_count):
-            vlr = f.read(54)
-            if len(vlr) < 54:
-                break
-            user = vlr[2:18].rstrip(b"\0")
-            record, length = struct.unpack_from("<HH", vlr, 18)
-            body = f.read(length)
-            if user == b"LASF_Projection":
-                crs.append((record, hashlib.sha256(body).hexdigest()))
-    return {"version": f"{major}.{minor}", "point_format": point_format & 0x3F,
-            "compressed": bool(point_format & 0xC0) or path.lower().endswith(".laz"),
-            "record_length": record_length, "points": count, "scale": scale, "offset": offset,
-            "bounds": (minx, miny, minz, maxx, maxy, maxz), "data_offset": data_offset,
-            "crs": sorted(crs)}
+    """The public header block of a LAS file (and its CRS records), read by the library's LAS
+    reader (the one the chunks are read with): counts, bounds, scale, offset, point format. No
+    point is read. A LAZ file gives {"compressed": True} alone."""
+    header = _pcl_ddg._las_header(os.fspath(path))
+    if not header["compressed"]:
+        header["crs"] = sorted((record, hashlib.sha256(data).hexdigest())
+                               for user, record, data in header.pop("vlrs")
+                               if user == b"LASF_Projection")
+    return header
 
 
 def _check_las(paths: List[str], allow_mixed_crs: bool) -> None:

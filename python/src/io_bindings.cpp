@@ -8,9 +8,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <set>
 
 #include "binding_common.h"
+#include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/cloud_pieces.h"
+#include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 
@@ -223,6 +227,49 @@ py::list recordsOf(const std::vector<LasVariableLengthRecord>& records) {
   return out;
 }
 
+// A LAS file's header and VLRs, read (no point) by the reader the Dask runner reads its chunks
+// with (CloudPieceReader: the library's LAS parser), for pcl_ddg.distributed's checks of the
+// inputs of one scene. A LAZ file (a LAS header whose point format has the compression bits set,
+// or one named .laz) is reported, {"compressed": True}, not refused: the runner names it with
+// how to decompress it, once every input's header is read.
+py::dict lasHeader(const std::string& path) {
+  CloudFileLayout file;
+  std::shared_ptr<const LasLayout> las;
+  bool compressed = false;
+  {
+    py::gil_scoped_release release;
+    std::string head(227, '\0');  // a LAS 1.0 header, as CloudPieceReader tells a LAS file
+    std::ifstream in(path, std::ios::binary);
+    in.read(head.data(), static_cast<std::streamsize>(head.size()));
+    compressed = in.gcount() == static_cast<std::streamsize>(head.size()) &&
+                 head.compare(0, 4, "LASF") == 0 &&
+                 (lasIsCompressed(head) || fileExtension(path) == "laz");
+    if (!compressed) {
+      CloudPieceReader pieces(path);
+      file = pieces.layout();
+      las = pieces.lasLayout();
+      if (las == nullptr) throw FileFormatException(path + ": not a LAS file (no LASF signature)");
+    }
+  }
+  py::dict d;
+  d["compressed"] = compressed;
+  if (compressed) return d;
+  d["version"] = std::to_string(las->version_major) + "." + std::to_string(las->version_minor);
+  d["point_format"] = las->point_format;
+  d["record_length"] = las->record_length;
+  d["points"] = file.points;
+  d["scale"] = vector3(las->scale);
+  d["offset"] = vector3(las->offset);
+  d["bounds"] = py::make_tuple(las->min.x(), las->min.y(), las->min.z(), las->max.x(), las->max.y(),
+                               las->max.z());
+  d["data_offset"] = file.header_bytes;
+  py::list vlrs;
+  for (const LasVariableLengthRecord& r : las->vlrs)
+    vlrs.append(py::make_tuple(bytesOf(r.userId()), r.record_id, bytesOf(r.data)));
+  d["vlrs"] = vlrs;
+  return d;
+}
+
 }  // namespace
 
 void bindIO(py::module_& m) {
@@ -263,6 +310,12 @@ void bindIO(py::module_& m) {
                ", points=" + std::to_string(l.point_count) +
                ", vlrs=" + std::to_string(l.vlrs.size()) + ")";
       });
+
+  m.def("_las_header", &lasHeader, py::arg("path"),
+        "A LAS file's header and VLRs as the library reads them (no point is read): compressed, "
+        "version, point_format, record_length, points, scale, offset, bounds (min x y z, max x y "
+        "z), data_offset, vlrs [(user_id bytes, record_id, data bytes)]; a LAZ file gives "
+        "{'compressed': True} alone.");
 
   m.def(
       "read",

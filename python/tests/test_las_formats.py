@@ -1,6 +1,6 @@
 """LAS point formats 0-10 read by pcl_ddg.read against an oracle written here from the ASPRS
 LAS 1.4 R15 specification (public header offsets, Tables 7-21 of the point record formats, the
-Extra Bytes descriptor), never from src/io/las_io.cpp:
+Extra Bytes descriptor), never from src/io/las_*.cpp:
 
 * every LAS file in the shared data (written by libLAS, PDAL and others: formats 0, 1, 2, 3, 6, 7
   in LAS 1.0-1.4) and files of every format 0-10 whose bytes this test writes from the tables:

@@ -8,7 +8,7 @@
 #include <numeric>
 #include <vector>
 
-#include "../mesh/disjoint_sets.h"
+#include "detail/disjoint_sets.h"
 #include "pcl_ddg/interruption.h"
 #include "pcl_ddg/search/point_kd_tree.h"
 

@@ -8,7 +8,8 @@
 #include <filesystem>
 #include <sstream>
 
-#include "formats.h"
+#include "las_format.h"
+#include "mesh_formats.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 
@@ -83,7 +84,7 @@ CloudPieceReader::CloudPieceReader(const std::string& path)
     in_.read(head.data(), static_cast<std::streamsize>(head.size()));
     if (in_.gcount() < 227 || head.compare(0, 4, "LASF") != 0)
       throw FileFormatException(path + ": not a LAS file (no LASF signature)");
-    if ((static_cast<std::uint8_t>(head[104]) & 0xC0) != 0) {
+    if (lasIsCompressed(head)) {
       throw FileFormatException(path +
                                 ": LAZ (compressed LAS) is not supported: decompress it first "
                                 "(laszip -i in.laz -o out.las)");

@@ -11,7 +11,8 @@
 
 #include "byte_cursor.h"
 #include "file_bytes.h"
-#include "formats.h"
+#include "las_format.h"
+#include "mesh_formats.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
 #include "pcl_ddg/mesh/vertex_positions.h"

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "byte_cursor.h"
-#include "formats.h"
 #include "loader_threads.h"
+#include "mesh_formats.h"
 #include "xyz_cloud.h"
 
 namespace pcl_ddg {

@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "byte_cursor.h"
-#include "formats.h"
+#include "mesh_formats.h"
 
 namespace pcl_ddg {
 namespace detail {

@@ -10,8 +10,8 @@
 #include <pcl/common/io.h>
 
 #include "byte_cursor.h"
-#include "formats.h"
 #include "loader_threads.h"
+#include "mesh_formats.h"
 
 namespace pcl_ddg {
 namespace detail {

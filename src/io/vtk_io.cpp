@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "byte_cursor.h"
-#include "formats.h"
+#include "mesh_formats.h"
 #include "xyz_cloud.h"
 
 namespace pcl_ddg {

@@ -6,7 +6,7 @@
 #include <utility>
 #include <vector>
 
-#include "disjoint_sets.h"
+#include "detail/disjoint_sets.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 
 namespace pcl_ddg {

@@ -4,9 +4,9 @@
 #include <numeric>
 #include <sstream>
 
-#include "disjoint_sets.h"
+#include "detail/disjoint_sets.h"
 #include "pcl_ddg/exceptions.h"
-#include "vertex_ranges.h"
+#include "detail/vertex_ranges.h"
 
 namespace pcl_ddg {
 namespace {

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <limits>
 
-#include "triangle_geometry.h"
+#include "detail/triangle_geometry.h"
 
 namespace pcl_ddg {
 Eigen::VectorXd angleDefect(const MeshTopology& topology, const PositionsRef& positions) {

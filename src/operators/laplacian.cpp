@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "triangle_geometry.h"
+#include "detail/triangle_geometry.h"
 
 namespace pcl_ddg {
 namespace {

@@ -1,6 +1,6 @@
 #include "pcl_ddg/operators/mass_matrix.h"
 
-#include "triangle_geometry.h"
+#include "detail/triangle_geometry.h"
 
 namespace pcl_ddg {
 

@@ -1,4 +1,4 @@
-// LAS reading and writing (src/io/las_io.cpp) on the shared LAS files (PDAL's test data), against
+// LAS reading and writing (src/io/las_*.cpp) on the shared LAS files (PDAL's test data), against
 // an independent reader written here from the specification's byte offsets (LAS 1.4 R15,
 // tables 3 and 7-17), and on hostile headers made from them.
 #include <gtest/gtest.h>

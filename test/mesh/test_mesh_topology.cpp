@@ -9,7 +9,7 @@
 #include <string>
 
 #include "analytic_surfaces.h"
-#include "mesh/disjoint_sets.h"  // internal: the union-find under the orientation check
+#include "detail/disjoint_sets.h"  // internal: the union-find under the orientation check
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/mesh/mesh_topology.h"
 #include "test_data.h"

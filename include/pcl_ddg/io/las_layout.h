@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace pcl_ddg {
@@ -69,6 +70,11 @@ struct LasLayout {
 /** The bytes of one record of a point data record format (0-10): 20, 28, 26, 34, 57, 63, 30, 36,
  *  38, 59, 67; 0 for any other format. */
 std::uint16_t lasPointFormatSize(int point_format);
+
+/** Whether a LAS file's first bytes (head) mark it as compressed (LAZ): the two high bits of the
+ *  point format byte (104) set. The reader refuses such a file first, saying how to decompress it.
+ */
+bool lasIsCompressed(std::string_view head);
 
 /** The field holding a record's bytes that no Extra Bytes descriptor describes (UINT8, count n). */
 inline constexpr const char* kLasUndocumentedBytesField = "las_undocumented_bytes";

@@ -1,6 +1,7 @@
 #pragma once
 // Union-find with path halving and union by size, plain and with a parity per element; internal to
-// the mesh layer. Both are near-linear on any input (no chains, whatever the element order).
+// the library (the mesh layer, orientation). Both are near-linear on any input (no chains, whatever
+// the element order).
 #include <cstdint>
 #include <numeric>
 #include <utility>

@@ -4,13 +4,12 @@
 // truncated data and never return a partial mesh.
 #include <pcl/PolygonMesh.h>
 
+#include <cstdint>
 #include <limits>
-#include <memory>
 #include <ostream>
 #include <string>
 #include <string_view>
 
-#include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/mesh_io.h"
 
 namespace pcl_ddg {
@@ -31,48 +30,6 @@ pcl::PolygonMesh parseVTK(std::string_view data);
 /** PCD, ascii, binary or binary_compressed (padding fields "_" kept as in PCL's reader); the
  *  VIEWPOINT into sensor_pose when given. */
 pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose = nullptr);
-
-/** A LAS file read: float x y z and the records' fields in the cloud, the exact coordinates
- *  (X * scale + offset in double) and the layout (header, VLRs, Extra Bytes). */
-struct LasCloud {
-  pcl::PolygonMesh mesh;
-  Eigen::Matrix3Xd positions;
-  LasLayout layout;
-};
-
-/** LAS 1.0-1.4, uncompressed, point formats 0-10; LAZ (the compression bit set in the point
- *  format) is refused first, with how to decompress it. */
-LasCloud parseLAS(std::string_view data);
-
-/** A cloud as a LAS file: the layout of `source` (version, point format, scale, offset, VLRs and
- *  EVLRs, Extra Bytes descriptors of the fields that remain), or LAS 1.4 format 6 (7 with
- *  colours) with a scale and offset chosen for the coordinates when null. Fields that the point
- *  format has no place for become Extra Bytes dimensions; bounds and counts are recomputed. */
-std::string encodeLAS(const pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions,
-                      const LasLayout* source);
-/** encodeLAS's bytes into the file at path, the records encoded a block at a time
- *  from the cloud's x, y, z fields: nothing the size of the file is held. */
-void writeLAS(const std::string& path, const pcl::PCLPointCloud2& cloud, const LasLayout* source);
-
-/** A LAS file written a piece of points at a time (the out-of-core path): source's layout (version,
- *  point format, scale, offset, VLRs and EVLRs; the Extra Bytes planned from the first piece's
- *  fields, which every piece must have), the header's counts and bounds written at close(). The
- *  bytes are writeLAS's for the same points at once. */
-class LasPieceWriter {
- public:
-  LasPieceWriter(const std::string& path, const LasLayout& source);
-  ~LasPieceWriter();
-  LasPieceWriter(const LasPieceWriter&) = delete;
-  LasPieceWriter& operator=(const LasPieceWriter&) = delete;
-  void write(const pcl::PCLPointCloud2& piece);
-  void close();
-
- private:
-  struct State;
-  LasLayout source_;
-  std::unique_ptr<State> state_;
-};
-
 /** How the points of a binary cloud file lie on disk, for reading it a piece at a time. */
 struct BinaryCloudLayout {
   std::int64_t header_bytes = 0;  ///< the first point starts here

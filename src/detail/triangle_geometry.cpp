@@ -1,4 +1,4 @@
-#include "triangle_geometry.h"
+#include "detail/triangle_geometry.h"
 
 #include <string>
 
