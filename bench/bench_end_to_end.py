@@ -3,8 +3,11 @@
 vertex normals, write a binary PLY. pcl_ddg_normals (a process, everything included) against
 Open3D's read_triangle_mesh + compute_vertex_normals + write_triangle_mesh in the same run.
 The two alternate, run after run, so that a load on a shared machine falls on both alike;
-medians of the repetitions (default 5) and of the runs' pairwise ratios. The mesh (the bench
-torus, 1600 x 720 grid) is generated once into a temporary folder.
+medians of the repetitions (default 5) and of the runs' pairwise ratios. Each run is a fresh
+process, ours and Open3D's (a Python running the three calls), and prints its peak resident
+memory and minor page faults beside its time (/usr/bin/time -f '%M %R'); Open3D's time is that of its three calls, without the interpreter's
+start and import. The mesh (the bench torus, 1600 x 720 grid) is generated once into a temporary
+folder.
 
     /usr/bin/python3 bench/bench_end_to_end.py build/tools/pcl_ddg_normals [repetitions]
     (Debian's python: python3-open3d)
@@ -35,10 +38,33 @@ def write_torus_off(path, around=1600, tube=720, major=1.0, minor=0.4):
         f.write("".join(lines))
 
 
-def seconds(run):
-    start = time.perf_counter()
-    run()
-    return time.perf_counter() - start
+OPEN3D_JOB = """
+import sys, time
+import open3d
+open3d.utility.set_verbosity_level(open3d.utility.VerbosityLevel.Error)
+mesh_path, out_path = sys.argv[1], sys.argv[2]
+start = time.perf_counter()
+if mesh_path:
+    m = open3d.io.read_triangle_mesh(mesh_path)
+    m.compute_vertex_normals()
+    open3d.io.write_triangle_mesh(out_path, m, write_ascii=False, compressed=False)
+print(time.perf_counter() - start)
+"""
+
+
+def measured(command):
+    """Runs command as a fresh process: (wall seconds, its stdout, peak resident MB, minor page
+    faults), the last two by /usr/bin/time -f '%M %R' (which forks the command from its own small
+    process: a child forked from this Python would start with this Python's peak)."""
+    with tempfile.NamedTemporaryFile("r", suffix=".time") as report:
+        start = time.perf_counter()
+        run = subprocess.run(["/usr/bin/time", "-o", report.name, "-f", "%M %R", *command],
+                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+        wall = time.perf_counter() - start
+        if run.returncode != 0:
+            sys.exit(f"{command[0]} failed with exit status {run.returncode}")
+        peak_kb, faults = report.read().split()[-2:]
+    return wall, run.stdout.decode(), int(peak_kb) / 1024.0, int(faults)
 
 
 def main():
@@ -48,36 +74,37 @@ def main():
     mesh = os.path.join(folder, "torus.off")
     write_torus_off(mesh)
     print(f"mesh: {mesh} ({os.path.getsize(mesh) / 1e6:.0f} MB ascii OFF)")
-
-    def ours_run():
-        subprocess.run([tool, mesh, os.path.join(folder, "ours.ply"), "-method", "area"],
-                       check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-
+    ours_command = [tool, mesh, os.path.join(folder, "ours.ply"), "-method", "area"]
     try:
-        import open3d
+        import open3d  # noqa: F401  (only whether it is there)
     except ImportError:
-        ours = statistics.median(seconds(ours_run) for _ in range(repetitions))
-        print(f"pcl_ddg_normals -method area     {ours * 1000:8.0f} ms")
+        runs = [measured(ours_command) for _ in range(repetitions)]
+        print(f"pcl_ddg_normals -method area  {statistics.median(r[0] for r in runs) * 1000:8.0f} ms"
+              f"  peak {statistics.median(r[2] for r in runs):6.0f} MB"
+              f"  {statistics.median(r[3] for r in runs):8.0f} minor faults")
         print("open3d not installed (apt-get install python3-open3d): no baseline")
         return
-    open3d.utility.set_verbosity_level(open3d.utility.VerbosityLevel.Error)
-
-    def open3d_run():
-        m = open3d.io.read_triangle_mesh(mesh)
-        m.compute_vertex_normals()
-        open3d.io.write_triangle_mesh(os.path.join(folder, "open3d.ply"), m,
-                                      write_ascii=False, compressed=False)
-
+    theirs_command = [sys.executable, "-c", OPEN3D_JOB, mesh, os.path.join(folder, "open3d.ply")]
+    # Open3D's process includes Python and the import: what an empty job costs is printed too.
+    baseline = measured([sys.executable, "-c", OPEN3D_JOB, "", ""])
     ours, theirs = [], []
     for _ in range(repetitions):
-        ours.append(seconds(ours_run))
-        theirs.append(seconds(open3d_run))
-    print(f"pcl_ddg_normals -method area     {statistics.median(ours) * 1000:8.0f} ms")
-    print(f"Open3D read + normals + write    {statistics.median(theirs) * 1000:8.0f} ms")
-    ratios = sorted(t / o for o, t in zip(ours, theirs))
-    print(f"ratio: ours {statistics.median(theirs) / statistics.median(ours):.2f}x faster "
+        ours.append(measured(ours_command))
+        theirs.append(measured(theirs_command))
+    o_time = statistics.median(r[0] for r in ours)
+    t_time = statistics.median(float(r[1]) for r in theirs)
+    print(f"pcl_ddg_normals -method area (the process)  {o_time * 1000:8.0f} ms"
+          f"  peak {statistics.median(r[2] for r in ours):6.0f} MB"
+          f"  {statistics.median(r[3] for r in ours):8.0f} minor faults")
+    print(f"Open3D read + normals + write (the calls)   {t_time * 1000:8.0f} ms"
+          f"  peak {statistics.median(r[2] for r in theirs):6.0f} MB"
+          f"  {statistics.median(r[3] for r in theirs):8.0f} minor faults (the process)")
+    print(f"  of which Python + import open3d alone:   peak {baseline[2]:6.0f} MB"
+          f"  {baseline[3]:8.0f} minor faults")
+    ratios = sorted(float(t[1]) / o[0] for o, t in zip(ours, theirs))
+    print(f"ratio: ours {t_time / o_time:.2f}x faster "
           f"(median of the runs' ratios {statistics.median(ratios):.2f}x, "
-          f"range {ratios[0]:.2f}-{ratios[-1]:.2f}x, {repetitions} runs each)")
+          f"range {ratios[0]:.2f}-{ratios[-1]:.2f}x, {repetitions} runs each, fresh processes)")
 
 
 if __name__ == "__main__":

@@ -207,7 +207,8 @@ int run(int argc, char** argv) {
         }
 
         tools::saveResult(kName, output, in.mesh, smoothed,
-                          tools::coordinatePrecision(in.coordinate_precision, precision));
+                          tools::coordinatePrecision(in.coordinate_precision, precision), {},
+                          nullptr, in.faces);
       });
 }
 

@@ -18,8 +18,10 @@ namespace detail {
 /** PLY, ascii or binary; faces from a `face` or a `tristrips` element; a `range_grid` element
  *  turns a face-less scan into an organized cloud (NaN where the grid is empty). */
 pcl::PolygonMesh parsePLY(std::string_view data);
-/** OFF (also COFF/NOFF/CNOFF; extra per-vertex or per-face values ignored) and binary OFF. */
-pcl::PolygonMesh parseOFF(std::string_view data);
+/** OFF (also COFF/NOFF/CNOFF; extra per-vertex or per-face values ignored) and binary OFF.
+ *  With rows (ascii OFF whose faces all have three corners): the faces go there, not into the
+ *  mesh's polygons. */
+pcl::PolygonMesh parseOFF(std::string_view data, FaceRows* rows = nullptr);
 /** Wavefront OBJ: `v` and `f` records (v, v/t, v//n, v/t/n, negative relative indices). */
 pcl::PolygonMesh parseOBJ(std::string_view data);
 /** STL, ascii or binary; identical corner coordinates are merged into one vertex. */

@@ -59,6 +59,19 @@ void requireFloatRange(const Eigen::Matrix3Xd& positions) {
   }
 }
 
+// The polygons as rows when they all have the same size; none otherwise.
+FaceRows faceRowsOf(const std::vector<pcl::Vertices>& polygons) {
+  FaceRows rows;
+  const std::size_t corners = polygons.front().vertices.size();
+  for (const pcl::Vertices& p : polygons)
+    if (p.vertices.size() != corners || corners == 0) return rows;
+  rows.corners = corners;
+  rows.indices.reserve(polygons.size() * corners);
+  for (const pcl::Vertices& p : polygons)
+    rows.indices.insert(rows.indices.end(), p.vertices.begin(), p.vertices.end());
+  return rows;
+}
+
 }  // namespace
 
 std::string fileExtension(const std::string& path) {
@@ -71,7 +84,7 @@ std::string fileExtension(const std::string& path) {
   return ext;
 }
 
-MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty) {
+MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorage faces) {
   const std::string ext = fileExtension(path);
   try {
     if (ext == "laz") {  // before anything is read: no LAZ decoder is at hand
@@ -95,7 +108,7 @@ MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty) {
     using Parser = pcl::PolygonMesh (*)(std::string_view);
     Parser parse = nullptr;
     if (ext == "ply") parse = detail::parsePLY;
-    if (ext == "off") parse = detail::parseOFF;
+    if (ext == "off") parse = [](std::string_view text) { return detail::parseOFF(text); };
     if (ext == "obj") parse = detail::parseOBJ;
     if (ext == "stl") parse = detail::parseSTL;
     if (ext == "vtk") parse = detail::parseVTK;
@@ -105,7 +118,16 @@ MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty) {
           " (expected .ply, .obj, .off, .stl, .vtk, .pcd or .las)");
     }
     MeshFile file;
-    file.mesh = ext == "pcd" ? detail::parsePCD(data, &file.sensor_pose) : parse(data);
+    auto rows = std::make_shared<FaceRows>();
+    const bool as_rows = faces == FaceStorage::Rows;
+    file.mesh = ext == "pcd"              ? detail::parsePCD(data, &file.sensor_pose)
+                : ext == "off" && as_rows ? detail::parseOFF(data, rows.get())
+                                          : parse(data);
+    if (as_rows && !file.mesh.polygons.empty()) *rows = faceRowsOf(file.mesh.polygons);
+    if (rows->rows() > 0) {
+      std::vector<pcl::Vertices>().swap(file.mesh.polygons);
+      file.faces = std::move(rows);
+    }
     pcl::PCLPointCloud2& cloud = file.mesh.cloud;
     if (cloud.width * cloud.height == 0) throw FileFormatException("file has no vertices");
     file.positions = vertexPositions(cloud, NonFinitePolicy::Keep);

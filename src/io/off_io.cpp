@@ -2,6 +2,7 @@
 // (COFF, NOFF, CNOFF) carry extra values per line, which are ignored; "OFF BINARY" in either byte
 // order and either face layout (Geomview's, pmp-library's).
 #include <algorithm>
+#include <atomic>
 #include <optional>
 #include <string>
 #include <vector>
@@ -157,7 +158,7 @@ pcl::PolygonMesh parseBinaryOFF(ByteCursor& cursor) {
 
 }  // namespace
 
-pcl::PolygonMesh parseOFF(std::string_view data) {
+pcl::PolygonMesh parseOFF(std::string_view data, FaceRows* rows) {
   ByteCursor cursor(data);
   const std::string_view magic = cursor.token();
   if (magic.size() < 3 || magic.substr(magic.size() - 3) != "OFF") {
@@ -194,24 +195,48 @@ pcl::PolygonMesh parseOFF(std::string_view data) {
   }
   std::vector<double> xyz(3 * static_cast<std::size_t>(num_vertices));
   pcl::PolygonMesh mesh;
-  mesh.polygons.resize(static_cast<std::size_t>(num_faces));
+  // Rows asked for: triangles go straight into them (no heap vector per face); a face of another
+  // size is still read and checked, and the faces are then read again as polygons.
+  std::vector<std::int32_t> triangles(rows ? 3 * static_cast<std::size_t>(num_faces) : 0);
+  std::atomic<bool> not_triangles{false};
+  bool as_rows = rows != nullptr;
+  if (!as_rows) mesh.polygons.resize(static_cast<std::size_t>(num_faces));
   const auto parseLine = [&](std::int64_t i) {
     ByteCursor values = cursor.within(lines[static_cast<std::size_t>(i)]);
     if (i < num_vertices) {
       for (int d = 0; d < 3; ++d) xyz[3 * i + d] = values.readDouble("vertex coordinate");
       return;
     }
-    auto& polygon = mesh.polygons[static_cast<std::size_t>(i - num_vertices)];
+    const auto face = static_cast<std::size_t>(i - num_vertices);
     const std::int64_t n = values.readInt("face size");
     if (n < 0 || n > static_cast<std::int64_t>(values.remaining())) {
       values.fail("face size " + std::to_string(n) + " does not fit its line");
     }
-    polygon.vertices.resize(static_cast<std::size_t>(n));
-    for (auto& corner : polygon.vertices) corner = cornerIndex(values.readInt("face index"));
+    if (as_rows && n == 3) {
+      for (int k = 0; k < 3; ++k)
+        triangles[3 * face + k] = cornerIndex(values.readInt("face index"));
+    } else if (as_rows) {
+      not_triangles = true;
+      for (std::int64_t k = 0; k < n; ++k) cornerIndex(values.readInt("face index"));
+    } else {
+      auto& polygon = mesh.polygons[face];
+      polygon.vertices.resize(static_cast<std::size_t>(n));
+      for (auto& corner : polygon.vertices) corner = cornerIndex(values.readInt("face index"));
+    }
   };
   // The first error by line order is the one reported: each thread's lines are contiguous.
   constexpr std::int64_t kLinesPerThread = 16384;  // small files: no thread started
   parallelForInLoader(num_vertices + num_faces, kLinesPerThread, parseLine);
+  if (as_rows && !not_triangles) {
+    rows->indices = std::move(triangles);
+    rows->corners = 3;
+  } else if (as_rows) {  // checked above: read again, as polygons
+    std::vector<std::int32_t>().swap(triangles);
+    as_rows = false;
+    mesh.polygons.resize(static_cast<std::size_t>(num_faces));
+    parallelForInLoader(num_faces, kLinesPerThread,
+                        [&](std::int64_t f) { parseLine(num_vertices + f); });
+  }
   mesh.cloud = makeXYZCloud(xyz);
   return mesh;
 }

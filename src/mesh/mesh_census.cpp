@@ -11,7 +11,7 @@
 
 namespace pcl_ddg {
 
-void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons,
+void MeshTopology::countDuplicatePolygons(const PolygonList& polygons,
                                           const std::vector<int>& others_ids,
                                           const Wedges& wedges) {
   // Two polygons are duplicates when they have the same corners (as a multiset). Plain triangles,
@@ -42,7 +42,7 @@ void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& poly
   std::vector<std::pair<int, int>> others;  // (smallest corner, polygon)
   others.reserve(others_ids.size());
   for (const int i : others_ids) {
-    const pcl::Indices& corners = polygons[i].vertices;
+    const PolygonCorners corners = polygons[i];
     others.emplace_back(*std::min_element(corners.begin(), corners.end()), i);
   }
   std::sort(others.begin(), others.end());
@@ -54,7 +54,7 @@ void MeshTopology::countDuplicatePolygons(const std::vector<pcl::Vertices>& poly
     bucket.resize(end - begin);
     for (std::size_t j = begin; j < end; ++j) {
       auto& key = bucket[j - begin];
-      const pcl::Indices& corners = polygons[others[j].second].vertices;
+      const PolygonCorners corners = polygons[others[j].second];
       key.assign(corners.begin(), corners.end());
       std::sort(key.begin(), key.end());
     }

@@ -5,24 +5,13 @@
 #include <sstream>
 
 #include "detail/disjoint_sets.h"
-#include "pcl_ddg/exceptions.h"
 #include "detail/vertex_ranges.h"
+#include "pcl_ddg/exceptions.h"
 
 namespace pcl_ddg {
 namespace {
 
-std::vector<pcl::Vertices> trianglesAsPolygons(
-    const Eigen::Ref<const Eigen::Matrix3Xi>& triangles) {
-  std::vector<pcl::Vertices> polygons(triangles.cols());
-  for (Eigen::Index t = 0; t < triangles.cols(); ++t) {
-    for (int k = 0; k < 3; ++k) {
-      polygons[t].vertices.push_back(triangles(k, t));
-    }
-  }
-  return polygons;
-}
-
-bool hasRepeatedCorner(const pcl::Indices& corners) {
+bool hasRepeatedCorner(const PolygonCorners& corners) {
   for (std::size_t i = 0; i < corners.size(); ++i) {
     for (std::size_t j = i + 1; j < corners.size(); ++j) {
       if (corners[i] == corners[j]) return true;
@@ -38,7 +27,7 @@ MeshTopology::MeshTopology(const pcl::PolygonMesh& mesh, OutOfRangeFacePolicy po
   build(mesh.polygons, policy);
 }
 
-MeshTopology::MeshTopology(int num_vertices, const std::vector<pcl::Vertices>& polygons,
+MeshTopology::MeshTopology(int num_vertices, const PolygonList& polygons,
                            OutOfRangeFacePolicy policy)
     : num_vertices_(num_vertices) {
   build(polygons, policy);
@@ -47,10 +36,18 @@ MeshTopology::MeshTopology(int num_vertices, const std::vector<pcl::Vertices>& p
 MeshTopology::MeshTopology(int num_vertices, const Eigen::Ref<const Eigen::Matrix3Xi>& triangles,
                            OutOfRangeFacePolicy policy)
     : num_vertices_(num_vertices) {
-  build(trianglesAsPolygons(triangles), policy);
+  // Rows of three corners (a column-major 3 x T matrix is row-major T x 3), read in place when
+  // its columns are packed.
+  const auto rows = static_cast<std::size_t>(triangles.cols());
+  if (triangles.outerStride() == 3 || rows == 0) {
+    build(PolygonList(triangles.data(), rows, 3), policy);
+    return;
+  }
+  const Eigen::Matrix3Xi packed = triangles;
+  build(PolygonList(packed.data(), rows, 3), policy);
 }
 
-void MeshTopology::build(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy) {
+void MeshTopology::build(const PolygonList& polygons, OutOfRangeFacePolicy policy) {
   if (num_vertices_ <= 0) throw InvalidMeshException("mesh has no vertices");
   std::vector<std::pair<int, int>> boundary_edges;
   {
@@ -67,11 +64,11 @@ void MeshTopology::build(const std::vector<pcl::Vertices>& polygons, OutOfRangeF
   countBoundaryLoops(boundary_edges);
 }
 
-MeshTopology::PolygonKinds MeshTopology::triangulate(const std::vector<pcl::Vertices>& polygons,
+MeshTopology::PolygonKinds MeshTopology::triangulate(const PolygonList& polygons,
                                                      OutOfRangeFacePolicy policy) {
   auto invalid = [&](pcl::index_t i) { return i < 0 || i >= num_vertices_; };
-  auto out_of_range = [&](const pcl::Vertices& p) {
-    return std::any_of(p.vertices.begin(), p.vertices.end(), invalid);
+  auto out_of_range = [&](const PolygonCorners& p) {
+    return std::any_of(p.begin(), p.end(), invalid);
   };
   std::int64_t first_bad = -1;
   for (std::size_t i = 0; i < polygons.size(); ++i) {
@@ -80,7 +77,7 @@ MeshTopology::PolygonKinds MeshTopology::triangulate(const std::vector<pcl::Vert
     ++counts_.out_of_range_polygons;
   }
   if (first_bad >= 0 && policy == OutOfRangeFacePolicy::Throw) {
-    const auto& corners = polygons[first_bad].vertices;
+    const PolygonCorners corners = polygons[first_bad];
     const auto bad = *std::find_if(corners.begin(), corners.end(), invalid);
     std::ostringstream msg;
     msg << "face " << first_bad << " refers to vertex " << bad << " but the mesh has "
@@ -91,8 +88,8 @@ MeshTopology::PolygonKinds MeshTopology::triangulate(const std::vector<pcl::Vert
 
   counts_.input_polygons = static_cast<std::int64_t>(polygons.size());
   std::size_t num_triangles = 0;
-  for (const auto& p : polygons) {
-    const std::size_t n = p.vertices.size();
+  for (std::size_t i = 0; i < polygons.size(); ++i) {
+    const std::size_t n = polygons[i].size();
     if (counts_.polygons_by_valence.size() <= n) counts_.polygons_by_valence.resize(n + 1, 0);
     ++counts_.polygons_by_valence[n];
     if (n >= 3) num_triangles += n - 2;
@@ -105,8 +102,8 @@ MeshTopology::PolygonKinds MeshTopology::triangulate(const std::vector<pcl::Vert
   kinds.plain.reserve(num_triangles);
   Eigen::Index t = 0;
   for (std::size_t i = 0; i < polygons.size(); ++i) {
-    const auto& c = polygons[i].vertices;
-    if (first_bad >= 0 && out_of_range(polygons[i])) continue;
+    const PolygonCorners c = polygons[i];
+    if (first_bad >= 0 && out_of_range(c)) continue;
     const bool repeated = c.size() < 3 || hasRepeatedCorner(c);
     if (repeated) ++counts_.repeated_index_polygons;
     if (c.size() > 3) ++counts_.triangulated_polygons;

@@ -46,6 +46,49 @@ TEST(MeshIO, EverySharedFileLoadsWithItsCatalogCounts) {
   }
 }
 
+/** The faces of a file read as rows, as polygons (each row one polygon). */
+std::vector<pcl::Vertices> polygonsOfRows(const FaceRows& rows) {
+  std::vector<pcl::Vertices> polygons(rows.rows());
+  for (std::size_t f = 0; f < rows.rows(); ++f)
+    polygons[f].vertices.assign(rows.indices.begin() + f * rows.corners,
+                                rows.indices.begin() + (f + 1) * rows.corners);
+  return polygons;
+}
+
+void expectSameTopology(const MeshTopology& a, const MeshTopology& b) {
+  EXPECT_EQ(a.triangles(), b.triangles());
+  EXPECT_EQ(a.counts().input_polygons, b.counts().input_polygons);
+  EXPECT_EQ(a.counts().duplicate_polygons, b.counts().duplicate_polygons);
+  EXPECT_EQ(a.counts().repeated_index_polygons, b.counts().repeated_index_polygons);
+  EXPECT_EQ(a.counts().triangulated_polygons, b.counts().triangulated_polygons);
+  EXPECT_EQ(a.counts().nonmanifold_edges, b.counts().nonmanifold_edges);
+  EXPECT_EQ(a.counts().polygons_by_valence, b.counts().polygons_by_valence);
+  EXPECT_EQ(a.numEdges(), b.numEdges());
+}
+
+// The tools read faces as rows (no heap vector per face): the same faces, in the same order, and
+// the same topology as PCL's polygons give, for every shared mesh.
+TEST(MeshIO, FacesAsRowsAreThePolygonsOfEverySharedMesh) {
+  for (const SharedMesh& e : sharedMeshes()) {
+    SCOPED_TRACE(e.path);
+    const MeshFile polygons = readMeshFile(sharedData(e.path));
+    const MeshFile rows =
+        readMeshFile(sharedData(e.path), EmptyFilePolicy::Refuse, FaceStorage::Rows);
+    ASSERT_TRUE(rows.faces) << "every shared mesh has faces of one size";
+    EXPECT_TRUE(rows.mesh.polygons.empty());
+    EXPECT_EQ(static_cast<int>(rows.faces->rows()), e.faces);
+    const std::vector<pcl::Vertices> read_back = polygonsOfRows(*rows.faces);
+    ASSERT_EQ(read_back.size(), polygons.mesh.polygons.size());
+    for (std::size_t f = 0; f < read_back.size(); ++f)
+      ASSERT_EQ(read_back[f].vertices, polygons.mesh.polygons[f].vertices) << "face " << f;
+    EXPECT_EQ(rows.positions, polygons.positions);
+    const int n = static_cast<int>(polygons.positions.cols());
+    expectSameTopology(MeshTopology(n, PolygonList(rows.faces->indices.data(), rows.faces->rows(),
+                                                   rows.faces->corners)),
+                       MeshTopology(polygons.mesh));
+  }
+}
+
 TEST(MeshIO, RangeGridBecomesAnOrganizedCloudWithHoles) {
   const pcl::PolygonMesh scan = loadMesh(sharedData("range/bun000.ply"));
   EXPECT_EQ(scan.cloud.width, 512u);
@@ -81,6 +124,41 @@ class MeshIOFiles : public ::testing::Test {
   std::string path(const std::string& name) const { return dir_ + "/" + name; }
   std::string dir_;
 };
+
+TEST_F(MeshIOFiles, FacesOfMixedSizesStayPolygonsAndQuadsBecomeRowsOfFour) {
+  const std::string vertices = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n";
+  // A triangle then a quad: the ascii OFF reader starts with rows and reads the faces again.
+  writeText(path("mixed.off"), "OFF\n5 2 0\n" + vertices + "3 1 4 2\n4 0 1 2 3\n");
+  const MeshFile mixed =
+      readMeshFile(path("mixed.off"), EmptyFilePolicy::Refuse, FaceStorage::Rows);
+  EXPECT_FALSE(mixed.faces);
+  ASSERT_EQ(mixed.mesh.polygons.size(), 2u);
+  EXPECT_EQ(mixed.mesh.polygons[0].vertices, (pcl::Indices{1, 4, 2}));
+  EXPECT_EQ(mixed.mesh.polygons[1].vertices, (pcl::Indices{0, 1, 2, 3}));
+  writeText(path("quads.off"), "OFF\n5 2 0\n" + vertices + "4 0 1 2 3\n4 1 4 2 3\n");
+  const MeshFile quads =
+      readMeshFile(path("quads.off"), EmptyFilePolicy::Refuse, FaceStorage::Rows);
+  ASSERT_TRUE(quads.faces);
+  EXPECT_EQ(quads.faces->corners, 4u);
+  EXPECT_EQ(quads.faces->indices, (std::vector<std::int32_t>{0, 1, 2, 3, 1, 4, 2, 3}));
+  expectSameTopology(MeshTopology(5, PolygonList(quads.faces->indices.data(), 2, 4)),
+                     MeshTopology(readMeshFile(path("quads.off")).mesh));
+  // The first bad face by line order is the one named, rows or not (here after a quad).
+  writeText(path("bad.off"), "OFF\n5 3 0\n" + vertices + "3 0 1 2\n4 0 1 2 3\n3 0 x 2\n");
+  std::string as_polygons, as_rows;
+  try {
+    readMeshFile(path("bad.off"));
+  } catch (const FileFormatException& e) {
+    as_polygons = e.what();
+  }
+  try {
+    readMeshFile(path("bad.off"), EmptyFilePolicy::Refuse, FaceStorage::Rows);
+  } catch (const FileFormatException& e) {
+    as_rows = e.what();
+  }
+  EXPECT_FALSE(as_polygons.empty());
+  EXPECT_EQ(as_rows, as_polygons);
+}
 
 TEST_F(MeshIOFiles, PlyRoundTripKeepsDoublesFieldsAndFaces) {
   Eigen::Matrix3Xd p(3, 4);

@@ -18,17 +18,19 @@ ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind k
   MeshFile file;
   {
     Timer timer("Loading " + path);
-    file = readMeshFile(path);
+    file = readMeshFile(path, EmptyFilePolicy::Refuse, FaceStorage::Rows);
     timer.done(static_cast<std::size_t>(file.positions.cols()));
   }
-  if (kind == InputKind::Mesh && file.mesh.polygons.empty())
+  const bool has_faces = file.faces || !file.mesh.polygons.empty();
+  if (kind == InputKind::Mesh && !has_faces)
     throw std::runtime_error(path + " has no faces (a point cloud?)");
   mesh = std::move(file.mesh);
+  faces = std::move(file.faces);
   positions = std::move(file.positions);
   sensor_pose = file.sensor_pose;
   las = std::move(file.las);
   coordinate_precision = file.coordinate_precision;
-  if (mesh.polygons.empty()) {
+  if (!has_faces) {
     const NonFiniteVertices bad = findNonFiniteVertices(positions);
     if (bad.count == positions.cols()) throw std::runtime_error(path + " has no finite point");
     if (bad.count > 0)
@@ -37,7 +39,10 @@ ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind k
   }
   Timer timer("Building the mesh topology");
   requireFinite(positions);
-  topology = std::make_shared<const MeshTopology>(mesh);
+  topology = faces ? std::make_shared<const MeshTopology>(
+                         static_cast<int>(mesh.cloud.width * mesh.cloud.height),
+                         PolygonList(faces->indices.data(), faces->rows(), faces->corners))
+                   : std::make_shared<const MeshTopology>(mesh);
   // Only the defects worth a warning (pcl_ddg_info makes the whole MeshReport).
   const TopologyCounts& counts = topology->counts();
   const std::int64_t degenerate =

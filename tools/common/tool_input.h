@@ -31,7 +31,10 @@ class ToolInput {
    *  non-finite points are counted in a warning (kept: NaN output there); none finite throws. */
   ToolInput(const std::string& path, const char* tool_name, InputKind kind = InputKind::Any);
 
-  pcl::PolygonMesh mesh;  ///< x, y, z as float (PCL's point types); positions holds them exactly
+  /** x, y, z as float (PCL's point types; positions holds them exactly); its polygons empty when
+   *  the faces are rows. */
+  pcl::PolygonMesh mesh;
+  std::shared_ptr<const FaceRows> faces;         ///< a mesh's faces of one size (FaceStorage::Rows)
   Eigen::Matrix3Xd positions;                    ///< double, as read (LAS: X * scale + offset)
   std::shared_ptr<const MeshTopology> topology;  ///< null for a cloud
   SensorPose sensor_pose;                        ///< a PCD's VIEWPOINT (kept for the output)

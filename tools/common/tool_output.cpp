@@ -61,7 +61,8 @@ FieldPrecision coordinatePrecision(FieldPrecision input, FieldPrecision requeste
 
 void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh& mesh,
                 const Eigen::Matrix3Xd& positions, FieldPrecision coordinates,
-                const SensorPose& sensor_pose, const std::shared_ptr<const LasLayout>& las) {
+                const SensorPose& sensor_pose, const std::shared_ptr<const LasLayout>& las,
+                const std::shared_ptr<const FaceRows>& faces) {
   setVertexCoordinates(mesh.cloud, positions, coordinates);
   if (fileExtension(path) == "pcd") {
     std::string doubles;
@@ -79,6 +80,7 @@ void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh
   MeshWriteOptions options;
   options.sensor_pose = sensor_pose;
   options.las = las;
+  options.faces = faces;
   saveMesh(path, mesh, options);
   timer.done(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height);
 }

@@ -54,12 +54,13 @@ FieldPrecision coordinatePrecision(FieldPrecision input, FieldPrecision requeste
  * (format by extension, atomic), with a timing line; a PCD output carries the sensor pose as its
  * VIEWPOINT, a LAS output the input's LAS layout (`las`: version, point format, scale, offset,
  * VLRs; null for a new LAS 1.4 file). Warns when a .pcd gets double fields, which PCL's float point
- * types cannot read.
+ * types cannot read. A mesh read as rows (ToolInput::faces) writes them as such.
  */
 void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh& mesh,
                 const Eigen::Matrix3Xd& positions, FieldPrecision coordinates,
                 const SensorPose& sensor_pose = {},
-                const std::shared_ptr<const LasLayout>& las = nullptr);
+                const std::shared_ptr<const LasLayout>& las = nullptr,
+                const std::shared_ptr<const FaceRows>& faces = nullptr);
 
 }  // namespace tools
 }  // namespace pcl_ddg

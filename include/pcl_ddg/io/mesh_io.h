@@ -65,6 +65,17 @@ struct MeshFile {
   /** A LAS file's header, VLRs and Extra Bytes layout (null for other formats). Its coordinates
    *  are X * scale + offset in double (positions; coordinate_precision Double). */
   std::shared_ptr<const LasLayout> las;
+  /** FaceStorage::Rows and every face of the same size: the faces, mesh.polygons left empty. */
+  std::shared_ptr<const FaceRows> faces;
+};
+
+/** How readMeshFile returns a mesh's faces. */
+enum class FaceStorage {
+  Polygons,  ///< in mesh.polygons, as PCL code reads them
+  /** In MeshFile::faces when they all have the same size (else as polygons): no heap vector per
+   *  face, a quarter of the memory (what the tools read; MeshTopology and the .ply writer take
+   *  them as they are). An ascii OFF of triangles is read straight into them. */
+  Rows
 };
 
 /** What readMeshFile does with a valid LAS file whose header counts no point. (A file of another
@@ -77,7 +88,8 @@ enum class EmptyFilePolicy {
 /** Loads any supported file. Throws FileFormatException when a finite coordinate lies beyond
  *  float's range (PCL's point types could not hold it), and for a file of no points unless
  *  empty is Accept and the file is LAS. */
-MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty = EmptyFilePolicy::Refuse);
+MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty = EmptyFilePolicy::Refuse,
+                      FaceStorage faces = FaceStorage::Polygons);
 
 /** readMeshFile's mesh; `sensor_pose`, if given, receives the file's VIEWPOINT (PCD). */
 pcl::PolygonMesh loadMesh(const std::string& path, SensorPose* sensor_pose = nullptr);

@@ -21,6 +21,8 @@
 #include <utility>
 #include <vector>
 
+#include "pcl_ddg/mesh/polygon_list.h"
+
 namespace pcl_ddg {
 
 /** What to do with a polygon that names a vertex that does not exist. */
@@ -75,8 +77,9 @@ class MeshTopology {
   explicit MeshTopology(const pcl::PolygonMesh& mesh,
                         OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw);
 
-  /** Builds from a vertex count and polygons (indices into 0..num_vertices-1). */
-  MeshTopology(int num_vertices, const std::vector<pcl::Vertices>& polygons,
+  /** Builds from a vertex count and polygons (indices into 0..num_vertices-1): PCL's
+   *  pcl::Vertices or rows of a fixed size (polygon_list.h). */
+  MeshTopology(int num_vertices, const PolygonList& polygons,
                OutOfRangeFacePolicy policy = OutOfRangeFacePolicy::Throw);
 
   /** Builds from a vertex count and a 3 x T triangle index matrix (or a view of T x 3 C-order
@@ -134,13 +137,13 @@ class MeshTopology {
   static IndexSpan row(const std::vector<int>& offsets, const std::vector<int>& data, int v) {
     return {data.data() + offsets[v], data.data() + offsets[v + 1]};
   }
-  void build(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
+  void build(const PolygonList& polygons, OutOfRangeFacePolicy policy);
   /** What triangulate learns of each polygon on its one pass over them, for the later passes. */
   struct PolygonKinds {
     std::vector<char> plain;  ///< per triangle: a whole input triangle (three distinct corners)
     std::vector<int> others;  ///< polygons in range with 3+ corners that are not plain triangles
   };
-  PolygonKinds triangulate(const std::vector<pcl::Vertices>& polygons, OutOfRangeFacePolicy policy);
+  PolygonKinds triangulate(const PolygonList& polygons, OutOfRangeFacePolicy policy);
   /** Per incidence of a vertex in a triangle (parallel to vt_triangles_): the triangle's next and
    *  previous corners after the vertex, and the vertex's corner index plus kPlainTriangle when the
    *  triangle is a whole input polygon. Built once, so that every later per-vertex pass reads its
@@ -155,7 +158,7 @@ class MeshTopology {
   void buildVertexNeighbours(const Wedges& wedges);
   /** Flags and edge counts from each vertex's own wedges and ring; returns the boundary edges. */
   std::vector<std::pair<int, int>> classifyVertices(const Wedges& wedges);
-  void countDuplicatePolygons(const std::vector<pcl::Vertices>& polygons,
+  void countDuplicatePolygons(const PolygonList& polygons,
                               const std::vector<int>& others, const Wedges& wedges);
   void findComponents();
   void checkOrientability();
