@@ -57,7 +57,16 @@ TEST(Curvature, GaussBonnetOnAnalyticMeshesOpenAndClosed) {
         makeParaboloid({16, 0.0, 1}), makeSaddle({12, 0.2, 5}).rotateAndShiftFar()}) {
     const MeshTopology t = topologyOf(s);
     const double expected = 2 * kPi * s.euler_characteristic;
-    EXPECT_NEAR(angleDefect(t, s.points).sum(), expected, 1e-9);
+    const Eigen::VectorXd defect = angleDefect(t, s.points);
+    EXPECT_NEAR(defect.sum(), expected, 1e-9);
+    // Vertex by vertex too, K dA = the defect (the sum alone would not see an angle taken at
+    // another corner of each triangle: its three angles still add up once).
+    const VertexCurvatures c = computeCurvatures(t, s.points);
+    for (int v = 0; v < t.numVertices(); ++v) {
+      ASSERT_NEAR(defect[v], c.gauss_curvature[v] * c.vertex_area[v],
+                  1e-12 * (1 + std::abs(defect[v])))
+          << "vertex " << v;
+    }
     for (auto mass : {MassType::MixedVoronoi, MassType::Barycentric}) {
       const IntegratedK k = integratedGaussCurvature(computeCurvatures(t, s.points, mass));
       EXPECT_EQ(k.nonfinite, 0);
