@@ -5,8 +5,8 @@
 #include <cmath>
 #include <limits>
 
-#include "detail/vertex_ranges.h"
 #include "detail/triangle_geometry.h"
+#include "detail/vertex_ranges.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 
 namespace pcl_ddg {

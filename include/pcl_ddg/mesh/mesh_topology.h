@@ -158,8 +158,8 @@ class MeshTopology {
   void buildVertexNeighbours(const Wedges& wedges);
   /** Flags and edge counts from each vertex's own wedges and ring; returns the boundary edges. */
   std::vector<std::pair<int, int>> classifyVertices(const Wedges& wedges);
-  void countDuplicatePolygons(const PolygonList& polygons,
-                              const std::vector<int>& others, const Wedges& wedges);
+  void countDuplicatePolygons(const PolygonList& polygons, const std::vector<int>& others,
+                              const Wedges& wedges);
   void findComponents();
   void checkOrientability();
   void countBoundaryLoops(const std::vector<std::pair<int, int>>& boundary_edges);
