@@ -15,10 +15,10 @@ folder.
 import math
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
+
+from fresh_process import measured
 
 
 def write_torus_off(path, around=1600, tube=720, major=1.0, minor=0.4):
@@ -50,21 +50,6 @@ if mesh_path:
     open3d.io.write_triangle_mesh(out_path, m, write_ascii=False, compressed=False)
 print(time.perf_counter() - start)
 """
-
-
-def measured(command):
-    """Runs command as a fresh process: (wall seconds, its stdout, peak resident MB, minor page
-    faults), the last two by /usr/bin/time -f '%M %R' (which forks the command from its own small
-    process: a child forked from this Python would start with this Python's peak)."""
-    with tempfile.NamedTemporaryFile("r", suffix=".time") as report:
-        start = time.perf_counter()
-        run = subprocess.run(["/usr/bin/time", "-o", report.name, "-f", "%M %R", *command],
-                             stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
-        wall = time.perf_counter() - start
-        if run.returncode != 0:
-            sys.exit(f"{command[0]} failed with exit status {run.returncode}")
-        peak_kb, faults = report.read().split()[-2:]
-    return wall, run.stdout.decode(), int(peak_kb) / 1024.0, int(faults)
 
 
 def main():

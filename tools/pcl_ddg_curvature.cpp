@@ -178,7 +178,7 @@ int run(int argc, char** argv) {
         }
         tools::saveResult(kName, output, in.mesh, in.positions,
                           tools::coordinatePrecision(in.coordinate_precision, precision),
-                          in.sensor_pose, in.las, in.faces);
+                          in.sensor_pose, in.las, in.outputFaces());
       });
 }
 

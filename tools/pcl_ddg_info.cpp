@@ -1,5 +1,7 @@
 // pcl_ddg_info: what a mesh or cloud file holds, defects included. It never refuses a file it can
 // parse: out-of-range faces, non-finite vertices and the like are counted, not fatal.
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -97,7 +99,17 @@ std::vector<BoundMismatch> boundMismatches(const pcl_ddg::LasLayout& las,
 std::string lasReport(const pcl_ddg::LasLayout& las, const pcl::PCLPointCloud2& cloud,
                       const pcl_ddg::BoundingBox& records_box, bool json) {
   std::map<int, long long> histogram;
-  if (pcl_ddg::hasVertexField(cloud, "classification")) {
+  const auto field =
+      std::find_if(cloud.fields.begin(), cloud.fields.end(),
+                   [](const pcl::PCLPointField& f) { return f.name == "classification"; });
+  if (field != cloud.fields.end() && field->datatype == pcl::PCLPointField::UINT8) {
+    // The LAS reader's byte, counted where it lies (no column of doubles, no map per point).
+    std::array<long long, 256> counts{};
+    const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
+    for (std::size_t i = 0; i < n; ++i) ++counts[cloud.data[i * cloud.point_step + field->offset]];
+    for (int c = 0; c < 256; ++c)
+      if (counts[c] > 0) histogram[c] = counts[c];
+  } else if (field != cloud.fields.end()) {
     const Eigen::VectorXd c = pcl_ddg::vertexScalarField(cloud, "classification");
     for (Eigen::Index i = 0; i < c.size(); ++i) ++histogram[static_cast<int>(c[i])];
   }

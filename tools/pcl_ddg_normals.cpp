@@ -196,6 +196,7 @@ int run(int argc, char** argv) {
             return fitLocalSurfaces(in.local(), in.topology, options);
           }();
           timer.done(in.points()->size());
+          in.releaseLocal();
           result.failed_points -= left_out;  // -classes: not fitted by request
           tools::warnAboutLocalFit(kName, result);
           tools::warnAboutRadius(kName, sampling, options, result);
@@ -215,7 +216,7 @@ int run(int argc, char** argv) {
         }
         tools::saveResult(kName, output, in.mesh, in.positions,
                           tools::coordinatePrecision(in.coordinate_precision, precision),
-                          in.sensor_pose, in.las, in.faces);
+                          in.sensor_pose, in.las, in.outputFaces());
       });
 }
 

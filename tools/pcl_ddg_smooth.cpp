@@ -208,7 +208,7 @@ int run(int argc, char** argv) {
 
         tools::saveResult(kName, output, in.mesh, smoothed,
                           tools::coordinatePrecision(in.coordinate_precision, precision), {},
-                          nullptr, in.faces);
+                          nullptr, in.outputFaces());
       });
 }
 

@@ -37,8 +37,9 @@ struct LasCloud {
 };
 
 /** LAS 1.0-1.4, uncompressed, point formats 0-10; LAZ (the compression bit set in the point
- *  format) is refused first, with how to decompress it. */
-LasCloud parseLAS(std::string_view data);
+ *  format) is refused first, with how to decompress it. The cloud's data has room for
+ *  spare_point_bytes more bytes per point (readMeshFile's). */
+LasCloud parseLAS(std::string_view data, std::size_t spare_point_bytes = 0);
 
 /** A cloud as a LAS file: the layout of `source` (version, point format, scale, offset, VLRs and
  *  EVLRs, Extra Bytes descriptors of the fields that remain), or LAS 1.4 format 6 (7 with

@@ -250,7 +250,7 @@ pcl::PCLPointField makeField(const std::string& name, std::uint8_t datatype, std
 
 }  // namespace
 
-LasCloud parseLAS(std::string_view data) {
+LasCloud parseLAS(std::string_view data, std::size_t spare_point_bytes) {
   HeaderFacts facts;
   LasCloud result;
   LasLayout& layout = result.layout;
@@ -329,6 +329,8 @@ LasCloud parseLAS(std::string_view data) {
   cloud.point_step = step;
   cloud.row_step = static_cast<std::uint32_t>(n * step);
   cloud.is_dense = true;  // integers times a finite scale plus a finite offset
+  if (spare_point_bytes > 0)
+    cloud.data.reserve(static_cast<std::size_t>(n * (step + spare_point_bytes)));
   cloud.data.resize(static_cast<std::size_t>(n * step));
   result.positions.resize(3, static_cast<Eigen::Index>(n));
 

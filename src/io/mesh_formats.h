@@ -30,8 +30,10 @@ pcl::PolygonMesh parseSTL(std::string_view data);
  *  POLYGONS and TRIANGLE_STRIPS become faces, other cells and attributes are ignored. */
 pcl::PolygonMesh parseVTK(std::string_view data);
 /** PCD, ascii, binary or binary_compressed (padding fields "_" kept as in PCL's reader); the
- *  VIEWPOINT into sensor_pose when given. */
-pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose = nullptr);
+ *  VIEWPOINT into sensor_pose when given; room for spare_point_bytes more per point reserved in
+ *  the cloud's data (readMeshFile's). */
+pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose = nullptr,
+                          std::size_t spare_point_bytes = 0);
 /** How the points of a binary cloud file lie on disk, for reading it a piece at a time. */
 struct BinaryCloudLayout {
   std::int64_t header_bytes = 0;  ///< the first point starts here

@@ -84,7 +84,8 @@ std::string fileExtension(const std::string& path) {
   return ext;
 }
 
-MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorage faces) {
+MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorage faces,
+                      std::size_t spare_point_bytes) {
   const std::string ext = fileExtension(path);
   try {
     if (ext == "laz") {  // before anything is read: no LAZ decoder is at hand
@@ -95,7 +96,7 @@ MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorag
     const detail::FileBytes bytes(path);  // first: a missing file says so
     const std::string_view data = bytes.view();
     if (ext == "las") {
-      detail::LasCloud las = detail::parseLAS(data);
+      detail::LasCloud las = detail::parseLAS(data, spare_point_bytes);
       if (las.positions.cols() == 0 && empty == EmptyFilePolicy::Refuse)
         throw FileFormatException("no points (the header counts none)");
       MeshFile file;
@@ -120,7 +121,7 @@ MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorag
     MeshFile file;
     auto rows = std::make_shared<FaceRows>();
     const bool as_rows = faces == FaceStorage::Rows;
-    file.mesh = ext == "pcd"              ? detail::parsePCD(data, &file.sensor_pose)
+    file.mesh = ext == "pcd" ? detail::parsePCD(data, &file.sensor_pose, spare_point_bytes)
                 : ext == "off" && as_rows ? detail::parseOFF(data, rows.get())
                                           : parse(data);
     if (as_rows && !file.mesh.polygons.empty()) *rows = faceRowsOf(file.mesh.polygons);

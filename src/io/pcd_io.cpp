@@ -243,7 +243,8 @@ BinaryCloudLayout pcdBinaryLayout(std::string_view head) {
   return layout;
 }
 
-pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose) {
+pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose,
+                          std::size_t spare_point_bytes) {
   ByteCursor cursor(data);
   const PcdHeader header = parseHeader(cursor);
   if (sensor_pose) *sensor_pose = header.sensor_pose;
@@ -273,6 +274,9 @@ pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose) {
   cloud.point_step = static_cast<std::uint32_t>(point_size);
   cloud.row_step = static_cast<std::uint32_t>(point_size * header.width);
   cloud.is_dense = false;  // unknown until checked; consumers test finiteness themselves
+  if (spare_point_bytes > 0)
+    cloud.data.reserve(static_cast<std::size_t>(bytes) +
+                       spare_point_bytes * cloud.width * cloud.height);
   switch (header.data) {
     case PcdData::Ascii:
       cloud.data.resize(static_cast<std::size_t>(bytes));

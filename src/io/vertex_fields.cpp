@@ -16,21 +16,59 @@ std::size_t pointCount(const pcl::PCLPointCloud2& cloud) {
   return static_cast<std::size_t>(cloud.width) * cloud.height;
 }
 
+// Rewrites every row of cloud.data as new_step bytes, fill(old_row, new_row) making each. In
+// place when the vector's capacity holds the new rows (readMeshFile reserves it for the fields a
+// tool adds): no second copy of the cloud. Rows then move back to front when they grow and front
+// to back when they shrink, so that a row's new place covers only rows already moved and its
+// own old bytes, which fill reads from a copy.
+template <typename Fill>
+void relayout(pcl::PCLPointCloud2& cloud, std::uint32_t new_step, Fill fill) {
+  const std::size_t n = pointCount(cloud);
+  const std::uint32_t old_step = cloud.point_step;
+  if (old_step == 0) {  // no bytes to keep (and no row to copy from)
+    cloud.data.assign(n * new_step, 0);
+  } else if (new_step <= old_step || cloud.data.capacity() >= n * new_step) {
+    std::vector<std::uint8_t> row(old_step);
+    std::uint8_t* data = nullptr;
+    if (new_step > old_step) {
+      cloud.data.resize(n * new_step);  // within the capacity: the same block
+      data = cloud.data.data();
+      for (std::size_t i = n; i-- > 0;) {
+        std::memcpy(row.data(), data + i * old_step, old_step);
+        fill(row.data(), data + i * new_step);
+      }
+    } else {
+      data = cloud.data.data();
+      for (std::size_t i = 0; i < n; ++i) {
+        std::memcpy(row.data(), data + i * old_step, old_step);
+        fill(row.data(), data + i * new_step);
+      }
+      cloud.data.resize(n * new_step);
+    }
+  } else {
+    std::vector<std::uint8_t> data(n * new_step);
+    const auto count = static_cast<std::int64_t>(n);
+#pragma omp parallel for schedule(static) if (count > 100000)
+    for (std::int64_t i = 0; i < count; ++i) {
+      fill(cloud.data.data() + static_cast<std::size_t>(i) * old_step,
+           data.data() + static_cast<std::size_t>(i) * new_step);
+    }
+    cloud.data.swap(data);
+  }
+  cloud.point_step = new_step;
+  cloud.row_step = new_step * cloud.width;
+}
+
 // Appends uninitialised scalar fields of one type in a single new layout; returns the offset of
 // the first (the others follow it).
 std::uint32_t appendFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
                            std::uint8_t datatype) {
-  const std::size_t n = pointCount(cloud);
   const std::uint32_t size = pcl::getFieldSize(datatype);
   const std::uint32_t old_step = cloud.point_step;
   const std::uint32_t new_step = old_step + size * static_cast<std::uint32_t>(names.size());
-  std::vector<std::uint8_t> data(n * new_step);
-  if (old_step > 0) {  // (no bytes: no pointers to copy from)
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-      std::memcpy(data.data() + i * new_step, cloud.data.data() + i * old_step, old_step);
-    }
-  }
+  relayout(cloud, new_step, [old_step](const std::uint8_t* from, std::uint8_t* to) {
+    std::memcpy(to, from, old_step);
+  });
   for (std::size_t k = 0; k < names.size(); ++k) {
     pcl::PCLPointField field;
     field.name = names[k];
@@ -39,9 +77,6 @@ std::uint32_t appendFields(pcl::PCLPointCloud2& cloud, const std::vector<std::st
     field.count = 1;
     cloud.fields.push_back(field);
   }
-  cloud.data.swap(data);
-  cloud.point_step = new_step;
-  cloud.row_step = new_step * cloud.width;
   return old_step;
 }
 
@@ -55,32 +90,23 @@ bool removeVertexField(pcl::PCLPointCloud2& cloud, const std::string& name) {
   const std::uint32_t size =
       pcl::getFieldSize(it->datatype) * std::max<std::uint32_t>(1, it->count);
   const std::uint32_t old_step = cloud.point_step;
-  const std::uint32_t new_step = old_step - size;
-  const std::size_t n = pointCount(cloud);
-  std::vector<std::uint8_t> data(n * new_step);
-  for (std::size_t i = 0; i < n && new_step > 0; ++i) {  // (the last field: nothing is left)
-    const std::uint8_t* src = cloud.data.data() + i * old_step;
-    std::uint8_t* dst = data.data() + i * new_step;
-    std::memcpy(dst, src, begin);
-    std::memcpy(dst + begin, src + begin + size, old_step - begin - size);
-  }
+  relayout(cloud, old_step - size, [=](const std::uint8_t* from, std::uint8_t* to) {
+    std::memcpy(to, from, begin);
+    std::memcpy(to + begin, from + begin + size, old_step - begin - size);
+  });
   cloud.fields.erase(it);
   for (auto& f : cloud.fields) {
     if (f.offset > begin) f.offset -= size;
   }
-  cloud.data.swap(data);
-  cloud.point_step = new_step;
-  cloud.row_step = new_step * cloud.width;
   return true;
 }
 
-void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
-                    const Eigen::VectorXd& values, FieldPrecision precision) {
-  setVertexFields(cloud, {name}, values.transpose(), precision);
-}
+namespace {
 
-void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
-                     const Eigen::MatrixXd& values, FieldPrecision precision) {
+// setVertexFields of doubles or floats (read where they lie: no copy into a matrix of doubles).
+template <typename Values>
+void writeFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                 const Values& values, FieldPrecision precision) {
   const std::size_t n = pointCount(cloud);
   if (static_cast<std::size_t>(values.rows()) != names.size() ||
       static_cast<std::size_t>(values.cols()) != n) {
@@ -108,6 +134,25 @@ void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>&
   }
 }
 
+}  // namespace
+
+void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
+                    const Eigen::VectorXd& values, FieldPrecision precision) {
+  writeFields(cloud, {name}, Eigen::Map<const Eigen::MatrixXd>(values.data(), 1, values.size()),
+              precision);
+}
+
+void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                     const Eigen::Ref<const Eigen::MatrixXd>& values, FieldPrecision precision) {
+  writeFields(cloud, names, values, precision);
+}
+
+void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                     const Eigen::Ref<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>& values,
+                     FieldPrecision precision) {
+  writeFields(cloud, names, values, precision);
+}
+
 void setVertexCoordinates(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& positions,
                           FieldPrecision precision) {
   const std::uint8_t datatype = precision == FieldPrecision::Double ? pcl::PCLPointField::FLOAT64
@@ -123,14 +168,10 @@ void setVertexCoordinates(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& po
     for (const char* axis : {"x", "y", "z"}) removeVertexField(cloud, axis);
     // The coordinates go first, where PCL's point types keep them.
     const std::uint32_t size = pcl::getFieldSize(datatype);
-    const std::size_t n = pointCount(cloud);
     const std::uint32_t old_step = cloud.point_step;
-    const std::uint32_t new_step = old_step + 3 * size;
-    std::vector<std::uint8_t> data(n * new_step, 0);
-    for (std::size_t i = 0; i < n && old_step > 0; ++i) {
-      std::memcpy(data.data() + i * new_step + 3 * size, cloud.data.data() + i * old_step,
-                  old_step);
-    }
+    relayout(cloud, old_step + 3 * size, [=](const std::uint8_t* from, std::uint8_t* to) {
+      std::memcpy(to + 3 * size, from, old_step);
+    });
     for (auto& f : cloud.fields) f.offset += 3 * size;
     for (std::uint32_t d = 0; d < 3; ++d) {
       pcl::PCLPointField field;
@@ -140,9 +181,6 @@ void setVertexCoordinates(pcl::PCLPointCloud2& cloud, const Eigen::Matrix3Xd& po
       field.count = 1;
       cloud.fields.insert(cloud.fields.begin() + d, field);
     }
-    cloud.data.swap(data);
-    cloud.point_step = new_step;
-    cloud.row_step = new_step * cloud.width;
   }
   setVertexPositions(cloud, positions);
 }

@@ -1,7 +1,10 @@
 #include "pcl_ddg/mesh/cloud_report.h"
 
+#include <boost/sort/spreadsort/integer_sort.hpp>
+
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <sstream>
 #include <vector>
 
@@ -10,6 +13,72 @@
 #include "pcl_ddg/mesh/vertex_positions.h"
 
 namespace pcl_ddg {
+namespace {
+
+std::uint64_t mixed(std::uint64_t v) {  // splitmix64's finaliser
+  v = (v ^ (v >> 30)) * 0xbf58476d1ce4e5b9ull;
+  v = (v ^ (v >> 27)) * 0x94d049bb133111ebull;
+  return v ^ (v >> 31);
+}
+
+// Of the three coordinates' values: +0.0 and -0.0 (equal coordinates) hash alike.
+std::uint64_t hashOf(const Eigen::Vector3d& p) {
+  std::uint64_t h = 0;
+  for (int d = 0; d < 3; ++d) {
+    const double v = p[d] + 0.0;
+    std::uint64_t bits;
+    std::memcpy(&bits, &v, 8);
+    h = mixed(h ^ bits);
+  }
+  return h;
+}
+
+// Finite points equal to an earlier one, in linear time (the sort of every triple took 0.5 s for
+// 10M points): the triples' hashes are sorted by radix, and only the points whose hash occurs
+// more than once are compared coordinate by coordinate, so that a collision of two distinct
+// triples is no duplicate.
+std::int64_t countDuplicates(const PositionsRef& positions) {
+  const auto n = static_cast<std::int64_t>(positions.cols());
+  std::vector<std::uint64_t> hashes(static_cast<std::size_t>(n));
+  std::int64_t non_finite = 0;
+#pragma omp parallel for schedule(static) reduction(+ : non_finite) if (n > 100000)
+  for (std::int64_t i = 0; i < n; ++i) {
+    const bool finite = positions.col(i).allFinite();
+    hashes[static_cast<std::size_t>(i)] = finite ? hashOf(positions.col(i)) : 0;
+    non_finite += finite ? 0 : 1;
+  }
+  if (non_finite > 0) {  // (rare) the non-finite points' places are taken out
+    std::size_t kept = 0;
+    for (std::int64_t i = 0; i < n; ++i)
+      if (positions.col(i).allFinite()) hashes[kept++] = hashes[static_cast<std::size_t>(i)];
+    hashes.resize(kept);
+  }
+  boost::sort::spreadsort::integer_sort(hashes.begin(), hashes.end());
+  std::vector<std::uint64_t> repeated;
+  for (std::size_t k = 1; k < hashes.size(); ++k) {
+    if (hashes[k] == hashes[k - 1] && (repeated.empty() || repeated.back() != hashes[k]))
+      repeated.push_back(hashes[k]);
+  }
+  std::vector<std::uint64_t>().swap(hashes);
+  if (repeated.empty()) return 0;
+  std::vector<std::array<double, 3>> suspects;
+#pragma omp parallel if (n > 100000)
+  {
+    std::vector<std::array<double, 3>> found;
+#pragma omp for schedule(static) nowait
+    for (std::int64_t i = 0; i < n; ++i) {
+      const auto p = positions.col(i);
+      if (p.allFinite() && std::binary_search(repeated.begin(), repeated.end(), hashOf(p)))
+        found.push_back({p[0], p[1], p[2]});
+    }
+#pragma omp critical
+    suspects.insert(suspects.end(), found.begin(), found.end());
+  }
+  std::sort(suspects.begin(), suspects.end());
+  return suspects.end() - std::unique(suspects.begin(), suspects.end());
+}
+
+}  // namespace
 
 CloudReport makeCloudReport(const pcl::PCLPointCloud2& cloud, const PositionsRef& positions) {
   if (positions.cols() != static_cast<Eigen::Index>(cloud.width) * cloud.height)
@@ -21,14 +90,7 @@ CloudReport makeCloudReport(const pcl::PCLPointCloud2& cloud, const PositionsRef
   r.height = cloud.height;
   r.points = positions.cols();
   r.nan_points = findNonFiniteVertices(positions).count;
-  std::vector<std::array<double, 3>> finite;
-  finite.reserve(static_cast<std::size_t>(positions.cols()));
-  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
-    const auto p = positions.col(i);
-    if (p.allFinite()) finite.push_back({p[0], p[1], p[2]});
-  }
-  std::sort(finite.begin(), finite.end());
-  r.duplicate_points = finite.end() - std::unique(finite.begin(), finite.end());
+  r.duplicate_points = countDuplicates(positions);
   r.bounding_box = boundingBox(positions);
   return r;
 }

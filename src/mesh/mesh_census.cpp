@@ -28,7 +28,7 @@ void MeshTopology::countDuplicatePolygons(const PolygonList& polygons,
     for (int v = 0; v < num_vertices_; ++v) {
       keys.clear();
       for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
-        const int next = wedges.next[i], previous = wedges.previous[i];
+        const int next = wedges.next(i), previous = wedges.previous(i);
         if (!(wedges.corner[i] & Wedges::kPlainTriangle) || next < v || previous < v) continue;
         const auto [low, high] = std::minmax(next, previous);
         keys.push_back(static_cast<std::uint64_t>(low) << 32 | static_cast<std::uint32_t>(high));

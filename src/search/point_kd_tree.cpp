@@ -97,14 +97,16 @@ class WithinRadius : public flann::ResultSet<float> {
 struct PointKdTree::Index {
   flann::KDTreeSingleIndex<flann::L2_Simple<float>> tree;
   Index(const flann::Matrix<float>& points)
-      : tree(points, flann::KDTreeSingleIndexParams(kLeafSize)) {}
+      : tree(points, flann::KDTreeSingleIndexParams(kLeafSize, /*reorder=*/true)) {}
 };
 
 PointKdTree::PointKdTree(std::vector<float> xyz, std::vector<pcl::index_t> ids)
-    : xyz_(std::move(xyz)), ids_(std::move(ids)) {
+    : ids_(std::move(ids)) {
   if (ids_.empty()) return;
-  index_ = std::make_unique<Index>(flann::Matrix<float>(xyz_.data(), ids_.size(), 3));
+  index_ = std::make_unique<Index>(flann::Matrix<float>(xyz.data(), ids_.size(), 3));
   index_->tree.buildIndex();
+  // xyz is freed here: the index searches its own copy of the points, in the tree's order (FLANN's
+  // "reorder", on by default), and never reads the dataset it was built from again.
 }
 
 PointKdTree::~PointKdTree() = default;

@@ -160,6 +160,48 @@ TEST_F(MeshIOFiles, FacesOfMixedSizesStayPolygonsAndQuadsBecomeRowsOfFour) {
   EXPECT_EQ(as_rows, as_polygons);
 }
 
+// Adding, replacing and removing fields gives the same rows whether the cloud's block has room
+// for them (readMeshFile's spare bytes: rewritten in place, back to front when rows grow) or not
+// (a new block); in place the block stays where it is.
+TEST(VertexFields, FieldsChangeInPlaceWhenTheBlockHasRoomAndAlikeWhenNot) {
+  const int n = 1000;
+  Eigen::Matrix3Xd p = Eigen::Matrix3Xd::Random(3, n) * 1000.0;
+  p.col(7) << 5.0e5 + 0.125, 5.0e6 + 0.25, 200.0;
+  const pcl::PolygonMesh base = makeMesh(p.cast<float>().cast<double>(), {});
+  Eigen::MatrixXd values = Eigen::MatrixXd::Random(2, n);
+  pcl::PointCloud<pcl::Normal> normals;
+  for (int i = 0; i < n; ++i) {
+    pcl::Normal m;
+    m.normal_x = 0.5f * i, m.normal_y = -1.0f * i, m.normal_z = 0.25f, m.curvature = 1e-3f * i;
+    normals.push_back(m);
+  }
+  const Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>> triple(
+      reinterpret_cast<const float*>(normals.points.data()), 3, n, Eigen::OuterStride<>(8));
+  std::vector<std::uint8_t> rows[2];
+  for (const bool room : {false, true}) {
+    pcl::PCLPointCloud2 cloud = base.cloud;
+    if (room) cloud.data.reserve(cloud.data.size() + 64 * n);
+    const std::uint8_t* block = cloud.data.data();
+    setVertexFields(cloud, {"a", "b"}, values, FieldPrecision::Double);
+    setVertexFields(cloud, {"nx", "ny", "nz"}, triple, FieldPrecision::Float);
+    setVertexCoordinates(cloud, p, FieldPrecision::Double);  // double x y z go first
+    EXPECT_TRUE(removeVertexField(cloud, "a"));
+    setVertexField(cloud, "b", values.row(0).transpose(), FieldPrecision::Float);  // replaced
+    EXPECT_EQ(cloud.data.data() == block, room);
+    EXPECT_TRUE(vertexPositions(cloud) == p);
+    EXPECT_FALSE(hasVertexField(cloud, "a"));
+    EXPECT_TRUE(vertexScalarField(cloud, "b") ==
+                values.row(0).transpose().cast<float>().cast<double>());
+    const char* names[] = {"nx", "ny", "nz"};
+    for (int d = 0; d < 3; ++d) {
+      EXPECT_TRUE(vertexScalarField(cloud, names[d]) == triple.row(d).transpose().cast<double>())
+          << names[d];
+    }
+    rows[room] = cloud.data;
+  }
+  EXPECT_TRUE(rows[0] == rows[1]);
+}
+
 TEST_F(MeshIOFiles, PlyRoundTripKeepsDoublesFieldsAndFaces) {
   Eigen::Matrix3Xd p(3, 4);
   p << 100000.123456789012, 1, 1, 0,  //

@@ -10,6 +10,7 @@
 
 #include "analytic_surfaces.h"
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/mesh/cloud_report.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/mesh_report.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -18,6 +19,34 @@
 namespace pcl_ddg {
 namespace test {
 namespace {
+
+// Duplicates are points equal, coordinate by coordinate, to an earlier finite one: k copies of a
+// point are k - 1 duplicates; -0 equals +0; a point one ulp away and a non-finite point are none.
+TEST(CloudReport, DuplicatesAreExactlyEqualFinitePoints) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double next = std::nextafter(5.0e6, 1.0e7);
+  Eigen::Matrix3Xd p(3, 9);
+  p << 0.0, -0.0, 5.0e6, 5.0e6, next, 1.0, 1.0, 1.0, nan,  //
+      2.0, 2.0, 1.0, 1.0, 1.0, 2.0, 2.0, 2.0, 1.0,         //
+      3.0, 3.0, 7.0, 7.0, 7.0, 3.0, 3.0, 3.0, 1.0;
+  pcl::PCLPointCloud2 layout;
+  layout.width = 9;
+  layout.height = 1;
+  const CloudReport r = makeCloudReport(layout, p);
+  EXPECT_EQ(r.duplicate_points, 1 + 1 + 2);  // (+-0, 2, 3); (5e6, 1, 7); three of (1, 2, 3)
+  EXPECT_EQ(r.nan_points, 1);
+  // A large cloud of distinct points, then the same twice over: 0, then n duplicates.
+  const int n = 200000;
+  Eigen::Matrix3Xd grid(3, 2 * n);
+  for (int i = 0; i < n; ++i) {
+    grid.col(i) = Eigen::Vector3d(5.0e5 + 0.01 * (i % 1000), 5.0e6 + 0.01 * (i / 1000), 200.0);
+    grid.col(n + i) = grid.col(i);
+  }
+  layout.width = n;
+  EXPECT_EQ(makeCloudReport(layout, grid.leftCols(n)).duplicate_points, 0);
+  layout.width = 2 * n;
+  EXPECT_EQ(makeCloudReport(layout, grid).duplicate_points, n);
+}
 
 TEST(MeshReport, ZeroAreaSliverIsDegenerate) {
   Eigen::Matrix3Xd p(3, 4);

@@ -3,6 +3,7 @@
 #include <pcl/common/point_tests.h>
 #include <pcl/search/kdtree.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -13,12 +14,19 @@
 
 namespace pcl_ddg {
 namespace tools {
+namespace {
+
+// Room for what a tool adds to a LAS or PCD cloud's rows in place: double coordinates, normals and
+// curvature in double, robust's scale and confidence (reserved, not touched until written).
+constexpr std::size_t kSparePointBytes = 24 + 4 * 8 + 2 * 8;
+
+}  // namespace
 
 ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind kind) {
   MeshFile file;
   {
     Timer timer("Loading " + path);
-    file = readMeshFile(path, EmptyFilePolicy::Refuse, FaceStorage::Rows);
+    file = readMeshFile(path, EmptyFilePolicy::Refuse, FaceStorage::Rows, kSparePointBytes);
     timer.done(static_cast<std::size_t>(file.positions.cols()));
   }
   const bool has_faces = file.faces || !file.mesh.polygons.empty();
@@ -43,6 +51,13 @@ ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind k
                          static_cast<int>(mesh.cloud.width * mesh.cloud.height),
                          PolygonList(faces->indices.data(), faces->rows(), faces->corners))
                    : std::make_shared<const MeshTopology>(mesh);
+  // Faces that are the topology's triangles, in order (triangles, none dropped or split), are
+  // kept once, by the topology, and written out from it (outputFaces).
+  const Eigen::Matrix3Xi& triangles = topology->triangles();
+  if (faces && faces->corners == 3 &&
+      faces->indices.size() == static_cast<std::size_t>(triangles.size()) &&
+      std::equal(faces->indices.begin(), faces->indices.end(), triangles.data()))
+    faces.reset();
   // Only the defects worth a warning (pcl_ddg_info makes the whole MeshReport).
   const TopologyCounts& counts = topology->counts();
   const std::int64_t degenerate =
@@ -73,6 +88,19 @@ const LocalCloud& ToolInput::local() {
 const pcl::PointCloud<pcl::PointXYZ>::Ptr& ToolInput::points() {
   local();
   return points_;
+}
+
+std::shared_ptr<const FaceRows> ToolInput::outputFaces() const {
+  if (faces || !topology || !mesh.polygons.empty()) return faces;
+  auto rows = std::make_shared<FaceRows>();
+  const Eigen::Matrix3Xi& triangles = topology->triangles();
+  rows->indices.assign(triangles.data(), triangles.data() + triangles.size());
+  return rows;
+}
+
+void ToolInput::releaseLocal() {
+  points_.reset();
+  local_.reset();
 }
 
 double ToolInput::spacing() {

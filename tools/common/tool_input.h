@@ -34,7 +34,9 @@ class ToolInput {
   /** x, y, z as float (PCL's point types; positions holds them exactly); its polygons empty when
    *  the faces are rows. */
   pcl::PolygonMesh mesh;
-  std::shared_ptr<const FaceRows> faces;         ///< a mesh's faces of one size (FaceStorage::Rows)
+  /** A mesh's faces of one size (FaceStorage::Rows); null once the topology holds them (a mesh
+   *  of triangles: outputFaces() writes them from it). */
+  std::shared_ptr<const FaceRows> faces;
   Eigen::Matrix3Xd positions;                    ///< double, as read (LAS: X * scale + offset)
   std::shared_ptr<const MeshTopology> topology;  ///< null for a cloud
   SensorPose sensor_pose;                        ///< a PCD's VIEWPOINT (kept for the output)
@@ -47,6 +49,13 @@ class ToolInput {
   const LocalCloud& local();
   /** local()'s float points, to change (a point made NaN is left out of the fits). */
   const pcl::PointCloud<pcl::PointXYZ>::Ptr& points();
+  /** The faces to write with the output (saveResult): faces, or the topology's triangles when
+   *  faces was let go for them; null for a cloud or polygons. */
+  std::shared_ptr<const FaceRows> outputFaces() const;
+  /** Frees local() once the fits are done (the output needs positions and the cloud only): its
+   *  memory is then free for the output's fields. A later local() makes it anew, without the
+   *  changes made through points(). */
+  void releaseLocal();
   /** h: a mesh's mean edge length, a cloud's mean distance to the nearest other point (over up to
    *  10,000 points, exact duplicates skipped: it costs a kd-tree). Measured on the first call. */
   double spacing();

@@ -14,8 +14,10 @@ FieldPrecision precisionArgument(const ToolArguments& args) {
                                                                             : FieldPrecision::Float;
 }
 
-void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
-                     const Eigen::Matrix3Xd& normals, FieldPrecision precision) {
+namespace {
+
+// The names of the output's normal triple; the other naming's fields are removed.
+std::vector<std::string> normalNames(pcl::PCLPointCloud2& cloud, const std::string& output_path) {
   const char* ply_names[] = {"nx", "ny", "nz"};
   const char* pcd_names[] = {"normal_x", "normal_y", "normal_z"};
   const bool pcd_naming = hasVertexField(cloud, "normal_x") ? true
@@ -24,15 +26,31 @@ void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
                                                               fileExtension(output_path) == "las";
   for (int d = 0; d < 3; ++d) removeVertexField(cloud, pcd_naming ? ply_names[d] : pcd_names[d]);
   const char** names = pcd_naming ? pcd_names : ply_names;
-  setVertexFields(cloud, {names[0], names[1], names[2]}, normals, precision);
+  return {names[0], names[1], names[2]};
+}
+
+// Rows first .. first + rows - 1 of the floats of a cloud of pcl::Normal (normal_x, normal_y,
+// normal_z, padding, curvature, ...: 8 floats a point), one column per point, where they lie.
+Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>> normalRows(
+    const pcl::PointCloud<pcl::Normal>& normals, int first, int rows) {
+  static_assert(sizeof(pcl::Normal) == 8 * sizeof(float), "pcl::Normal is 8 floats");
+  static const float none[8] = {};
+  const float* base =
+      normals.empty() ? none : reinterpret_cast<const float*>(normals.points.data());
+  return {base + first, rows, static_cast<Eigen::Index>(normals.size()), Eigen::OuterStride<>(8)};
+}
+
+}  // namespace
+
+void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
+                     const Eigen::Matrix3Xd& normals, FieldPrecision precision) {
+  setVertexFields(cloud, normalNames(cloud, output_path), normals, precision);
 }
 
 void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
                      const pcl::PointCloud<pcl::Normal>& normals, FieldPrecision precision) {
-  setNormalTriple(cloud, output_path, normalsOf(normals), precision);
-  Eigen::VectorXd values(normals.size());
-  for (std::size_t i = 0; i < normals.size(); ++i) values[i] = normals[i].curvature;
-  setVertexField(cloud, "curvature", values, precision);
+  setVertexFields(cloud, normalNames(cloud, output_path), normalRows(normals, 0, 3), precision);
+  setVertexFields(cloud, {"curvature"}, normalRows(normals, 4, 1), precision);
 }
 
 Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals) {

@@ -87,9 +87,14 @@ enum class EmptyFilePolicy {
 
 /** Loads any supported file. Throws FileFormatException when a finite coordinate lies beyond
  *  float's range (PCL's point types could not hold it), and for a file of no points unless
- *  empty is Accept and the file is LAS. */
+ *  empty is Accept and the file is LAS.
+ *
+ *  spare_point_bytes: room reserved in a LAS or PCD cloud's mesh.cloud.data for that many more
+ *  bytes per point, untouched (no memory is used until written), so that the fields a caller adds
+ *  (setVertexFields: normals, curvature, double coordinates) widen the rows in place instead of
+ *  holding the cloud twice. */
 MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty = EmptyFilePolicy::Refuse,
-                      FaceStorage faces = FaceStorage::Polygons);
+                      FaceStorage faces = FaceStorage::Polygons, std::size_t spare_point_bytes = 0);
 
 /** readMeshFile's mesh; `sensor_pose`, if given, receives the file's VIEWPOINT (PCD). */
 pcl::PolygonMesh loadMesh(const std::string& path, SensorPose* sensor_pose = nullptr);

@@ -21,9 +21,16 @@ void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
                     FieldPrecision precision = FieldPrecision::Float);
 
 /** setVertexField for several fields at once, row r of `values` (one column per vertex) as
- *  names[r]: the cloud is laid out anew once, not once per field. */
+ *  names[r]: the cloud is laid out anew once, not once per field. The rows are widened in place
+ *  when cloud.data's capacity holds them (readMeshFile's spare bytes per point), so that adding
+ *  fields to a large cloud does not hold it twice. */
 void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
-                     const Eigen::MatrixXd& values,
+                     const Eigen::Ref<const Eigen::MatrixXd>& values,
+                     FieldPrecision precision = FieldPrecision::Float);
+/** The same of float values where they lie, e.g. the normals of a pcl::PointCloud<pcl::Normal>
+ *  (a map of its floats with an outer stride of 8). */
+void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                     const Eigen::Ref<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>& values,
                      FieldPrecision precision = FieldPrecision::Float);
 
 /**

@@ -144,15 +144,20 @@ class MeshTopology {
     std::vector<int> others;  ///< polygons in range with 3+ corners that are not plain triangles
   };
   PolygonKinds triangulate(const PolygonList& polygons, OutOfRangeFacePolicy policy);
-  /** Per incidence of a vertex in a triangle (parallel to vt_triangles_): the triangle's next and
-   *  previous corners after the vertex, and the vertex's corner index plus kPlainTriangle when the
-   *  triangle is a whole input polygon. Built once, so that every later per-vertex pass reads its
-   *  own contiguous row instead of triangles all over memory. Left uninitialised until the
-   *  parallel scatter writes them, so that their pages are first touched by both threads. */
+  /** Per incidence of a vertex in a triangle (parallel to vt_triangles_): the vertex's corner
+   *  index plus kPlainTriangle when the triangle is a whole input polygon, and from it the
+   *  triangle's next and previous corners after the vertex. One byte per incidence, not nine:
+   *  the corners are read from the triangle (a scan's triangles lie near their vertices in
+   *  memory), so that the build's peak holds no copy of the faces (55 MB for the bench torus).
+   *  Left uninitialised until the parallel scatter writes them, so that their pages are first
+   *  touched by both threads. */
   struct Wedges {
     static constexpr std::uint8_t kPlainTriangle = 4;
-    std::unique_ptr<int[]> next, previous;
+    const int* triangles;  ///< triangles_'s corners, three per triangle
+    const int* incident;   ///< vt_triangles_
     std::unique_ptr<std::uint8_t[]> corner;
+    int next(int i) const { return triangles[3 * incident[i] + ((corner[i] & 3) + 1) % 3]; }
+    int previous(int i) const { return triangles[3 * incident[i] + ((corner[i] & 3) + 2) % 3]; }
   };
   Wedges buildVertexTriangles(const std::vector<char>& plain);
   void buildVertexNeighbours(const Wedges& wedges);

@@ -41,7 +41,6 @@ class PointKdTree {
 
  private:
   struct Index;
-  std::vector<float> xyz_;
   std::vector<pcl::index_t> ids_;
   std::unique_ptr<Index> index_;
 };
