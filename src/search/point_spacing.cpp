@@ -3,11 +3,13 @@
 #include <pcl/common/point_tests.h>
 #include <pcl/exceptions.h>
 
-#include <boost/sort/spreadsort/float_sort.hpp>
+#include <boost/sort/spreadsort/integer_sort.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "pcl_ddg/search/point_kd_tree.h"
@@ -39,6 +41,21 @@ std::vector<pcl::index_t> sample(const std::vector<pcl::index_t>& finite, int sa
   return chosen;
 }
 
+// A finite float's bits as an unsigned key of the same order: negatives (sign bit set) reversed
+// below the positives. -0 and +0 get neighbouring keys (their gap, 0, is no quantum).
+std::uint32_t orderedKey(float v) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &v, 4);
+  return bits & 0x80000000u ? ~bits : bits | 0x80000000u;
+}
+
+float valueOf(std::uint32_t key) {
+  const std::uint32_t bits = key & 0x80000000u ? key & 0x7fffffffu : ~key;
+  float v;
+  std::memcpy(&v, &bits, 4);
+  return v;
+}
+
 template <typename T>
 T median(std::vector<T> values) {
   if (values.empty()) return T(0);
@@ -52,19 +69,20 @@ PointSpacing measurePointSpacing(const pcl::PointCloud<pcl::PointXYZ>& cloud, in
   PointSpacing result;
   const std::vector<pcl::index_t> finite = finitePoints(cloud);
   if (finite.size() < 2) return result;
-  // Each axis's values sorted by radix (float_sort: 0.17 s for 10M values, std::sort 0.68 s),
-  // the three axes side by side.
+  // Each axis's values sorted by radix, the three axes side by side: as unsigned keys in the
+  // floats' order (Boost's integer_sort: 0.17 s for 10M values, std::sort 0.68 s; its float_sort
+  // computes differences of signed ints that overflow).
   std::array<double, 3> smallest{}, extent{};
 #pragma omp parallel for schedule(static, 1) if (finite.size() > 100000)
   for (int d = 0; d < 3; ++d) {
-    std::vector<float> values(finite.size());
-    for (std::size_t i = 0; i < finite.size(); ++i) values[i] = cloud[finite[i]].data[d];
-    boost::sort::spreadsort::float_sort(values.begin(), values.end());
-    for (std::size_t i = 1; i < values.size(); ++i) {
-      const double gap = static_cast<double>(values[i]) - values[i - 1];
+    std::vector<std::uint32_t> keys(finite.size());
+    for (std::size_t i = 0; i < finite.size(); ++i) keys[i] = orderedKey(cloud[finite[i]].data[d]);
+    boost::sort::spreadsort::integer_sort(keys.begin(), keys.end());
+    for (std::size_t i = 1; i < keys.size(); ++i) {
+      const double gap = static_cast<double>(valueOf(keys[i])) - valueOf(keys[i - 1]);
       if (gap > 0.0 && (smallest[d] == 0.0 || gap < smallest[d])) smallest[d] = gap;
     }
-    extent[d] = static_cast<double>(values.back()) - values.front();
+    extent[d] = static_cast<double>(valueOf(keys.back())) - valueOf(keys.front());
   }
   double diagonal_squared = 0.0;
   for (int d = 0; d < 3; ++d) {
