@@ -11,7 +11,7 @@ build=$(cd "$1" && pwd)
 seconds=$2
 shift 2
 targets=("$@")
-((${#targets[@]})) || targets=(ply off obj stl vtk pcd las mesh)
+((${#targets[@]})) || targets=(ply off obj stl vtk pcd las laz mesh)
 # The shared scans, where the tests look for them too (test/CMakeLists.txt).
 shared=${PCL_DDG_SHARED_DATA:-}
 for candidate in "$here/../../shared/data" /work/shared/data; do

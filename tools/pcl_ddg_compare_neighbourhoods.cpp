@@ -37,7 +37,8 @@ int run(int argc, char** argv) {
   const FieldPrecision precision = tools::precisionArgument(args);
   tools::checkLocalFitArguments(args);
   return tools::forEachInput(
-      args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
+      args, kName, {"ply", "pcd", "las", "laz"},
+      [&](const std::string& input, const std::string& output) {
         tools::ToolInput in(input, kName);
         const bool organized = !in.topology && in.points()->height > 1;
         if (!in.topology && !organized)

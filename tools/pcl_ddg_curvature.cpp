@@ -113,7 +113,8 @@ int run(int argc, char** argv) {
   }
 
   return tools::forEachInput(
-      args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
+      args, kName, {"ply", "pcd", "las", "laz"},
+      [&](const std::string& input, const std::string& output) {
         tools::ToolInput in(input, kName);
         const std::string method =
             !requested.empty() ? requested : (in.topology ? "cotan" : "quadric");

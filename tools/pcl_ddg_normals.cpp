@@ -146,7 +146,8 @@ int run(int argc, char** argv) {
         });
   }
   return tools::forEachInput(
-      args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
+      args, kName, {"ply", "pcd", "las", "laz"},
+      [&](const std::string& input, const std::string& output) {
         if (args.has("normal_map")) tools::checkOutputFile(*args.value("normal_map"), {input});
         tools::ToolInput in(input, kName);
         if (orientation) {

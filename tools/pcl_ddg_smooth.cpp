@@ -125,7 +125,8 @@ int run(int argc, char** argv) {
   const FieldPrecision precision = tools::precisionArgument(args);
 
   return tools::forEachInput(
-      args, kName, {"ply", "pcd", "las"}, [&](const std::string& input, const std::string& output) {
+      args, kName, {"ply", "pcd", "las", "laz"},
+      [&](const std::string& input, const std::string& output) {
         tools::ToolInput in(input, kName, tools::InputKind::Mesh);
         const ResolvedSteps resolved = resolveSteps(*in.topology, in.positions, steps, p);
         std::cerr << kName << ": " << describeSteps(p, resolved) << "\n";

@@ -796,7 +796,8 @@ def _path(path: Union[str, bytes, "os.PathLike[str]"]) -> str:
 def read(path: Union[str, "os.PathLike[str]"]) -> MeshFile:
     """Reads a mesh or a cloud: .ply (ascii/binary; face, tristrips, range_grid), .obj, .off
     (also binary), .stl, .vtk (legacy POLYDATA), .pcd (organized or not), .las (LAS 1.0-1.4,
-    formats 0-10; LAZ is refused). OSError if the file is missing, unknown or malformed."""
+    formats 0-10), .laz (LASzip-compressed: formats 0-3 and 6-8, COPC included). OSError if the
+    file is missing, unknown or malformed."""
     path = _path(path)
     if not os.path.exists(path):
         import errno
@@ -827,7 +828,8 @@ def write(
     las: Optional["_pcl_ddg.LasLayout"] = None,
 ) -> None:
     """Writes a .ply (binary, or ``encoding="ascii"``), a .pcd (binary_compressed; faces are
-    not stored) or a .las, atomically (a failed write leaves no file).
+    not stored), a .las or a .laz (LASzip-compressed; formats 0-3 and 6-8), atomically (a failed
+    write leaves no file).
 
     fields: per-vertex values by name, (n,) each; ``"normals"`` (n, 3) becomes nx ny nz (PLY) or
     normal_x normal_y normal_z (PCD); ``"rgb"`` uint8 (n, 3) the colours; another (n, c) array
@@ -863,7 +865,7 @@ def write(
         None if organized_shape is None else (int(organized_shape[0]), int(organized_shape[1])),
         las,
     )
-    if las is None and path.lower().endswith(".las"):
+    if las is None and path.lower().endswith((".las", ".laz")):
         _warn([
             f"{path}: written without las=, so it carries no CRS and no VLR of any input; pass "
             "las=pcl_ddg.read(input).las to keep the input's projection, VLRs, scale and offset"

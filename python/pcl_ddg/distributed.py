@@ -155,8 +155,10 @@ def _check_las(paths: List[str], allow_mixed_crs: bool) -> None:
     headers = [las_header(p) for p in paths]
     for p, h in zip(paths, headers):
         if h["compressed"]:
-            raise ValueError(f"{p}: LAZ (compressed LAS) cannot be read; decompress it first "
-                             "(laszip -i in.laz -o out.las, or pdal translate)")
+            raise ValueError(f"{p}: LAZ (compressed LAS) is not read in tiles by the runner "
+                             "yet; pcl_ddg.read and the tools read it whole, or convert it once: "
+                             "m = pcl_ddg.read('in.laz'); pcl_ddg.write('in.las', m.points, "
+                             "fields=m.fields, las=m.las)")
     first = headers[0]
     for p, h in zip(paths[1:], headers[1:]):
         if h["scale"] != first["scale"] or h["offset"] != first["offset"]:

@@ -391,7 +391,7 @@ void bindIO(py::module_& m) {
             const py::array array = py::array::ensure(value);
             if (!array || array.ndim() < 1 || array.shape(0) != n)
               throw py::value_error("field '" + name + "' must have one row per point");
-            if (extension == "las" && name != "rgb") {
+            if ((extension == "las" || extension == "laz") && name != "rgb") {
               if (array.ndim() > 2)
                 throw py::value_error("field '" + name + "' has more than 2 dimensions");
               const std::uint8_t datatype = pclTypeOf(array.dtype());

@@ -66,19 +66,14 @@ struct CloudPieceReader::Format {
 CloudPieceReader::CloudPieceReader(const std::string& path)
     : path_(path), format_(std::make_unique<Format>()) {
   const std::string ext = fileExtension(path);
-  if (ext == "laz") {
-    throw FileFormatException(path +
-                              ": LAZ (compressed LAS) is not supported: decompress it first "
-                              "(laszip -i in.laz -o out.las)");
-  }
-  if (ext != "pcd" && ext != "ply" && ext != "las") {
+  if (ext != "pcd" && ext != "ply" && ext != "las" && ext != "laz") {
     throw FileFormatException(path +
                               ": only binary .pcd, binary .ply and .las clouds are read in pieces");
   }
   in_.open(path, std::ios::binary);
   if (!in_) failSystem(path);
   const auto size = static_cast<std::int64_t>(std::filesystem::file_size(path));
-  if (ext == "las") {
+  if (ext == "las" || ext == "laz") {  // LAZ is told by its header, and refused there
     // The public header block (LAS 1.4: 375 bytes), then the header and VLRs up to the points.
     std::string head(static_cast<std::size_t>(std::min<std::int64_t>(375, size)), '\0');
     in_.read(head.data(), static_cast<std::streamsize>(head.size()));
@@ -86,8 +81,8 @@ CloudPieceReader::CloudPieceReader(const std::string& path)
       throw FileFormatException(path + ": not a LAS file (no LASF signature)");
     if (lasIsCompressed(head)) {
       throw FileFormatException(path +
-                                ": LAZ (compressed LAS) is not supported: decompress it first "
-                                "(laszip -i in.laz -o out.las)");
+                                ": LAZ (compressed LAS) is not read in pieces: run without "
+                                "-memory (LAZ is read whole), or write it as .las first");
     }
     Format& f = *format_;
     f.las = true;

@@ -88,12 +88,10 @@ void readRecords(std::string_view data, std::uint64_t begin, std::uint64_t end, 
 LasLayout parseLayout(std::string_view data, HeaderFacts& facts) {
   const std::uint64_t size = data.size();
   if (size < 4 || data.substr(0, 4) != "LASF") fail("not a LAS file (no LASF signature)");
-  // LAZ first: nothing else of a compressed file is worth reading.
-  if (lasIsCompressed(data)) {
-    throw FileFormatException(
-        "LAZ (compressed LAS) is not supported: decompress it first with "
-        "`laszip -i in.laz -o out.las` or `pdal translate in.laz out.las`");
-  }
+  // LAZ first: nothing else of a compressed file is worth reading here (readMeshFile decompresses
+  // it, laz/laz_codec.h, before it comes here).
+  if (lasIsCompressed(data))
+    throw FileFormatException("LAZ (compressed LAS) data: its points must be decompressed first");
   if (size < 227) fail("the file (" + std::to_string(size) + " bytes) is shorter than a header");
   LasLayout layout;
   const char* h = data.data();

@@ -17,16 +17,21 @@
 namespace pcl_ddg {
 namespace detail {
 
+/** The threads a loader uses at most: OpenMP's setting, else the cores. */
+inline int loaderThreads() {
+#ifdef _OPENMP
+  return std::max(1, omp_get_max_threads());
+#else
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+#endif
+}
+
 /** Calls body(i) for every i in [0, count), each thread on its own contiguous range, with fewer
- *  threads than OpenMP's setting when a thread would get fewer than `min_per_thread` items. The
+ *  threads than loaderThreads() when a thread would get fewer than `min_per_thread` items. The
  *  first exception by range order is rethrown once all threads have finished. */
 template <class Body>
 void parallelForInLoader(std::int64_t count, std::int64_t min_per_thread, const Body& body) {
-#ifdef _OPENMP
-  const std::int64_t max_threads = std::max(1, omp_get_max_threads());
-#else
-  const std::int64_t max_threads = std::max(1u, std::thread::hardware_concurrency());
-#endif
+  const std::int64_t max_threads = loaderThreads();
   const std::int64_t threads =
       std::clamp<std::int64_t>(count / std::max<std::int64_t>(1, min_per_thread), 1, max_threads);
   std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads));

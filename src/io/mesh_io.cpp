@@ -12,6 +12,8 @@
 #include "byte_cursor.h"
 #include "file_bytes.h"
 #include "las_format.h"
+#include "laz/laz_codec.h"
+#include "loader_threads.h"
 #include "mesh_formats.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
@@ -88,14 +90,16 @@ MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorag
                       std::size_t spare_point_bytes) {
   const std::string ext = fileExtension(path);
   try {
-    if (ext == "laz") {  // before anything is read: no LAZ decoder is at hand
-      throw FileFormatException(
-          "LAZ (compressed LAS) is not supported: decompress it first with "
-          "`laszip -i in.laz -o out.las` or `pdal translate in.laz out.las`");
-    }
     const detail::FileBytes bytes(path);  // first: a missing file says so
-    const std::string_view data = bytes.view();
-    if (ext == "las") {
+    std::string_view data = bytes.view();
+    std::string decompressed;
+    if (ext == "las" || ext == "laz") {
+      // LAZ (by its header's compression bits, whatever the name): its chunks decompressed on
+      // every core into the LAS file it stands for, which is then read as any other.
+      if (lasIsCompressed(data)) {
+        decompressed = detail::lazToLas(data, detail::loaderThreads());
+        data = decompressed;
+      }
       detail::LasCloud las = detail::parseLAS(data, spare_point_bytes);
       if (las.positions.cols() == 0 && empty == EmptyFilePolicy::Refuse)
         throw FileFormatException("no points (the header counts none)");
@@ -116,7 +120,7 @@ MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorag
     if (parse == nullptr && ext != "pcd") {
       throw FileFormatException(
           (ext.empty() ? std::string("no file extension") : "unknown file type '." + ext + "'") +
-          " (expected .ply, .obj, .off, .stl, .vtk, .pcd or .las)");
+          " (expected .ply, .obj, .off, .stl, .vtk, .pcd, .las or .laz)");
     }
     MeshFile file;
     auto rows = std::make_shared<FaceRows>();
@@ -162,14 +166,19 @@ void saveMesh(const std::string& path, const pcl::PolygonMesh& mesh,
               const MeshWriteOptions& options) {
   const std::string ext = fileExtension(path);
   try {
-    if (ext != "ply" && ext != "pcd" && ext != "las") {
-      throw FileFormatException("cannot write '." + ext + "' files (use .ply, .pcd or .las)");
+    if (ext != "ply" && ext != "pcd" && ext != "las" && ext != "laz") {
+      throw FileFormatException("cannot write '." + ext + "' files (use .ply, .pcd, .las or .laz)");
     }
     if (options.faces && !mesh.polygons.empty())
       throw pcl::BadArgumentException("faces given twice: as polygons and as rows");
     AtomicFile file(path);
     if (ext == "las") {
       detail::writeLAS(file.temporaryPath(), mesh.cloud, options.las.get());
+    } else if (ext == "laz") {
+      // The LAS file writeLAS would write, made in memory, then compressed (laz/laz_codec.h).
+      const std::string las = detail::encodeLAS(
+          mesh.cloud, vertexPositions(mesh.cloud, NonFinitePolicy::Keep), options.las.get());
+      writeBytes(file.temporaryPath(), detail::lasToLaz(las));
     } else if (ext == "ply") {
       savePLY(file.temporaryPath(), mesh, options.ply_encoding, options.faces.get());
     } else {

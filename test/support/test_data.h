@@ -34,6 +34,9 @@ std::string scratchFolder(const std::string& name);
 /** Writes text to a file (for hand-made inputs). */
 void writeText(const std::string& path, const std::string& text);
 
+/** A file's bytes (empty if it cannot be read). */
+std::string readBytes(const std::string& path);
+
 /** A PCL mesh from positions (float x, y, z fields) and polygons. */
 pcl::PolygonMesh makeMesh(const Eigen::Matrix3Xd& positions,
                           const std::vector<std::vector<int>>& polygons);

@@ -53,13 +53,6 @@ std::vector<std::string> nonEmptyLines(const std::string& text) {
   return ::testing::AssertionFailure() << "not one \"" << tool_name << ": error:\" line:\n" << err;
 }
 
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  return bytes.str();
-}
-
 /** Every name in a folder (temporaries included), sorted. */
 std::vector<std::string> folderListing(const std::string& folder) {
   std::vector<std::string> names;

@@ -144,12 +144,12 @@ namespace {
 
 const char* const kCommonHelp =
     "Every tool but the viewer also takes:\n"
-    "         -input_dir DIR [-output_dir OUT]  every .ply .obj .off .stl .vtk .pcd .las file\n"
-    "                  of DIR (PCL's batch mode; outputs OUT/<name>.<ext>, a failure does not\n"
-    "                  stop the others)\n"
+    "         -input_dir DIR [-output_dir OUT]  every .ply .obj .off .stl .vtk .pcd .las .laz\n"
+    "                  file of DIR (PCL's batch mode; outputs OUT/<name>.<ext>, a failure does\n"
+    "                  not stop the others)\n"
     "         -h, -help  this text;  --version  pcl_ddg's version\n";
 
-const char* const kReadableExtensions[] = {"ply", "obj", "off", "stl", "vtk", "pcd", "las"};
+const char* const kReadableExtensions[] = {"ply", "obj", "off", "stl", "vtk", "pcd", "las", "laz"};
 
 std::string extensionList(const std::vector<std::string>& extensions) {
   std::string list;
@@ -171,7 +171,7 @@ std::vector<std::string> batchInputs(const std::string& folder) {
   }
   if (error) throw std::runtime_error("cannot list " + folder + ": " + error.message());
   if (inputs.empty())
-    throw std::runtime_error(folder + " holds no .ply .obj .off .stl .vtk .pcd or .las file");
+    throw std::runtime_error(folder + " holds no .ply .obj .off .stl .vtk .pcd .las or .laz file");
   std::sort(inputs.begin(), inputs.end());
   return inputs;
 }

@@ -23,7 +23,8 @@ std::vector<std::string> normalNames(pcl::PCLPointCloud2& cloud, const std::stri
   const bool pcd_naming = hasVertexField(cloud, "normal_x") ? true
                           : hasVertexField(cloud, "nx")     ? false
                                                             : fileExtension(output_path) == "pcd" ||
-                                                              fileExtension(output_path) == "las";
+                                                              fileExtension(output_path) == "las" ||
+                                                              fileExtension(output_path) == "laz";
   for (int d = 0; d < 3; ++d) removeVertexField(cloud, pcd_naming ? ply_names[d] : pcd_names[d]);
   const char** names = pcd_naming ? pcd_names : ply_names;
   return {names[0], names[1], names[2]};

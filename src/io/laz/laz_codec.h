@@ -1,0 +1,58 @@
+#pragma once
+/** \file
+ * LAZ (LASzip-compressed LAS) to LAS and back, in memory.
+ *
+ * A LAZ file is a LAS file whose point format byte has bit 7 (0x80; some writers also bit 6,
+ * 0x40) set, with a VLR of user id "laszip encoded", record id 22204, whose payload is
+ *
+ * | offset | type     | field                                                        |
+ * |--------|----------|--------------------------------------------------------------|
+ * | 0      | u16      | compressor: 1 pointwise, 2 pointwise-chunked, 3 layered-chunked |
+ * | 2      | u16      | coder: 0 arithmetic                                          |
+ * | 4      | u8, u8   | LASzip version major, minor                                  |
+ * | 6      | u16      | revision                                                     |
+ * | 8      | u32      | options                                                      |
+ * | 12     | u32      | chunk size in points (0xFFFFFFFF: variable, see the table)   |
+ * | 16     | i64, i64 | number of / offset to special EVLRs (-1: unused)             |
+ * | 32     | u16      | number of items, then per item: u16 type, u16 size, u16 version |
+ *
+ * and whose point data is, for the chunked compressors, an i64 offset to the chunk table (-1
+ * when the writer could not seek back: the offset is then in the last 8 bytes), the chunks, and
+ * the chunk table: u32 version (0), u32 number of chunks, then per chunk (point count, for
+ * variable chunks, and) byte count, coded with an IntegerCompressor(32 bits, 2 contexts) from the
+ * previous chunk's values. Every chunk restarts the coders, so chunks decode independently (in
+ * parallel here). Item coding: see laz_items.h; entropy coding: see laz_arithmetic.h.
+ *
+ * Supported: point formats 0-3 with the version 2 items (POINT10, GPSTIME11, RGB12, BYTE),
+ * pointwise or pointwise-chunked; formats 6-8 with the version 3 or 4 layered items (POINT14,
+ * RGB14, RGBNIR14, BYTE14), as written by LASzip 3 and COPC writers. Refused with a message:
+ * LASzip 1.x's version 1 items, waveform formats 4, 5, 9, 10, other coders, and anything
+ * inconsistent. Corrupt data never reads outside the input, never loops without end and never
+ * allocates more than the point count allows (itself bounded by the compressed size): it throws
+ * pcl_ddg::FileFormatException naming the chunk.
+ */
+#include <string>
+#include <string_view>
+
+namespace pcl_ddg {
+namespace detail {
+
+/**
+ * The uncompressed LAS file equivalent to a LAZ file: the same header with the compression bits
+ * cleared, the LASzip VLR removed (VLR count and point data offset adjusted), the points
+ * decompressed and the EVLRs kept (their offset adjusted). Chunks are decoded by up to `threads`
+ * threads (at least one).
+ * @throws pcl_ddg::FileFormatException if the file is not LAZ, unsupported or corrupt.
+ */
+std::string lazToLas(std::string_view laz_file_bytes, int threads);
+
+/**
+ * The LAZ file equivalent to an uncompressed LAS file of point format 0-3 (version 2 items,
+ * pointwise-chunked) or 6-8 (version 3 layered items), in chunks of 50,000 points with a chunk
+ * table, the LASzip VLR appended to the VLRs.
+ * @throws pcl_ddg::FileFormatException if the file is not a LAS file of those formats.
+ */
+std::string lasToLaz(std::string_view las_file_bytes);
+
+}  // namespace detail
+}  // namespace pcl_ddg
