@@ -88,6 +88,23 @@ struct Slot {
   std::uint32_t size;
 };
 
+// A COPC file's info VLR and hierarchy EVLR (user id "copc") describe its chunks' octree, which
+// the records written here do not follow: kept, they would make a COPC reader misread the file.
+void dropCopcRecords(LasLayout& layout) {
+  const auto copc = [](const LasVariableLengthRecord& r) { return r.userId() == "copc"; };
+  layout.vlrs.erase(std::remove_if(layout.vlrs.begin(), layout.vlrs.end(), copc),
+                    layout.vlrs.end());
+  std::vector<LasVariableLengthRecord> kept;
+  int waveform = -1;
+  for (std::size_t i = 0; i < layout.evlrs.size(); ++i) {
+    if (copc(layout.evlrs[i])) continue;
+    if (static_cast<int>(i) == layout.waveform_evlr) waveform = static_cast<int>(kept.size());
+    kept.push_back(std::move(layout.evlrs[i]));
+  }
+  layout.evlrs = std::move(kept);
+  layout.waveform_evlr = waveform;
+}
+
 }  // namespace
 
 LasPlan planLAS(const pcl::PCLPointCloud2& cloud, const LasLayout* source,
@@ -96,6 +113,7 @@ LasPlan planLAS(const pcl::PCLPointCloud2& cloud, const LasLayout* source,
   LasLayout& layout = plan.layout;
   if (source != nullptr) {
     layout = *source;
+    dropCopcRecords(layout);
   } else {
     layout.version_major = 1;
     layout.version_minor = 4;

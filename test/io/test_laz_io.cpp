@@ -105,6 +105,29 @@ TEST(LazIO, TheCopcFileHoldsItsTwinsPointsInOctreeOrder) {
   EXPECT_TRUE(points(copc) == points(twin));
 }
 
+// Written out (as LAS or LAZ), a COPC file's points no longer follow its octree: its "copc"
+// info VLR and hierarchy EVLR are left out, its other records kept.
+TEST(LazIO, ACopcFileWrittenOutDropsItsOctreeRecords) {
+  const MeshFile copc = readMeshFile(sharedData("las/laz/1.2-with-color.copc.laz"));
+  const auto has = [](const std::vector<LasVariableLengthRecord>& records, const char* user) {
+    return std::any_of(records.begin(), records.end(),
+                       [&](const LasVariableLengthRecord& r) { return r.userId() == user; });
+  };
+  ASSERT_TRUE(has(copc.las->vlrs, "copc") && has(copc.las->evlrs, "copc"));
+  const std::string folder = scratchFolder("laz_copc_out");
+  MeshWriteOptions options;
+  options.las = copc.las;
+  pcl::PolygonMesh exact = copc.mesh;  // the coordinates as the tools write them: exact
+  setVertexCoordinates(exact.cloud, copc.positions, FieldPrecision::Double);
+  for (const char* name : {"/out.las", "/out.laz"}) {
+    saveMesh(folder + name, exact, options);
+    const MeshFile out = readMeshFile(folder + name);
+    EXPECT_FALSE(has(out.las->vlrs, "copc") || has(out.las->evlrs, "copc")) << name;
+    EXPECT_TRUE(has(out.las->vlrs, "LASF_Projection")) << name;
+    EXPECT_TRUE(out.positions == copc.positions) << name;
+  }
+}
+
 TEST(LazIO, TheFirstLaszipCompressorsAreRefusedWithOneLine) {
   try {
     readMeshFile(sharedData("las/laz/simple-laszip-compressor-version-1.2r0.laz"));
