@@ -37,8 +37,8 @@ struct LasCloud {
 };
 
 /** LAS 1.0-1.4, uncompressed, point formats 0-10; LAZ (the compression bit set in the point
- *  format) is refused first, with how to decompress it. The cloud's data has room for
- *  spare_point_bytes more bytes per point (readMeshFile's). */
+ *  format) is refused first (readMeshFile decompresses it before: laz/laz_codec.h). The cloud's
+ *  data has room for spare_point_bytes more bytes per point (readMeshFile's). */
 LasCloud parseLAS(std::string_view data, std::size_t spare_point_bytes = 0);
 
 /** A cloud as a LAS file: the layout of `source` (version, point format, scale, offset, VLRs and

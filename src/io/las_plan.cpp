@@ -88,10 +88,14 @@ struct Slot {
   std::uint32_t size;
 };
 
-// A COPC file's info VLR and hierarchy EVLR (user id "copc") describe its chunks' octree, which
-// the records written here do not follow: kept, they would make a COPC reader misread the file.
-void dropCopcRecords(LasLayout& layout) {
-  const auto copc = [](const LasVariableLengthRecord& r) { return r.userId() == "copc"; };
+// Records of the source's encoding, which the file written here does not have: a COPC file's
+// info VLR and hierarchy EVLR (user id "copc": the records no longer follow its octree) and a
+// LASzip VLR (22204; an uncompressed file carrying one would be read as LAZ by some readers, and
+// a LAZ output gets its own).
+void dropEncodingRecords(LasLayout& layout) {
+  const auto copc = [](const LasVariableLengthRecord& r) {
+    return r.userId() == "copc" || (r.userId() == "laszip encoded" && r.record_id == 22204);
+  };
   layout.vlrs.erase(std::remove_if(layout.vlrs.begin(), layout.vlrs.end(), copc),
                     layout.vlrs.end());
   std::vector<LasVariableLengthRecord> kept;
@@ -113,7 +117,7 @@ LasPlan planLAS(const pcl::PCLPointCloud2& cloud, const LasLayout* source,
   LasLayout& layout = plan.layout;
   if (source != nullptr) {
     layout = *source;
-    dropCopcRecords(layout);
+    dropEncodingRecords(layout);
   } else {
     layout.version_major = 1;
     layout.version_minor = 4;

@@ -274,9 +274,12 @@ pcl::PolygonMesh parsePCD(std::string_view data, SensorPose* sensor_pose,
   cloud.point_step = static_cast<std::uint32_t>(point_size);
   cloud.row_step = static_cast<std::uint32_t>(point_size * header.width);
   cloud.is_dense = false;  // unknown until checked; consumers test finiteness themselves
-  if (spare_point_bytes > 0)
-    cloud.data.reserve(static_cast<std::size_t>(bytes) +
-                       spare_point_bytes * cloud.width * cloud.height);
+  // The room asked for, at most four times the points' own bytes (a compressed file's claimed
+  // size is itself a multiple of the file's).
+  const std::size_t spare =
+      std::min<std::size_t>(spare_point_bytes, 4 * static_cast<std::size_t>(point_size));
+  if (spare > 0)
+    cloud.data.reserve(static_cast<std::size_t>(bytes) + spare * cloud.width * cloud.height);
   switch (header.data) {
     case PcdData::Ascii:
       cloud.data.resize(static_cast<std::size_t>(bytes));

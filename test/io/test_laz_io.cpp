@@ -164,6 +164,48 @@ TEST(LazIO, EncodedFilesDecodeBitForBit) {
   EXPECT_GE(tried, 12);
 }
 
+// Identical points compress beyond a thousand to one (here more than 128 points per byte) and
+// are no lie: they decode. A layout that carries a LASzip VLR (an uncompressed file may) writes
+// .las without it and .laz with its own.
+TEST(LazIO, IdenticalPointsAndAStaleLaszipRecordRoundTrip) {
+  const MeshFile twin = readMeshFile(sharedData("las/formats/1.2_0.las"));
+  ASSERT_EQ(twin.las->point_format, 0);
+  const int n = 1000000;
+  pcl::PolygonMesh mesh;
+  pcl::PCLPointCloud2& cloud = mesh.cloud;
+  cloud = twin.mesh.cloud;
+  cloud.width = n;
+  cloud.height = 1;
+  cloud.row_step = cloud.point_step * n;
+  cloud.data.resize(static_cast<std::size_t>(n) * cloud.point_step);
+  for (int i = 1; i < n; ++i)
+    std::memcpy(cloud.data.data() + static_cast<std::size_t>(i) * cloud.point_step,
+                cloud.data.data(), cloud.point_step);
+  const Eigen::Matrix3Xd positions = twin.positions.col(0).replicate(1, n);
+  setVertexCoordinates(cloud, positions, FieldPrecision::Double);
+  auto layout = std::make_shared<LasLayout>(*twin.las);
+  LasVariableLengthRecord laszip;
+  laszip.user_id = std::string("laszip encoded").append(2, '\0');
+  laszip.record_id = 22204;
+  laszip.description.assign(32, '\0');
+  laszip.data.assign(34, '\0');
+  layout->vlrs.push_back(laszip);
+  MeshWriteOptions options;
+  options.las = layout;
+  const std::string folder = scratchFolder("laz_identical");
+  for (const char* name : {"/same.las", "/same.laz"}) {
+    saveMesh(folder + name, mesh, options);
+    const MeshFile back = readMeshFile(folder + name);
+    EXPECT_TRUE(back.positions == positions) << name;
+    EXPECT_TRUE(std::none_of(back.las->vlrs.begin(), back.las->vlrs.end(),
+                             [](const LasVariableLengthRecord& r) { return r.record_id == 22204; }))
+        << name;
+  }
+  const std::string laz = readBytes(folder + "/same.laz");
+  const double point_data = static_cast<double>(laz.size() - at<std::uint32_t>(laz, 96));
+  EXPECT_GT(n / point_data, 128.0) << point_data;  // the bound this file once broke
+}
+
 // Truncated anywhere, or with a chunk table that lies, a LAZ file is refused, never read past
 // its end (the sanitizer build runs this too).
 TEST(LazIO, TruncatedAndLyingFilesAreRefused) {

@@ -4,9 +4,10 @@
  *
  * Read: .ply (ascii/binary; face, tristrips or range_grid elements), .obj, .off (also binary OFF),
  * .stl (ascii/binary), .vtk (legacy POLYDATA), .pcd (organized or not; no faces), .las (LAS
- * 1.0-1.4 uncompressed, point formats 0-10; .laz is refused with how to decompress it).
- * Written: .ply (binary by default), .pcd (binary_compressed, as PCL's tools write it; faces
- * are not stored) and .las (the input's LAS layout when given, else LAS 1.4 format 6/7). Colours
+ * 1.0-1.4, point formats 0-10) and .laz (LASzip-compressed LAS: formats 0-3 and 6-8, COPC
+ * included; told by the header, whatever the name). Written: .ply (binary by default), .pcd
+ * (binary_compressed, as PCL's tools write it; faces are not stored), .las (the input's LAS
+ * layout when given, else LAS 1.4 format 6/7) and .laz (the .las compressed). Colours
  * are written as each format's viewers read them (ColorLayout): PLY red green blue, PCD a packed
  * rgb. A cloud is a mesh without polygons. The mesh hands PCL what its point types read: x, y, z as
  * FLOAT32 (pcl::fromPCLPointCloud2 into pcl::PointXYZ works after any load); the coordinates as

@@ -28,7 +28,8 @@ void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>&
                      const Eigen::Ref<const Eigen::MatrixXd>& values,
                      FieldPrecision precision = FieldPrecision::Float);
 /** The same of float values where they lie, e.g. the normals of a pcl::PointCloud<pcl::Normal>
- *  (a map of its floats with an outer stride of 8). */
+ *  (a map of its floats with an outer stride of 8); `values` must not lie in cloud.data, which
+ *  the new layout rewrites. */
 void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
                      const Eigen::Ref<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>& values,
                      FieldPrecision precision = FieldPrecision::Float);

@@ -16,6 +16,7 @@
 #include "laz_item_common.h"
 #include "laz_items.h"
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/las_layout.h"
 
 namespace pcl_ddg {
 namespace detail {
@@ -37,20 +38,14 @@ constexpr std::uint16_t kLaszipRecordId = 22204;
 constexpr char kLaszipUserId[] = "laszip encoded";
 constexpr std::uint32_t kChunkSize = 50000;  // points per chunk written by lasToLaz
 constexpr std::uint32_t kVariableChunks = 0xFFFFFFFFu;
-// A coded point costs at least a few hundredths of a bit; a stricter bound than the format's
-// lets a lying point count be refused before the output is allocated.
-constexpr std::uint64_t kMaxPointsPerByte = 128;
-constexpr std::uint64_t kPointAllowance = 65536;
-// The records decompressed, at most this many times the compressed bytes plus an allowance
-// (LASzip reaches 5-20 on surveys; wide extra bytes that never change more): a larger claim is a
-// lie, refused before the output is allocated.
-constexpr std::uint64_t kMaxExpansion = 4096;
+// The records decompressed, at most this many times the compressed bytes plus an allowance: a
+// larger claim is a lie, refused before the output is allocated. LASzip reaches 5-20 on surveys,
+// about 3,000 on a million identical points of format 0; the bound leaves room above that.
+constexpr std::uint64_t kMaxExpansion = std::uint64_t{1} << 17;
 constexpr std::uint64_t kByteAllowance = std::uint64_t{1} << 26;
-
-std::uint16_t basePointSize(int format) {
-  static constexpr std::uint16_t kSizes[] = {20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67};
-  return format >= 0 && format <= 10 ? kSizes[format] : 0;
-}
+// The memory the decoders of one thread may take (a model per extra byte and scanner channel):
+// fewer threads decode a file whose records are that wide.
+constexpr std::uint64_t kDecoderBudget = std::uint64_t{1} << 28;
 
 /** The LAS header fields this codec reads or rewrites. */
 struct LasHeader {
@@ -225,7 +220,7 @@ LaszipInfo parseLaszipVlr(std::string_view payload, int format, std::uint16_t re
   if (format > 3 && format < 6)
     fail("point format " + std::to_string(format) + " (with waveform packets) is not supported");
   if (format > 8) fail("point format " + std::to_string(format) + " is not supported");
-  const std::uint16_t base = basePointSize(format);
+  const std::uint16_t base = lasPointFormatSize(format);
   if (record_length < base)
     fail("point record length " + std::to_string(record_length) + " is below point format " +
          std::to_string(format) + "'s " + std::to_string(base) + " bytes");
@@ -475,7 +470,13 @@ void decodeChunks(const std::uint8_t* file, const std::vector<Chunk>& chunks,
       if (!other_error) other_error = std::current_exception();
     }
   };
-  const std::size_t n = std::min<std::size_t>(std::max(threads, 1), chunks.size());
+  // A decoder holds about 2.5 KB of models per byte of the record (extra bytes included) and,
+  // layered, per scanner channel: within the budget, whatever the record's width.
+  const std::uint64_t decoder_bytes = std::uint64_t{2560} * record_length * (info.layered ? 4 : 1);
+  const auto affordable =
+      static_cast<std::size_t>(std::max<std::uint64_t>(1, kDecoderBudget / decoder_bytes));
+  const std::size_t n =
+      std::min({static_cast<std::size_t>(std::max(threads, 1)), chunks.size(), affordable});
   std::vector<std::thread> pool;
   for (std::size_t t = 1; t < n; ++t) pool.emplace_back(work);
   work();
@@ -492,7 +493,9 @@ void decodeChunks(const std::uint8_t* file, const std::vector<Chunk>& chunks,
 void decodeSequentially(const std::uint8_t* file, std::uint64_t chunks_begin,
                         std::uint64_t data_end, const LaszipInfo& info, std::uint16_t record_length,
                         std::uint64_t point_count, std::uint8_t* out, const std::string& why) {
-  const bool variable = info.chunk_size == kVariableChunks || info.chunk_size == 0;
+  // (The pointwise compressor has one stream: its chunk size field means nothing.)
+  const bool variable =
+      info.compressor != 1 && (info.chunk_size == kVariableChunks || info.chunk_size == 0);
   if (variable && !info.layered)
     fail("the chunk table is unusable (" + why +
          ") and chunks of variable size cannot be found "
@@ -539,10 +542,6 @@ std::string lazToLas(std::string_view laz_file_bytes, int threads) {
 
   const std::uint64_t data_begin = h.point_offset, data_end = h.points_end;
   const std::uint64_t data_bytes = data_end - data_begin;
-  if (h.point_count > kMaxPointsPerByte * data_bytes + kPointAllowance) {
-    fail("the header's " + std::to_string(h.point_count) + " points cannot be coded in " +
-         std::to_string(data_bytes) + " bytes of point data");
-  }
   if (h.point_count * h.record_length > kMaxExpansion * data_bytes + kByteAllowance) {
     fail("the header's " + std::to_string(h.point_count) + " points of " +
          std::to_string(h.record_length) + " bytes cannot be coded in " +
@@ -707,7 +706,7 @@ std::string lasToLaz(std::string_view las_file_bytes) {
          " cannot be compressed here (formats 0-3 and "
          "6-8 can)");
   }
-  const std::uint16_t base = basePointSize(format);
+  const std::uint16_t base = lasPointFormatSize(format);
   if (h.record_length < base) {
     fail("point record length " + std::to_string(h.record_length) + " is below point format " +
          std::to_string(format) + "'s " + std::to_string(base) + " bytes");

@@ -27,9 +27,12 @@
  * pointwise or pointwise-chunked; formats 6-8 with the version 3 or 4 layered items (POINT14,
  * RGB14, RGBNIR14, BYTE14), as written by LASzip 3 and COPC writers. Refused with a message:
  * LASzip 1.x's version 1 items, waveform formats 4, 5, 9, 10, other coders, and anything
- * inconsistent. Corrupt data never reads outside the input, never loops without end and never
- * allocates more than the point count allows (itself bounded by the compressed size): it throws
- * pcl_ddg::FileFormatException naming the chunk.
+ * inconsistent. Corrupt data never reads outside the input and never loops without end: it
+ * throws pcl_ddg::FileFormatException naming the chunk. The records are allocated only when the
+ * header's count times the record length is at most 2^17 times the compressed point data plus
+ * 64 MiB (a million identical points reach about 3,000 times), and fewer threads decode a file
+ * whose records are so wide that their decoders (2.5 KB per record byte and channel) would
+ * exceed 256 MiB each.
  */
 #include <string>
 #include <string_view>
