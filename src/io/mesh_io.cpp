@@ -7,6 +7,7 @@
 #include <cstring>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "byte_cursor.h"
@@ -90,8 +91,9 @@ MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorag
                       std::size_t spare_point_bytes) {
   const std::string ext = fileExtension(path);
   try {
-    const detail::FileBytes bytes(path);  // first: a missing file says so
-    std::string_view data = bytes.view();
+    std::optional<detail::FileBytes> bytes;
+    bytes.emplace(path);  // first: a missing file says so
+    std::string_view data = bytes->view();
     std::string decompressed;
     if (ext == "las" || ext == "laz") {
       // LAZ (by its header's compression bits, whatever the name): its chunks decompressed on
@@ -99,6 +101,7 @@ MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorag
       if (lasIsCompressed(data)) {
         decompressed = detail::lazToLas(data, detail::loaderThreads());
         data = decompressed;
+        bytes.reset();
       }
       detail::LasCloud las = detail::parseLAS(data, spare_point_bytes);
       if (las.positions.cols() == 0 && empty == EmptyFilePolicy::Refuse)
@@ -128,6 +131,7 @@ MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorag
     file.mesh = ext == "pcd" ? detail::parsePCD(data, &file.sensor_pose, spare_point_bytes)
                 : ext == "off" && as_rows ? detail::parseOFF(data, rows.get())
                                           : parse(data);
+    bytes.reset();  // parsed: its memory is free for the positions
     if (as_rows && !file.mesh.polygons.empty()) *rows = faceRowsOf(file.mesh.polygons);
     if (rows->rows() > 0) {
       std::vector<pcl::Vertices>().swap(file.mesh.polygons);

@@ -185,8 +185,8 @@ pcl::PolygonMesh parseOFF(std::string_view data, FaceRows* rows) {
     cursor.fail("vertex or face count larger than the file can hold (truncated?)");
   }
 
-  std::vector<double> xyz(3 * static_cast<std::size_t>(num_vertices));
   pcl::PolygonMesh mesh;
+  mesh.cloud = doubleXYZCloud(static_cast<std::size_t>(num_vertices));
   // Rows asked for: triangles go straight into them (no heap vector per face); a face of another
   // size is still read and checked, and the faces are then read again as polygons.
   std::vector<std::int32_t> triangles(rows ? 3 * static_cast<std::size_t>(num_faces) : 0);
@@ -200,7 +200,8 @@ pcl::PolygonMesh parseOFF(std::string_view data, FaceRows* rows) {
   const auto parseLine = [&](std::int64_t i) {
     ByteCursor values = cursor.within(lines[static_cast<std::size_t>(i - first_line)]);
     if (i < num_vertices) {
-      for (int d = 0; d < 3; ++d) xyz[3 * i + d] = values.readDouble("vertex coordinate");
+      for (int d = 0; d < 3; ++d)
+        setXYZ(mesh.cloud, static_cast<std::size_t>(i), d, values.readDouble("vertex coordinate"));
       return;
     }
     const auto face = static_cast<std::size_t>(i - num_vertices);
@@ -248,7 +249,7 @@ pcl::PolygonMesh parseOFF(std::string_view data, FaceRows* rows) {
     cursor.seek(faces_start);
     parseLines(num_vertices, num_vertices + num_faces);
   }
-  mesh.cloud = makeXYZCloud(xyz);
+  narrowXYZCloud(mesh.cloud);
   return mesh;
 }
 

@@ -53,7 +53,6 @@ void MeshTopology::build(const PolygonList& polygons, OutOfRangeFacePolicy polic
   {
     const PolygonKinds kinds = triangulate(polygons, policy);
     const Wedges wedges = buildVertexTriangles(kinds.plain);
-    buildVertexNeighbours(wedges);
     boundary_edges = classifyVertices(wedges);
     countDuplicatePolygons(polygons, kinds.others, wedges);
   }
@@ -154,50 +153,57 @@ MeshTopology::Wedges MeshTopology::buildVertexTriangles(const std::vector<char>&
   return wedges;
 }
 
-void MeshTopology::buildVertexNeighbours(const Wedges& wedges) {
-  // Each incident triangle offers two neighbours; a vertex's row is their sorted distinct values.
-  // A row is found twice, once to size the rows and once to fill them, in a buffer per thread:
-  // no scratch of two ints per wedge (55 MB for the bench torus) at the build's peak.
-  const auto gather = [&](int v, std::vector<int>& row) {
-    row.clear();
-    for (int i = vt_offsets_[v]; i < vt_offsets_[v + 1]; ++i) {
-      row.push_back(wedges.next(i));
-      row.push_back(wedges.previous(i));
-    }
-    std::sort(row.begin(), row.end());
-    row.erase(std::unique(row.begin(), row.end()), row.end());
-  };
-  vv_offsets_.assign(num_vertices_ + 1, 0);
-  std::int64_t edges = 0;  // each counted at its smaller end
-#pragma omp parallel reduction(+ : edges)
-  {
-    std::vector<int> row;
-#pragma omp for schedule(static)
-    for (int v = 0; v < num_vertices_; ++v) {
-      gather(v, row);
-      vv_offsets_[v + 1] = static_cast<int>(row.size());
-      edges += row.end() - std::upper_bound(row.begin(), row.end(), v);
-    }
+void MeshTopology::gatherRing(int v, std::vector<int>& ring) const {
+  ring.clear();
+  for (const int t : incidentTriangles(v)) {
+    const int k = triangles_(0, t) == v ? 0 : triangles_(1, t) == v ? 1 : 2;
+    ring.push_back(triangles_((k + 1) % 3, t));
+    ring.push_back(triangles_((k + 2) % 3, t));
   }
-  num_edges_ = static_cast<int>(edges);
-  std::partial_sum(vv_offsets_.begin(), vv_offsets_.end(), vv_offsets_.begin());
-  vv_neighbours_.resize(vv_offsets_.back());
+  std::sort(ring.begin(), ring.end());
+  ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
+}
+
+void MeshTopology::buildNeighbourRowsOnce() const {
+  std::call_once(neighbour_rows_->once, [this] {
+    neighbour_rows_->rows = buildNeighbourRows();
+    neighbour_rows_->built.store(true, std::memory_order_release);
+  });
+}
+
+MeshTopology::NeighbourRows MeshTopology::buildNeighbourRows() const {
+  // A row is found twice, once to size the rows and once to fill them, in a buffer per thread:
+  // no scratch of two ints per incidence (55 MB for the bench torus).
+  NeighbourRows rows;
+  rows.offsets.assign(num_vertices_ + 1, 0);
 #pragma omp parallel
   {
-    std::vector<int> row;
+    std::vector<int> ring;
 #pragma omp for schedule(static)
     for (int v = 0; v < num_vertices_; ++v) {
-      gather(v, row);
-      std::copy(row.begin(), row.end(), vv_neighbours_.begin() + vv_offsets_[v]);
+      gatherRing(v, ring);
+      rows.offsets[v + 1] = static_cast<int>(ring.size());
     }
   }
+  std::partial_sum(rows.offsets.begin(), rows.offsets.end(), rows.offsets.begin());
+  rows.neighbours.resize(rows.offsets.back());
+#pragma omp parallel
+  {
+    std::vector<int> ring;
+#pragma omp for schedule(static)
+    for (int v = 0; v < num_vertices_; ++v) {
+      gatherRing(v, ring);
+      std::copy(ring.begin(), ring.end(), rows.neighbours.begin() + rows.offsets[v]);
+    }
+  }
+  return rows;
 }
 
 int MeshTopology::findEdge(int a, int b) const {
   const IndexSpan row_a = neighbours(a);
   const int* it = std::lower_bound(row_a.begin(), row_a.end(), b);
   if (it == row_a.end() || *it != b) return -1;
-  return edgeMap().vv_edges[vv_offsets_[a] + static_cast<int>(it - row_a.begin())];
+  return edgeMap().vv_edges[neighbourRows().offsets[a] + static_cast<int>(it - row_a.begin())];
 }
 
 void MeshTopology::buildEdgeMapOnce() const {
@@ -221,10 +227,11 @@ MeshTopology::EdgeMap MeshTopology::buildEdgeMap() const {
   for (int v = 0; v < num_vertices_; ++v) first_edge[v + 1] = neighbours(v).size() - firstLarger(v);
   std::partial_sum(first_edge.begin(), first_edge.end(), first_edge.begin());
 
+  const std::vector<int>& offsets = neighbourRows().offsets;
   EdgeMap map;
-  map.vv_edges.resize(vv_neighbours_.size());
+  map.vv_edges.resize(neighbourRows().neighbours.size());
   map.edge_vertices.resize(2, num_edges_);
-  std::vector<int> smaller_filled(vv_offsets_.begin(), vv_offsets_.end() - 1);
+  std::vector<int> smaller_filled(offsets.begin(), offsets.end() - 1);
   detail::forEachVertexRange(num_vertices_, [&](int first, int last) {
     for (int v = 0; v < num_vertices_; ++v) {
       const IndexSpan row = neighbours(v);
@@ -232,7 +239,7 @@ MeshTopology::EdgeMap MeshTopology::buildEdgeMap() const {
       for (int i = row.size() - larger; i < row.size(); ++i) {
         const int w = row[i], e = first_edge[v] + i - (row.size() - larger);
         if (v >= first && v < last) {
-          map.vv_edges[vv_offsets_[v] + i] = e;
+          map.vv_edges[offsets[v] + i] = e;
           map.edge_vertices.col(e) << v, w;
         }
         if (w >= first && w < last) map.vv_edges[smaller_filled[w]++] = e;
@@ -249,7 +256,7 @@ MeshTopology::EdgeMap MeshTopology::buildEdgeMap() const {
     const IndexSpan row = neighbours(v);
     const auto edgeTo = [&](int w) {
       const int at = static_cast<int>(std::lower_bound(row.begin(), row.end(), w) - row.begin());
-      return map.vv_edges[vv_offsets_[v] + at];
+      return map.vv_edges[offsets[v] + at];
     };
     for (const int t : incidentTriangles(v)) {
       const int k = triangles_(0, t) == v ? 0 : triangles_(1, t) == v ? 1 : 2;
@@ -282,10 +289,12 @@ std::vector<std::pair<int, int>> MeshTopology::classifyVertices(const Wedges& we
   vertex_flags_.assign(num_vertices_, 0);
   std::vector<std::pair<int, int>> boundary_edges;
   std::int64_t boundary = 0, nonmanifold = 0, bow_ties = 0, unreferenced = 0;
+  std::int64_t edges = 0;  // each counted at its smaller end
   bool consistent = true;
-#pragma omp parallel reduction(+ : boundary, nonmanifold, bow_ties, unreferenced) \
+#pragma omp parallel reduction(+ : boundary, nonmanifold, bow_ties, unreferenced, edges) \
     reduction(&& : consistent)
   {
+    std::vector<int> ring;
     std::vector<int> parent(max_valence);
     std::vector<int> first_triangle_at_neighbour(max_valence * 2);
     std::vector<int> triangles_at_neighbour(max_valence * 2), forward_at_neighbour(max_valence * 2);
@@ -296,7 +305,8 @@ std::vector<std::pair<int, int>> MeshTopology::classifyVertices(const Wedges& we
     };
 #pragma omp for schedule(static) nowait
     for (int v = 0; v < num_vertices_; ++v) {
-      const IndexSpan ring = neighbours(v);
+      gatherRing(v, ring);
+      edges += ring.end() - std::upper_bound(ring.begin(), ring.end(), v);
       const int valence = vt_offsets_[v + 1] - vt_offsets_[v];
       if (valence == 0) {
         vertex_flags_[v] = static_cast<std::uint8_t>(VertexFlag::Isolated);
@@ -332,7 +342,7 @@ std::vector<std::pair<int, int>> MeshTopology::classifyVertices(const Wedges& we
         flags |= static_cast<std::uint8_t>(VertexFlag::NonManifoldVertex);
         ++bow_ties;
       }
-      for (int slot = 0; slot < ring.size(); ++slot) {
+      for (int slot = 0; slot < static_cast<int>(ring.size()); ++slot) {
         const int count = triangles_at_neighbour[slot];
         const bool smaller_end = ring[slot] > v;
         if (count == 1) {
@@ -351,6 +361,7 @@ std::vector<std::pair<int, int>> MeshTopology::classifyVertices(const Wedges& we
 #pragma omp critical(pcl_ddg_boundary_edges)
     boundary_edges.insert(boundary_edges.end(), my_boundary_edges.begin(), my_boundary_edges.end());
   }
+  num_edges_ = static_cast<int>(edges);
   counts_.boundary_edges = boundary;
   counts_.nonmanifold_edges = nonmanifold;
   counts_.nonmanifold_vertices = bow_ties;

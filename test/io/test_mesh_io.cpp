@@ -19,6 +19,7 @@
 #include <cmath>
 
 #include "data_catalogue.h"
+#include "io/mesh_formats.h"  // internal: the ascii OFF parser's own cloud
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
 #include "pcl_ddg/io/mesh_io.h"
@@ -294,6 +295,43 @@ TEST_F(MeshIOFiles, PCLReadsFloatCoordinatesFromEveryFormatAndPrecision) {
     EXPECT_EQ(readMeshFile(path(name)).positions(0, 1), 100000.123456789) << name;
     EXPECT_EQ(readMeshFile(path(name)).coordinate_precision, FieldPrecision::Double) << name;
   }
+}
+
+// The ascii OFF parser holds the coordinates exactly in its cloud, parsed straight into it: as
+// float when every one is a float's value (narrowed in place), else as double; readMeshFile then
+// keeps them in positions and gives PCL floats.
+TEST_F(MeshIOFiles, TextCoordinatesAreFloatWhenExactlyFloatElseDouble) {
+  const auto types = [](const pcl::PCLPointCloud2& cloud) {
+    std::string names;
+    for (const pcl::PCLPointField& f : cloud.fields)
+      names += f.name + std::to_string(f.datatype) + "@" + std::to_string(f.offset) + " ";
+    return names + "step " + std::to_string(cloud.point_step);
+  };
+  const std::string floats = "OFF\n3 1 0\n0.5 -2 1e3\n0.25 1 0\n0 0.125 nan\n3 0 1 2\n";
+  const pcl::PolygonMesh exact = detail::parseOFF(floats);
+  EXPECT_EQ(types(exact.cloud), "x7@0 y7@4 z7@8 step 12");  // PCLPointField::FLOAT32 = 7
+  EXPECT_EQ(exact.cloud.data.size(), 36u);
+  pcl::PointCloud<pcl::PointXYZ> points;
+  pcl::fromPCLPointCloud2(exact.cloud, points);
+  EXPECT_EQ(points[0].z, 1000.0f);
+  EXPECT_EQ(points[1].x, 0.25f);
+  EXPECT_EQ(points[2].y, 0.125f);
+  EXPECT_TRUE(std::isnan(points[2].z));
+  EXPECT_FALSE(exact.cloud.is_dense);
+
+  const std::string text = "OFF\n3 1 0\n0.1 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const pcl::PolygonMesh wide = detail::parseOFF(text);
+  EXPECT_EQ(types(wide.cloud), "x8@0 y8@8 z8@16 step 24");  // FLOAT64 = 8
+  double x = 0.0;
+  std::memcpy(&x, wide.cloud.data.data(), 8);
+  EXPECT_EQ(x, 0.1);
+  EXPECT_TRUE(wide.cloud.is_dense);
+  writeText(path("double.off"), text);
+  const MeshFile file = readMeshFile(path("double.off"));
+  EXPECT_EQ(types(file.mesh.cloud), "x7@0 y7@4 z7@8 step 12");
+  EXPECT_EQ(file.positions(0, 0), 0.1);
+  pcl::fromPCLPointCloud2(file.mesh.cloud, points);
+  EXPECT_EQ(points[0].x, 0.1f);
 }
 
 TEST_F(MeshIOFiles, CoordinatesBeyondFloatAreRefused) {

@@ -267,6 +267,32 @@ TEST(MeshTopology, NeighbourRowsAreSortedSymmetricAndMatchEdges) {
   EXPECT_EQ(t.numEdges(), 3 * t.numVertices());
 }
 
+// The neighbour rows are built on first use: asked for first by many threads at once, and by a
+// copy made before, they are the rows a brute force finds (each triangle's other two corners).
+TEST(MeshTopology, NeighbourRowsBuiltOnFirstUseAreTheBruteForceRows) {
+  const SurfaceSample sphere = makeIcosphere(4);
+  const int n = static_cast<int>(sphere.points.cols());
+  std::vector<std::set<int>> expected(n);
+  for (Eigen::Index t = 0; t < sphere.triangles.cols(); ++t)
+    for (int k = 0; k < 3; ++k)
+      for (int j = 1; j < 3; ++j)
+        expected[sphere.triangles(k, t)].insert(sphere.triangles((k + j) % 3, t));
+  const MeshTopology topology(n, sphere.triangles);
+  const MeshTopology copy = topology;
+  EXPECT_EQ(topology.numEdges(), sphere.triangles.cols() * 3 / 2);  // counted without the rows
+  std::vector<std::vector<int>> rows(n);
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int v = 0; v < n; ++v) {
+    const IndexSpan row = topology.neighbours(v);
+    rows[v].assign(row.begin(), row.end());
+  }
+  for (int v = 0; v < n; ++v) {
+    ASSERT_EQ(rows[v], std::vector<int>(expected[v].begin(), expected[v].end())) << v;
+    const IndexSpan row = copy.neighbours(v);
+    ASSERT_EQ(std::vector<int>(row.begin(), row.end()), rows[v]) << v;
+  }
+}
+
 // The orientation union-find must stay linear on chains (a long strip unites each triangle with
 // the previous one): counted in parent links followed, not by a clock. Without path compression
 // and union by size the strip below takes n^2 / 2 = 5e11 steps.

@@ -104,10 +104,16 @@ class MeshTopology {
   /** Number of triangles on each edge (1: boundary, 2: manifold interior, >2: non-manifold). */
   const std::vector<int>& edgeTriangleCount() const { return edgeMap().triangle_count; }
 
-  /** Sorted distinct neighbours of v. */
-  IndexSpan neighbours(int v) const { return row(vv_offsets_, vv_neighbours_, v); }
+  /** Sorted distinct neighbours of v. The rows are built on first use (once, thread-safe): a
+   *  user of the triangles and incidences only (face-weighted normals) never pays for them. */
+  IndexSpan neighbours(int v) const {
+    const NeighbourRows& rows = neighbourRows();
+    return row(rows.offsets, rows.neighbours, v);
+  }
   /** Edge ids parallel to neighbours(v). */
-  IndexSpan neighbourEdges(int v) const { return row(vv_offsets_, edgeMap().vv_edges, v); }
+  IndexSpan neighbourEdges(int v) const {
+    return row(neighbourRows().offsets, edgeMap().vv_edges, v);
+  }
   /** Triangles having v as a corner (a triangle repeats only if the input repeats it). */
   IndexSpan incidentTriangles(int v) const { return row(vt_offsets_, vt_triangles_, v); }
   /** The id of edge {a, b}, or -1 if no triangle has it. */
@@ -160,8 +166,11 @@ class MeshTopology {
     int previous(int i) const { return triangles[3 * incident[i] + ((corner[i] & 3) + 2) % 3]; }
   };
   Wedges buildVertexTriangles(const std::vector<char>& plain);
-  void buildVertexNeighbours(const Wedges& wedges);
-  /** Flags and edge counts from each vertex's own wedges and ring; returns the boundary edges. */
+  /** v's sorted distinct neighbours, from its incident triangles, into ring. */
+  void gatherRing(int v, std::vector<int>& ring) const;
+  /** Flags and edge counts from each vertex's own wedges and ring (gathered from its wedges in a
+   *  buffer per thread, not read from the neighbour rows, which may never be needed); returns
+   *  the boundary edges. */
   std::vector<std::pair<int, int>> classifyVertices(const Wedges& wedges);
   void countDuplicatePolygons(const PolygonList& polygons, const std::vector<int>& others,
                               const Wedges& wedges);
@@ -173,8 +182,25 @@ class MeshTopology {
     Eigen::Matrix3Xi triangle_edges;
     Eigen::Matrix2Xi edge_vertices;
     std::vector<int> triangle_count;
-    std::vector<int> vv_edges;  ///< parallel to vv_neighbours_
+    std::vector<int> vv_edges;  ///< parallel to NeighbourRows::neighbours
   };
+  /** CSR rows of each vertex's sorted distinct neighbours. */
+  struct NeighbourRows {
+    std::vector<int> offsets, neighbours;
+  };
+  /** Built at most once, by the first caller; shared by copies, which have the same rows. */
+  struct LazyNeighbourRows {
+    std::once_flag once;
+    std::atomic<bool> built{false};  ///< the inline check: no call once the rows are there
+    NeighbourRows rows;
+  };
+  const NeighbourRows& neighbourRows() const {
+    if (!neighbour_rows_->built.load(std::memory_order_acquire)) buildNeighbourRowsOnce();
+    return neighbour_rows_->rows;
+  }
+  void buildNeighbourRowsOnce() const;
+  /** From the incidence rows: each incident triangle offers its two other corners. */
+  NeighbourRows buildNeighbourRows() const;
   /** Built at most once, by the first caller; shared by copies, which have the same rows. */
   struct LazyEdgeMap {
     std::once_flag once;
@@ -193,7 +219,7 @@ class MeshTopology {
   std::vector<int> triangle_source_;  ///< empty when triangle t is polygon t for all t
   int num_edges_ = 0;
   std::shared_ptr<LazyEdgeMap> edge_map_ = std::make_shared<LazyEdgeMap>();
-  std::vector<int> vv_offsets_, vv_neighbours_;
+  std::shared_ptr<LazyNeighbourRows> neighbour_rows_ = std::make_shared<LazyNeighbourRows>();
   std::vector<int> vt_offsets_, vt_triangles_;
   std::vector<std::uint8_t> vertex_flags_;
   std::vector<int> vertex_component_;
