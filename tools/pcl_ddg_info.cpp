@@ -5,14 +5,18 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <vector>
 
 #include "common/fit_steps.h"
 #include "common/tool_common.h"
 #include "common/tool_input.h"
+#include "pcl_ddg/io/copc.h"
+#include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/cloud_report.h"
 #include "pcl_ddg/mesh/mesh_report.h"
@@ -24,7 +28,8 @@ constexpr const char* kName = "pcl_ddg_info";
 constexpr const char* kDescription =
     "Reports the topology and defects of a mesh (or the layout of a point cloud).";
 constexpr const char* kSyntax =
-    "input.{ply,obj,off,stl,vtk,pcd,las} [-json] | -input_dir DIR [-json] (one report per file)";
+    "input.{ply,obj,off,stl,vtk,pcd,las,laz} [-json] | -input_dir DIR [-json] (one report per "
+    "file)";
 
 const char* asprsClassName(int c) {
   static const char* const kNames[] = {
@@ -93,11 +98,50 @@ std::vector<BoundMismatch> boundMismatches(const pcl_ddg::LasLayout& las,
   return found;
 }
 
+// A COPC file's octree: its cube, and per level the nodes and points (read by byte ranges: the
+// header, VLRs and hierarchy pages again, a few kB).
+std::string copcReport(const pcl_ddg::CopcInfo& copc, bool json) {
+  std::map<int, std::pair<long long, long long>> levels;  // depth: nodes, points
+  for (const pcl_ddg::CopcNode& node : copc.nodes) {
+    ++levels[node.key.depth].first;
+    levels[node.key.depth].second += node.points;
+  }
+  std::ostringstream out;
+  if (json) {
+    out << "{\"center\": [" << jsonNumber(copc.center[0]) << ", " << jsonNumber(copc.center[1])
+        << ", " << jsonNumber(copc.center[2]) << "], \"halfsize\": " << jsonNumber(copc.halfsize)
+        << ", \"spacing\": " << jsonNumber(copc.spacing) << ", \"nodes\": " << copc.nodes.size()
+        << ", \"hierarchy_pages\": " << copc.hierarchy_pages << ", \"levels\": [";
+    bool first = true;
+    for (const auto& [depth, level] : levels) {
+      out << (first ? "" : ", ") << "{\"depth\": " << depth << ", \"nodes\": " << level.first
+          << ", \"points\": " << level.second << "}";
+      first = false;
+    }
+    out << "]}";
+    return out.str();
+  }
+  out << "COPC octree:       " << copc.nodes.size() << " nodes in " << levels.size() << " levels, "
+      << copc.hierarchy_pages << " hierarchy page" << (copc.hierarchy_pages == 1 ? "" : "s")
+      << "; cube centre " << triple(copc.center) << ", half size " << number(copc.halfsize)
+      << ", spacing " << number(copc.spacing) << "\n";
+  for (const auto& [depth, level] : levels)
+    out << "COPC level " << depth << (depth < 10 ? ":      " : ":     ") << level.first
+        << (level.first == 1 ? " node, " : " nodes, ") << level.second << " points\n";
+  return out.str();
+}
+
 // What a LAS file holds beside its points: version, point format, scale and offset, the header's
 // bounds against the records' (records_box: their exact coordinates' box), VLRs, Extra Bytes
 // dimensions and the classification histogram; as text lines, or as a JSON object.
-std::string lasReport(const pcl_ddg::LasLayout& las, const pcl::PCLPointCloud2& cloud,
-                      const pcl_ddg::BoundingBox& records_box, bool json) {
+std::string lasReport(const std::string& path, const pcl_ddg::LasLayout& las,
+                      const pcl::PCLPointCloud2& cloud, const pcl_ddg::BoundingBox& records_box,
+                      bool json) {
+  char head[105] = {};
+  std::ifstream(path, std::ios::binary).read(head, sizeof head);
+  const bool compressed = pcl_ddg::lasIsCompressed(std::string_view(head, sizeof head));
+  std::optional<pcl_ddg::CopcInfo> copc;
+  if (compressed && pcl_ddg::isCopcFile(path)) copc = pcl_ddg::readCopcInfo(path);
   std::map<int, long long> histogram;
   const auto field =
       std::find_if(cloud.fields.begin(), cloud.fields.end(),
@@ -130,8 +174,9 @@ std::string lasReport(const pcl_ddg::LasLayout& las, const pcl::PCLPointCloud2& 
     };
     const char* agree = "null";
     if (compared) agree = mismatches.empty() ? "true" : "false";
-    out << "\"las\": {\"version\": " << jsonText(version)
-        << ", \"point_format\": " << int(las.point_format)
+    out << "\"las\": {\"storage\": " << (compressed ? "\"laz\"" : "\"las\"")
+        << ", \"copc\": " << (copc ? copcReport(*copc, true) : "null")
+        << ", \"version\": " << jsonText(version) << ", \"point_format\": " << int(las.point_format)
         << ", \"record_length\": " << las.record_length << ", \"scale\": " << array(las.scale)
         << ", \"offset\": " << array(las.offset) << ", \"header_bounds_min\": " << array(las.min)
         << ", \"header_bounds_max\": " << array(las.max) << ", \"header_bounds_agree\": " << agree
@@ -163,7 +208,7 @@ std::string lasReport(const pcl_ddg::LasLayout& las, const pcl::PCLPointCloud2& 
     return out.str();
   }
   out << "LAS:               " << version << ", point format " << int(las.point_format) << " ("
-      << las.record_length << "-byte records)\n"
+      << las.record_length << "-byte records)" << (compressed ? ", compressed (LAZ)" : "") << "\n"
       << "scale:             " << triple(las.scale) << "\n"
       << "offset:            " << triple(las.offset) << "\n"
       << "header bounds:     [" << triple(las.min) << "] .. [" << triple(las.max) << "]\n";
@@ -177,6 +222,7 @@ std::string lasReport(const pcl_ddg::LasLayout& las, const pcl::PCLPointCloud2& 
         << number(m.header - m.records) << " (header " << number(m.header) << ", records "
         << number(m.records) << ")\n";
   }
+  if (copc) out << copcReport(*copc, false);
   for (const auto& r : las.vlrs) out << "VLR:               " << record(r) << "\n";
   for (const auto& r : las.evlrs) out << "EVLR:              " << record(r) << "\n";
   if (!las.extra_bytes.empty()) {
@@ -211,11 +257,12 @@ int run(int argc, char** argv) {
       if (file.las && json) {
         std::string text = report.toJson();  // one object: the LAS layout goes inside it
         text.pop_back();
-        std::cout << text << ", " << lasReport(*file.las, mesh.cloud, report.bounding_box, true)
-                  << "}\n";
+        std::cout << text << ", "
+                  << lasReport(path, *file.las, mesh.cloud, report.bounding_box, true) << "}\n";
       } else {
         std::cout << (json ? report.toJson() + "\n" : report.toText());
-        if (file.las) std::cout << lasReport(*file.las, mesh.cloud, report.bounding_box, false);
+        if (file.las)
+          std::cout << lasReport(path, *file.las, mesh.cloud, report.bounding_box, false);
       }
       tools::warnAboutQuantisation(kName, *makeLocalCloud(file.positions).points);
       return;

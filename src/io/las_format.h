@@ -24,6 +24,7 @@
 #include <string_view>
 
 #include "pcl_ddg/io/las_layout.h"
+#include "pcl_ddg/io/mesh_io.h"
 
 namespace pcl_ddg {
 namespace detail {
@@ -40,6 +41,9 @@ struct LasCloud {
  *  format) is refused first (readMeshFile decompresses it before: laz/laz_codec.h). The cloud's
  *  data has room for spare_point_bytes more bytes per point (readMeshFile's). */
 LasCloud parseLAS(std::string_view data, std::size_t spare_point_bytes = 0);
+
+/** parseLAS's cloud as readMeshFile returns a LAS file (coordinates Double, the layout kept). */
+MeshFile lasMeshFile(std::string_view data, std::size_t spare_point_bytes = 0);
 
 /** A cloud as a LAS file: the layout of `source` (version, point format, scale, offset, VLRs and
  *  EVLRs, Extra Bytes descriptors of the fields that remain), or LAS 1.4 format 6 (7 with

@@ -77,6 +77,20 @@ FaceRows faceRowsOf(const std::vector<pcl::Vertices>& polygons) {
 
 }  // namespace
 
+namespace detail {
+
+MeshFile lasMeshFile(std::string_view data, std::size_t spare_point_bytes) {
+  LasCloud las = parseLAS(data, spare_point_bytes);
+  MeshFile file;
+  file.mesh = std::move(las.mesh);
+  file.positions = std::move(las.positions);
+  file.coordinate_precision = FieldPrecision::Double;  // X * scale + offset
+  file.las = std::make_shared<const LasLayout>(std::move(las.layout));
+  return file;
+}
+
+}  // namespace detail
+
 std::string fileExtension(const std::string& path) {
   const std::size_t dot = path.find_last_of('.');
   const std::size_t slash = path.find_last_of('/');
@@ -103,14 +117,9 @@ MeshFile readMeshFile(const std::string& path, EmptyFilePolicy empty, FaceStorag
         data = decompressed;
         bytes.reset();
       }
-      detail::LasCloud las = detail::parseLAS(data, spare_point_bytes);
-      if (las.positions.cols() == 0 && empty == EmptyFilePolicy::Refuse)
+      MeshFile file = detail::lasMeshFile(data, spare_point_bytes);
+      if (file.positions.cols() == 0 && empty == EmptyFilePolicy::Refuse)
         throw FileFormatException("no points (the header counts none)");
-      MeshFile file;
-      file.mesh = std::move(las.mesh);
-      file.positions = std::move(las.positions);
-      file.coordinate_precision = FieldPrecision::Double;  // X * scale + offset
-      file.las = std::make_shared<const LasLayout>(std::move(las.layout));
       return file;
     }
     using Parser = pcl::PolygonMesh (*)(std::string_view);

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <sstream>
 #include <vector>
 
@@ -147,6 +148,42 @@ TEST(PclDdgInfo, LasBoxDuplicatesAndHeaderAreTheFilesExactValues) {
   EXPECT_NE(text.out.find("scale:             0.001 0.001 0.01\n"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("offset:            500000 5000000 200\n"), std::string::npos);
   EXPECT_NE(text.out.find("header vs records: agree"), std::string::npos) << text.out;
+}
+
+// The levels of the COPC file's octree, from its one hierarchy page read here by the COPC
+// specification's offsets (info VLR after the 375-byte header: root page offset at payload byte
+// 40, size at 48; entries of 32 bytes: depth first, point count last).
+TEST(PclDdgInfo, CopcOctreeAndCompressionAreReported) {
+  const std::string copc = sharedData("las/laz/1.2-with-color.copc.laz");
+  const std::string bytes = readBytes(copc);
+  std::uint64_t root = 0, size = 0;
+  std::memcpy(&root, bytes.data() + 375 + 54 + 40, 8);
+  std::memcpy(&size, bytes.data() + 375 + 54 + 48, 8);
+  std::map<int, std::pair<int, long long>> levels;
+  for (std::uint64_t e = root; e < root + size; e += 32) {
+    std::int32_t depth, points;
+    std::memcpy(&depth, bytes.data() + e, 4);
+    std::memcpy(&points, bytes.data() + e + 28, 4);
+    ++levels[depth].first;
+    levels[depth].second += points;
+  }
+  const auto j = json(copc);
+  EXPECT_EQ(j.get<std::string>("las.storage"), "laz");
+  EXPECT_EQ(j.get<std::size_t>("las.copc.nodes"), size / 32);
+  EXPECT_EQ(j.get<int>("las.copc.hierarchy_pages"), 1);
+  std::map<int, std::pair<int, long long>> reported;
+  for (const auto& level : j.get_child("las.copc.levels"))
+    reported[level.second.get<int>("depth")] = {level.second.get<int>("nodes"),
+                                                level.second.get<long long>("points")};
+  EXPECT_EQ(reported, levels);
+  EXPECT_EQ(levels.size(), 4u);
+  const ToolRun text = runInfo(copc);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("(36-byte records), compressed (LAZ)\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("COPC level 0:      1 node, "), std::string::npos) << text.out;
+  EXPECT_EQ(json(sharedData("las/laz/autzen_trim.laz")).get<std::string>("las.copc"), "null");
+  EXPECT_EQ(json(sharedData("las/laz/autzen_trim.laz")).get<std::string>("las.storage"), "laz");
+  EXPECT_EQ(json(sharedData("las/autzen_trim.las")).get<std::string>("las.storage"), "las");
 }
 
 TEST(PclDdgInfo, LasHeaderBoundsThatDisagreeWithTheRecordsAreNamed) {

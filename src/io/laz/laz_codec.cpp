@@ -665,6 +665,34 @@ class ChunkEncoder {
   laz::ArithmeticEncoder enc_;
 };
 
+/** Appends the chunk table (version 0, count, then each chunk's point count when `points` is
+ *  given, a variable-chunk file's, and byte count, coded from the previous chunk's) and stores
+ *  its offset at the start of the point data. */
+void appendChunkTable(std::string& laz, std::uint64_t point_offset,
+                      const std::vector<std::uint32_t>& points,
+                      const std::vector<std::uint32_t>& bytes) {
+  const std::uint64_t table_offset = laz.size();
+  store<std::int64_t>(reinterpret_cast<std::uint8_t*>(&laz[point_offset]),
+                      static_cast<std::int64_t>(table_offset));
+  ChunkEncoder::appendU32(laz, 0);
+  ChunkEncoder::appendU32(laz, static_cast<std::uint32_t>(bytes.size()));
+  if (bytes.empty()) return;
+  laz::ArithmeticEncoder enc;
+  enc.init();
+  laz::IntegerCompressor ic(32, 2, false);
+  std::int32_t last_points = 0, last_bytes = 0;
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    if (!points.empty()) {
+      ic.compress(enc, last_points, static_cast<std::int32_t>(points[i]), 0);
+      last_points = static_cast<std::int32_t>(points[i]);
+    }
+    ic.compress(enc, last_bytes, static_cast<std::int32_t>(bytes[i]), 1);
+    last_bytes = static_cast<std::int32_t>(bytes[i]);
+  }
+  enc.done();
+  laz.append(reinterpret_cast<const char*>(enc.bytes().data()), enc.bytes().size());
+}
+
 std::string laszipVlr(const std::vector<Item>& items, bool layered) {
   std::string payload(34 + 6 * items.size(), '\0');
   auto* p = reinterpret_cast<std::uint8_t*>(&payload[0]);
@@ -753,28 +781,51 @@ std::string lasToLaz(std::string_view las_file_bytes) {
     chunk_bytes.push_back(static_cast<std::uint32_t>(laz.size() - start));
     done += count;
   }
-  // The chunk table: version 0, count, byte counts coded from the previous one.
-  const std::uint64_t table_offset = laz.size();
-  store<std::int64_t>(reinterpret_cast<std::uint8_t*>(&laz[point_offset]),
-                      static_cast<std::int64_t>(table_offset));
-  ChunkEncoder::appendU32(laz, 0);
-  ChunkEncoder::appendU32(laz, static_cast<std::uint32_t>(chunk_bytes.size()));
-  if (!chunk_bytes.empty()) {
-    laz::ArithmeticEncoder enc;
-    enc.init();
-    laz::IntegerCompressor ic(32, 2, false);
-    std::int32_t last = 0;
-    for (std::uint32_t size : chunk_bytes) {
-      ic.compress(enc, last, static_cast<std::int32_t>(size), 1);
-      last = static_cast<std::int32_t>(size);
-    }
-    enc.done();
-    laz.append(reinterpret_cast<const char*>(enc.bytes().data()), enc.bytes().size());
-  }
+  appendChunkTable(laz, point_offset, {}, chunk_bytes);
   if (h.has_evlrs) {
     store<std::uint64_t>(reinterpret_cast<std::uint8_t*>(&laz[235]), laz.size());
     laz.append(file.substr(h.points_end));
   }
+  return laz;
+}
+
+std::string lazOfChunks(std::string_view prefix, const std::vector<LazChunk>& chunks) {
+  std::string laz(prefix);
+  auto* header = reinterpret_cast<std::uint8_t*>(&laz[0]);
+  // The other file's EVLRs (a COPC hierarchy) are not carried over.
+  if (laz.size() >= 375 && header[25] >= 4 && load<std::uint16_t>(header + 94) >= 375) {
+    store<std::uint64_t>(header + 235, 0);
+    store<std::uint32_t>(header + 243, 0);
+  }
+  const LasHeader h = parseHeader(laz);
+  if (h.point_offset != laz.size())
+    fail("the prefix ends at byte " + std::to_string(laz.size()) + ", not at the point data (" +
+         std::to_string(h.point_offset) + ")");
+  if ((h.format_byte & 0xC0) == 0) fail("the file is not compressed");
+  const std::vector<Vlr> vlrs = walkVlrs(laz, h);
+  const auto laszip = std::find_if(vlrs.begin(), vlrs.end(), [](const Vlr& v) { return v.laszip; });
+  if (laszip == vlrs.end()) fail("the file has no LASzip VLR");
+  const LaszipInfo info = parseLaszipVlr(
+      std::string_view(laz).substr(laszip->offset + kVlrHeaderSize, laszip->size - kVlrHeaderSize),
+      h.format_byte & 0x3F, h.record_length);
+  if (info.compressor == 1 || !(info.chunk_size == kVariableChunks || info.chunk_size == 0))
+    fail("chunks are taken apart only from a file of variable-size chunks (COPC's)");
+  std::vector<std::uint32_t> points, bytes;
+  std::uint64_t total = 0;
+  laz.append(8, '\0');  // chunk table offset
+  for (const LazChunk& chunk : chunks) {
+    if (chunk.points == 0) continue;  // an empty node has no chunk
+    points.push_back(chunk.points);
+    bytes.push_back(static_cast<std::uint32_t>(chunk.bytes.size()));
+    laz.append(chunk.bytes);
+    total += chunk.points;
+  }
+  header = reinterpret_cast<std::uint8_t*>(&laz[0]);
+  const int format = h.format_byte & 0x3F;
+  store<std::uint32_t>(header + 107,
+                       format < 6 && total <= 0xFFFFFFFFu ? static_cast<std::uint32_t>(total) : 0u);
+  if (h.minor >= 4 && h.header_size >= 375) store<std::uint64_t>(header + 247, total);
+  appendChunkTable(laz, h.point_offset, points, bytes);
   return laz;
 }
 

@@ -34,8 +34,10 @@
  * whose records are so wide that their decoders (2.5 KB per record byte and channel) would
  * exceed 256 MiB each.
  */
+#include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace pcl_ddg {
 namespace detail {
@@ -56,6 +58,21 @@ std::string lazToLas(std::string_view laz_file_bytes, int threads);
  * @throws pcl_ddg::FileFormatException if the file is not a LAS file of those formats.
  */
 std::string lasToLaz(std::string_view las_file_bytes);
+
+/** A chunk of a LAZ file of variable chunks: its point count and its bytes. */
+struct LazChunk {
+  std::uint32_t points = 0;
+  std::string_view bytes;
+};
+
+/**
+ * The LAZ file holding the given chunks of another (COPC nodes read by byte ranges), in that
+ * order: `prefix` is the other file's bytes up to its point data (header and VLRs, its LASzip
+ * VLR's chunks of variable size); the header's point count becomes the chunks' and its EVLRs
+ * are left out. Its points are then what lazToLas decodes, each chunk checked as in any file.
+ * @throws pcl_ddg::FileFormatException if prefix is not such a file's beginning.
+ */
+std::string lazOfChunks(std::string_view prefix, const std::vector<LazChunk>& chunks);
 
 }  // namespace detail
 }  // namespace pcl_ddg
