@@ -82,6 +82,8 @@ __all__ = [
     "orient_normals",
     "compare_neighbourhoods",
     "read",
+    "read_copc",
+    "copc_info",
     "write",
 ]
 
@@ -793,17 +795,8 @@ def _path(path: Union[str, bytes, "os.PathLike[str]"]) -> str:
     return os.fsdecode(os.fspath(path))
 
 
-def read(path: Union[str, "os.PathLike[str]"]) -> MeshFile:
-    """Reads a mesh or a cloud: .ply (ascii/binary; face, tristrips, range_grid), .obj, .off
-    (also binary), .stl, .vtk (legacy POLYDATA), .pcd (organized or not), .las (LAS 1.0-1.4,
-    formats 0-10), .laz (LASzip-compressed: formats 0-3 and 6-8, COPC included). OSError if the
-    file is missing, unknown or malformed."""
-    path = _path(path)
-    if not os.path.exists(path):
-        import errno
-
-        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), path)
-    points, faces, fields, viewpoint, orientation, shape, precision, las = _pcl_ddg.read(path)
+def _file_of(result: Tuple[Any, ...]) -> MeshFile:
+    points, faces, fields, viewpoint, orientation, shape, precision, las = result
     return MeshFile(
         points,
         faces,
@@ -814,6 +807,63 @@ def read(path: Union[str, "os.PathLike[str]"]) -> MeshFile:
         precision,
         las,
     )
+
+
+def _existing(path: Union[str, "os.PathLike[str]"]) -> str:
+    path = _path(path)
+    if not os.path.exists(path):
+        import errno
+
+        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), path)
+    return path
+
+
+def read(path: Union[str, "os.PathLike[str]"]) -> MeshFile:
+    """Reads a mesh or a cloud: .ply (ascii/binary; face, tristrips, range_grid), .obj, .off
+    (also binary), .stl, .vtk (legacy POLYDATA), .pcd (organized or not), .las (LAS 1.0-1.4,
+    formats 0-10), .laz (LASzip-compressed: formats 0-3 and 6-8, COPC included). OSError if the
+    file is missing, unknown or malformed."""
+    return _file_of(_pcl_ddg.read(_existing(path)))
+
+
+def copc_info(path: Union[str, "os.PathLike[str]"]) -> Dict[str, Any]:
+    """A COPC file's octree (docs/las.md, COPC), read from its header, VLRs and hierarchy pages
+    only: ``center``, ``halfsize``, ``spacing``, ``gpstime`` (min, max), ``points``,
+    ``hierarchy_pages`` and ``nodes``, a list of (depth, x, y, z, offset, bytes, points). OSError
+    if the file is not COPC or its hierarchy is inconsistent."""
+    return dict(_pcl_ddg.copc_info(_existing(path)))
+
+
+def read_copc(
+    path: Union[str, "os.PathLike[str]"],
+    bounds: Optional[ArrayLike] = None,
+    max_depth: Optional[int] = None,
+    nodes: Optional[Sequence[Sequence[int]]] = None,
+) -> Tuple[MeshFile, int]:
+    """Part of a COPC file, read by byte ranges: the points within ``bounds`` ((2, 3) or 6
+    numbers: min x y z, max x y z, in the file's coordinates; closed) from the nodes whose cubes
+    meet it, down to ``max_depth`` (None: every level; smaller is a coarser sample), or the points
+    of the chosen ``nodes`` ((depth, x, y, z) each, in that order). Returns the points as
+    :func:`read` gives a LAS file's, and the bytes read. ValueError for both or neither of
+    bounds and nodes, or a node the file does not hold; OSError for a file that is not COPC."""
+    path = _existing(path)
+    if (bounds is None) == (nodes is None):
+        raise ValueError("read_copc takes bounds or nodes (one of them)")
+    if nodes is not None:
+        keys = []
+        for node in nodes:
+            key = [_integer(v, "a node's depth, x, y, z", 0, 2**31 - 1, required=True) for v in node]
+            if len(key) != 4:
+                raise ValueError(f"a node is (depth, x, y, z), not {_shown(node)}")
+            keys.append(key)
+        result, bytes_read = _pcl_ddg.read_copc(path, keys, None, -1)
+        return _file_of(result), bytes_read
+    box = np.asarray(bounds, dtype=np.float64).reshape(-1)
+    if box.size != 6 or not np.all(np.isfinite(box)) or np.any(box[:3] > box[3:]):
+        raise ValueError(f"bounds are min x y z, max x y z (finite, min <= max), not {_shown(bounds)}")
+    depth = -1 if max_depth is None else _integer(max_depth, "max_depth", 0, 31)
+    result, bytes_read = _pcl_ddg.read_copc(path, None, box.tolist(), depth)
+    return _file_of(result), bytes_read
 
 
 def write(

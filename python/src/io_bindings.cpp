@@ -14,6 +14,7 @@
 #include "binding_common.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/cloud_pieces.h"
+#include "pcl_ddg/io/copc.h"
 #include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
@@ -270,6 +271,40 @@ py::dict lasHeader(const std::string& path) {
   return d;
 }
 
+/** read's tuple of a file read: (points, faces, fields, viewpoint, orientation, organized_shape,
+ *  precision, las). */
+py::tuple meshFileTuple(MeshFile&& file) {
+  const pcl::PCLPointCloud2& cloud = file.mesh.cloud;
+  py::dict fields;
+  // LAS: every field as stored (red green blue stay uint16, so that write gives them back).
+  const bool colours = !file.las && vertexColorLayout(cloud).has_value();
+  const std::set<std::string> coordinates = {"x", "y", "z", "_"};
+  const std::set<std::string> colour_fields = {"rgb", "rgba", "red", "green", "blue", "alpha"};
+  for (const pcl::PCLPointField& field : cloud.fields) {
+    if (coordinates.count(field.name) != 0) continue;
+    if (colours && colour_fields.count(field.name) != 0) continue;  // as "rgb" (n, 3)
+    fields[py::str(field.name)] = fieldArray(cloud, field);
+  }
+  if (colours) {
+    const VertexColors rgb = vertexColors(cloud);
+    py::array_t<std::uint8_t> array({static_cast<py::ssize_t>(rgb.cols()), py::ssize_t{3}});
+    std::memcpy(array.mutable_data(), rgb.data(), static_cast<std::size_t>(rgb.size()));
+    fields["rgb"] = array;
+  }
+  const py::object faces =
+      file.mesh.polygons.empty() ? py::object(py::none()) : facesOf(file.mesh.polygons);
+  const Eigen::Quaterniond& q = file.sensor_pose.orientation;
+  const py::object shape = cloud.height > 1 ? py::object(py::make_tuple(cloud.height, cloud.width))
+                                            : py::object(py::none());
+  const Eigen::Vector3d origin = file.sensor_pose.origin;
+  return py::make_tuple(
+      rowsArray(std::move(file.positions)), faces, fields,
+      py::make_tuple(origin.x(), origin.y(), origin.z()),
+      py::make_tuple(q.w(), q.x(), q.y(), q.z()), shape,
+      file.coordinate_precision == FieldPrecision::Double ? "double" : "float",
+      file.las ? py::cast(std::const_pointer_cast<LasLayout>(file.las)) : py::object(py::none()));
+}
+
 }  // namespace
 
 void bindIO(py::module_& m) {
@@ -324,42 +359,62 @@ void bindIO(py::module_& m) {
           py::gil_scoped_release release;
           return readMeshFile(path);
         }();
-        const pcl::PCLPointCloud2& cloud = file.mesh.cloud;
-        py::dict fields;
-        // LAS: every field as stored (red green blue stay uint16, so that write gives them back).
-        const bool colours = !file.las && vertexColorLayout(cloud).has_value();
-        const std::set<std::string> coordinates = {"x", "y", "z", "_"};
-        const std::set<std::string> colour_fields = {"rgb",   "rgba", "red",
-                                                     "green", "blue", "alpha"};
-        for (const pcl::PCLPointField& field : cloud.fields) {
-          if (coordinates.count(field.name) != 0) continue;
-          if (colours && colour_fields.count(field.name) != 0) continue;  // as "rgb" (n, 3)
-          fields[py::str(field.name)] = fieldArray(cloud, field);
-        }
-        if (colours) {
-          const VertexColors rgb = vertexColors(cloud);
-          py::array_t<std::uint8_t> array({static_cast<py::ssize_t>(rgb.cols()), py::ssize_t{3}});
-          std::memcpy(array.mutable_data(), rgb.data(), static_cast<std::size_t>(rgb.size()));
-          fields["rgb"] = array;
-        }
-        const py::object faces =
-            file.mesh.polygons.empty() ? py::object(py::none()) : facesOf(file.mesh.polygons);
-        const Eigen::Quaterniond& q = file.sensor_pose.orientation;
-        const py::object shape = cloud.height > 1
-                                     ? py::object(py::make_tuple(cloud.height, cloud.width))
-                                     : py::object(py::none());
-        const Eigen::Vector3d origin = file.sensor_pose.origin;
-        return py::make_tuple(
-            rowsArray(std::move(file.positions)), faces, fields,
-            py::make_tuple(origin.x(), origin.y(), origin.z()),
-            py::make_tuple(q.w(), q.x(), q.y(), q.z()), shape,
-            file.coordinate_precision == FieldPrecision::Double ? "double" : "float",
-            file.las ? py::cast(std::const_pointer_cast<LasLayout>(file.las))
-                     : py::object(py::none()));
+        return meshFileTuple(std::move(file));
       },
       py::arg("path"),
       "(points, faces, fields, viewpoint, orientation, organized_shape, precision, las) of a "
       "file; las: a LAS file's LasLayout, else None.");
+
+  m.def(
+      "copc_info",
+      [](const std::string& path) {
+        const CopcInfo info = [&] {
+          py::gil_scoped_release release;
+          return readCopcInfo(path);
+        }();
+        py::list nodes;
+        for (const CopcNode& n : info.nodes)
+          nodes.append(
+              py::make_tuple(n.key.depth, n.key.x, n.key.y, n.key.z, n.offset, n.bytes, n.points));
+        py::dict d;
+        d["center"] = py::make_tuple(info.center.x(), info.center.y(), info.center.z());
+        d["halfsize"] = info.halfsize;
+        d["spacing"] = info.spacing;
+        d["gpstime"] = py::make_tuple(info.gpstime_min, info.gpstime_max);
+        d["points"] = info.point_count;
+        d["hierarchy_pages"] = info.hierarchy_pages;
+        d["nodes"] = nodes;
+        return d;
+      },
+      py::arg("path"),
+      "A COPC file's octree: center, halfsize, spacing, gpstime, points, hierarchy_pages, nodes "
+      "[(depth, x, y, z, offset, bytes, points)].");
+
+  m.def(
+      "read_copc",
+      [](const std::string& path, std::optional<std::vector<std::vector<int>>> keys,
+         std::optional<std::vector<double>> bounds, int max_depth) {
+        CopcPoints part = [&] {
+          py::gil_scoped_release release;
+          if (keys) {
+            std::vector<CopcKey> chosen;
+            for (const auto& k : *keys) {
+              if (k.size() != 4) throw pcl::BadArgumentException("a node is (depth, x, y, z)");
+              chosen.push_back({k[0], k[1], k[2], k[3]});
+            }
+            return readCopcNodes(path, chosen);
+          }
+          const std::vector<double>& b = *bounds;
+          return readCopcBox(path,
+                             Eigen::AlignedBox3d(Eigen::Vector3d(b[0], b[1], b[2]),
+                                                 Eigen::Vector3d(b[3], b[4], b[5])),
+                             max_depth);
+        }();
+        return py::make_tuple(meshFileTuple(std::move(part.file)), part.bytes_read);
+      },
+      py::arg("path"), py::arg("nodes"), py::arg("bounds"), py::arg("max_depth"),
+      "(read's tuple, bytes read) of a COPC file's chosen nodes (depth, x, y, z), or of the "
+      "points within bounds (min x y z, max x y z) from the nodes down to max_depth (-1: all).");
 
   m.def(
       "write",

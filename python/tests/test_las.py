@@ -384,3 +384,73 @@ def test_bad_fields_are_refused(tmp_path):
         pcl_ddg.write(tmp_path / "x.las", m.points,
                       fields={"name": np.array(["a"] * len(m.points))})
     assert not (tmp_path / "x.las").exists()
+
+
+# --- COPC: the octree from the hierarchy, parts of the file by byte ranges --------------------
+
+
+def copc_path():
+    return las_path("laz/1.2-with-color.copc.laz")
+
+
+def test_copc_info_is_the_hierarchy_page_read_by_the_specification():
+    raw = copc_path().read_bytes()
+    # The info VLR follows the 375-byte header and its 54-byte VLR header (COPC 1.0).
+    center = struct.unpack_from("<3d", raw, 375 + 54)
+    root, size = struct.unpack_from("<2Q", raw, 375 + 54 + 40)
+    entries = [struct.unpack_from("<4iQii", raw, e) for e in range(root, root + size, 32)]
+    info = pcl_ddg.copc_info(copc_path())
+    assert info["center"] == center
+    assert info["points"] == sum(e[6] for e in entries) == 1065
+    assert info["hierarchy_pages"] == 1
+    assert [tuple(n) for n in info["nodes"]] == entries
+
+
+def test_read_copc_gives_the_files_points_by_nodes_and_by_box():
+    whole = pcl_ddg.read(copc_path())
+    info = pcl_ddg.copc_info(copc_path())
+    nodes = [n[:4] for n in info["nodes"]]
+    every, read_bytes = pcl_ddg.read_copc(copc_path(), nodes=nodes)
+    np.testing.assert_array_equal(np.unique(every.points, axis=0), np.unique(whole.points, axis=0))
+    assert every.points.shape == whole.points.shape
+    assert every.fields.keys() == whole.fields.keys()
+    assert read_bytes < os.path.getsize(copc_path()) + 2000
+    # A box over the points' south-west quarter: exactly the file's points inside it.
+    lo, hi = whole.points.min(axis=0), whole.points.max(axis=0)
+    box = np.array([lo, [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2]]])
+    part, part_bytes = pcl_ddg.read_copc(copc_path(), bounds=box)
+    inside = whole.points[np.all((whole.points >= box[0]) & (whole.points <= box[1]), axis=1)]
+    assert 50 < len(inside) < len(whole.points)
+    np.testing.assert_array_equal(np.unique(part.points, axis=0), np.unique(inside, axis=0))
+    assert len(part.points) == len(inside)
+    assert part_bytes < read_bytes
+    assert part.las is not None and part.fields["classification"].shape == (len(inside),)
+    # Down to level 1: fewer points, every one of them in the box.
+    coarse, _ = pcl_ddg.read_copc(copc_path(), bounds=box, max_depth=1)
+    assert 0 < len(coarse.points) < len(inside)
+    assert np.all((coarse.points >= box[0]) & (coarse.points <= box[1]))
+
+
+def test_read_copc_refuses_what_it_cannot_read(tmp_path):
+    with pytest.raises(ValueError, match="bounds or nodes"):
+        pcl_ddg.read_copc(copc_path())
+    with pytest.raises(ValueError, match="bounds or nodes"):
+        pcl_ddg.read_copc(copc_path(), bounds=[0] * 6, nodes=[(0, 0, 0, 0)])
+    with pytest.raises(ValueError, match="no node 4-0-0-0"):
+        pcl_ddg.read_copc(copc_path(), nodes=[(4, 0, 0, 0)])
+    with pytest.raises(ValueError, match="a node is"):
+        pcl_ddg.read_copc(copc_path(), nodes=[(0, 0, 0)])
+    with pytest.raises(ValueError, match="bounds are"):
+        pcl_ddg.read_copc(copc_path(), bounds=[1, 0, 0, 0, 0, 0])
+    with pytest.raises(ValueError, match="max_depth"):
+        pcl_ddg.read_copc(copc_path(), bounds=[0, 0, 0, 1, 1, 1], max_depth=-2)
+    with pytest.raises(OSError, match="autzen_trim.laz: COPC: not a LAS 1.4 file"):
+        pcl_ddg.copc_info(las_path("laz/autzen_trim.laz"))
+    copc = pcl_ddg.read(copc_path())  # written again: LAZ 1.4 format 7, its octree left out
+    pcl_ddg.write(tmp_path / "plain.laz", copc.points, fields=copc.fields, las=copc.las)
+    with pytest.raises(OSError, match="no COPC info VLR"):
+        pcl_ddg.copc_info(tmp_path / "plain.laz")
+    with pytest.raises(OSError, match="not a LAZ file"):
+        pcl_ddg.read_copc(las_path("test1_4.las"), bounds=[0, 0, 0, 1, 1, 1])
+    with pytest.raises(FileNotFoundError):
+        pcl_ddg.copc_info(tmp_path / "missing.copc.laz")

@@ -275,32 +275,44 @@ bool isCopcFile(const std::string& path) {
   return detail::isCopc(file);
 }
 
-CopcInfo readCopcInfo(const std::string& path) {
+namespace {
+
+/** f(file) on the file at path, its format errors naming the path. */
+template <typename F>
+auto onFile(const std::string& path, F f) {
   detail::FileRanges file(path);
   try {
-    return detail::readCopcInfo(file);
+    return f(file);
   } catch (const FileFormatException& e) {
-    throw FileFormatException(path + ": " + e.what());
+    throw FileFormatException(path + ": " + errorDescription(e));
   }
+}
+
+}  // namespace
+
+CopcInfo readCopcInfo(const std::string& path) {
+  return onFile(path, [](detail::FileRanges& file) { return detail::readCopcInfo(file); });
 }
 
 CopcPoints readCopcNodes(const std::string& path, const std::vector<CopcKey>& keys) {
-  detail::FileRanges file(path);
-  const CopcInfo info = detail::readCopcInfo(file);
-  return detail::pointsOf(detail::copcNodesAsLas(file, info, keys), file);
+  return onFile(path, [&](detail::FileRanges& file) {
+    const CopcInfo info = detail::readCopcInfo(file);
+    return detail::pointsOf(detail::copcNodesAsLas(file, info, keys), file);
+  });
 }
 
 CopcPoints readCopcBox(const std::string& path, const Eigen::AlignedBox3d& box, int max_depth) {
-  detail::FileRanges file(path);
-  const CopcInfo info = detail::readCopcInfo(file);
-  std::vector<CopcKey> keys;
-  for (const CopcNode& node : info.nodes) {
-    if (max_depth >= 0 && node.key.depth > max_depth) continue;
-    if (node.points > 0 && info.bounds(node.key).intersects(box)) keys.push_back(node.key);
-  }
-  std::string las = detail::copcNodesAsLas(file, info, keys);
-  detail::keepRecordsWithin(las, box);
-  return detail::pointsOf(las, file);
+  return onFile(path, [&](detail::FileRanges& file) {
+    const CopcInfo info = detail::readCopcInfo(file);
+    std::vector<CopcKey> keys;
+    for (const CopcNode& node : info.nodes) {
+      if (max_depth >= 0 && node.key.depth > max_depth) continue;
+      if (node.points > 0 && info.bounds(node.key).intersects(box)) keys.push_back(node.key);
+    }
+    std::string las = detail::copcNodesAsLas(file, info, keys);
+    detail::keepRecordsWithin(las, box);
+    return detail::pointsOf(las, file);
+  });
 }
 
 }  // namespace pcl_ddg
