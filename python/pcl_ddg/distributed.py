@@ -56,7 +56,7 @@ CLOUD_EXTENSIONS = (".pcd", ".ply", ".las", ".laz")
 # they do not write gives a .ply output, the one format that keeps its faces (the tools' own
 # -input_dir rule).
 MESH_EXTENSIONS = (".obj", ".off", ".stl", ".vtk")
-OUTPUT_EXTENSIONS = (".ply", ".pcd", ".las")
+OUTPUT_EXTENSIONS = (".ply", ".pcd", ".las", ".laz")
 # What a worker process holds before any tile (the interpreter, NumPy, Dask, the module), and
 # what a gathered point costs at once (float points, indices, the kd-tree, the fit, the results
 # and their copies): the tile size follows from --memory-per-worker with these.
@@ -83,6 +83,9 @@ class CloudInput:
     viewpoint: Tuple[float, float, float]
     width: int
     height: int
+    #: a LAZ file's chunks (first, count), which the plan's chunks follow: a tile then decodes
+    #: only the compressed chunks its points and halo lie in
+    chunks: Optional[List[Tuple[int, int]]] = None
 
 
 def parse_size(text: str) -> int:
@@ -117,9 +120,8 @@ def expand_inputs(inputs: Sequence[str],
             found = sorted(os.path.join(item, n) for n in os.listdir(item)
                            if n.lower().endswith(tuple(extensions)))
             if not found:
-                named = [e for e in extensions if e != ".laz"]  # (listed to be refused)
-                raise FileNotFoundError(f"{item}: no {', '.join(named[:-1])} or {named[-1]} file "
-                                        "in the folder")
+                raise FileNotFoundError(f"{item}: no {', '.join(extensions[:-1])} or "
+                                        f"{extensions[-1]} file in the folder")
             paths += found
         elif os.path.exists(item):
             paths.append(item)
@@ -142,23 +144,16 @@ def expand_inputs(inputs: Sequence[str],
 def las_header(path: str) -> Dict[str, Any]:
     """The public header block of a LAS file (and its CRS records), read by the library's LAS
     reader (the one the chunks are read with): counts, bounds, scale, offset, point format. No
-    point is read. A LAZ file gives {"compressed": True} alone."""
+    point is read. A LAZ file's (``compressed`` True) is that of the LAS file it stands for."""
     header = _pcl_ddg._las_header(os.fspath(path))
-    if not header["compressed"]:
-        header["crs"] = sorted((record, hashlib.sha256(data).hexdigest())
-                               for user, record, data in header.pop("vlrs")
-                               if user == b"LASF_Projection")
+    header["crs"] = sorted((record, hashlib.sha256(data).hexdigest())
+                           for user, record, data in header.pop("vlrs")
+                           if user == b"LASF_Projection")
     return header
 
 
 def _check_las(paths: List[str], allow_mixed_crs: bool) -> None:
     headers = [las_header(p) for p in paths]
-    for p, h in zip(paths, headers):
-        if h["compressed"]:
-            raise ValueError(f"{p}: LAZ (compressed LAS) is not read in tiles by the runner "
-                             "yet; pcl_ddg.read and the tools read it whole, or convert it once: "
-                             "m = pcl_ddg.read('in.laz'); pcl_ddg.write('in.las', m.points, "
-                             "fields=m.fields, las=m.las)")
     first = headers[0]
     for p, h in zip(paths[1:], headers[1:]):
         if h["scale"] != first["scale"] or h["offset"] != first["offset"]:
@@ -181,18 +176,20 @@ def scan_inputs(paths: List[str], allow_mixed_crs: bool = False) -> List[CloudIn
     clouds: List[CloudInput] = []
     first = 0
     for p in paths:
-        if not p.lower().endswith((".pcd", ".ply", ".las")):
-            raise ValueError(f"{p}: not a .pcd, .ply or .las cloud")
+        if not p.lower().endswith(CLOUD_EXTENSIONS):
+            raise ValueError(f"{p}: not a .pcd, .ply, .las or .laz cloud")
         try:
             layout = _pcl_ddg._cloud_layout(p)
         except OSError as error:
             raise OSError(f"{error} (pcl_ddg.distributed reads LAS, binary PCD and binary PLY "
                           "clouds by byte ranges; write it as binary PLY, e.g. "
                           "pcl_ddg.write('cloud.ply', pcl_ddg.read(path).points))") from None
+        chunks = layout["chunks"]
         clouds.append(CloudInput(p, int(layout["points"]), first,
                                  [tuple(f) for f in layout["fields"]],
                                  tuple(layout["viewpoint"]), int(layout["width"]),
-                                 int(layout["height"])))
+                                 int(layout["height"]),
+                                 None if chunks is None else [tuple(c) for c in chunks]))
         first += int(layout["points"])
     reference = clouds[0]
     names = lambda c: " ".join(f"{n}:{t}x{k}" for n, t, k, _ in c.fields)  # noqa: E731
@@ -285,8 +282,9 @@ def _grid_dims(extent: np.ndarray, tiles: int) -> Tuple[int, int, int]:
 def make_plan(client: Any, clouds: List[CloudInput], points_per_tile: int,
               options: Dict[str, Any]) -> Plan:
     chunk = max(4096, min(CHUNK_POINTS_MAX, points_per_tile // 8))
-    jobs = [(c.path, i, first, min(chunk, c.points - first))
-            for i, c in enumerate(clouds) for first in range(0, c.points, chunk)]
+    jobs = [(c.path, i, first, count) for i, c in enumerate(clouds)
+            for first, count in (c.chunks or
+                                 [(f, min(chunk, c.points - f)) for f in range(0, c.points, chunk)])]
     futures = client.map(_chunk_bounds, *zip(*jobs), pure=False, key=[
         f"pcl_ddg-bounds-{uuid.uuid4().hex[:8]}-{j}" for j in range(len(jobs))])
     results = client.gather(futures)
@@ -723,7 +721,7 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
     # Aerial LiDAR has no single viewpoint: LAS inputs are oriented up unless told otherwise, as
     # the tools orient them (fit_steps.h, orientLasUp).
     las_up = orient is None and viewpoint is None and all(
-        c.path.lower().endswith(".las") for c in clouds)
+        c.path.lower().endswith((".las", ".laz")) for c in clouds)
     if las_up:
         options["orient"] = "up"
         if progress:
@@ -739,10 +737,11 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
             raise ValueError("two inputs have the same file name: give --merge FILE")
         outputs = [os.path.join(output_dir, n) for n in names]
     else:
-        if os.path.splitext(merge)[1].lower() not in (".ply", ".pcd", ".las"):
-            raise ValueError(f"--merge {merge}: the output must be .ply, .pcd or .las")
-        if merge.lower().endswith(".las") and not clouds[0].path.lower().endswith(".las"):
-            raise ValueError(f"--merge {merge}: a .las output keeps a LAS input's layout "
+        if os.path.splitext(merge)[1].lower() not in OUTPUT_EXTENSIONS:
+            raise ValueError(f"--merge {merge}: the output must be .ply, .pcd, .las or .laz")
+        if merge.lower().endswith((".las", ".laz")) and \
+                not clouds[0].path.lower().endswith((".las", ".laz")):
+            raise ValueError(f"--merge {merge}: a LAS or LAZ output keeps a LAS input's layout "
                              "(scale, offset, VLRs): the inputs are not LAS")
         outputs = [merge]
     os.makedirs(output_dir, exist_ok=True)

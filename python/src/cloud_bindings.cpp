@@ -1,7 +1,7 @@
-// Point cloud functions: fitted normals and curvatures (pca, quadric, robust) with kd-tree, mesh-ring or
-// pixel-grid neighbourhoods, orientation, and the neighbourhood comparison. The points are placed
-// about their local origin as the tools place a file's (local_cloud.h), so results equal the
-// tools'.
+// Point cloud functions: fitted normals and curvatures (pca, quadric, robust) with kd-tree,
+// mesh-ring or pixel-grid neighbourhoods, orientation, and the neighbourhood comparison. The points
+// are placed about their local origin as the tools place a file's (local_cloud.h), so results equal
+// the tools'.
 #include <pcl/exceptions.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>

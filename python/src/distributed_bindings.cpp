@@ -42,10 +42,12 @@ py::dict cloudLayout(const std::string& path) {
   py::list fields;
   CloudFileLayout layout;
   pcl::PCLPointCloud2 empty;
+  std::vector<std::pair<std::int64_t, std::int64_t>> chunks;
   {
     py::gil_scoped_release release;
     CloudPieceReader pieces(path);
     layout = pieces.layout();
+    chunks = pieces.lazChunks();
     empty = pieces.read(0, std::min<std::int64_t>(1, layout.points)).cloud;
   }
   for (const auto& f : empty.fields)
@@ -61,6 +63,7 @@ py::dict cloudLayout(const std::string& path) {
   d["orientation"] = py::make_tuple(pose.orientation.w(), pose.orientation.x(),
                                     pose.orientation.y(), pose.orientation.z());
   d["fields"] = fields;
+  d["chunks"] = chunks.empty() ? py::object(py::none()) : py::cast(chunks);
   return d;
 }
 
@@ -146,9 +149,9 @@ Eigen::AlignedBox3d boxOf(const std::vector<double>& b) {
  * Fits the `own` points of a gathered tile (points in the merged cloud's order, so that the
  * kd-tree's ties break as on the whole cloud). mode "certified": a point's fit counts only when
  * its k-th neighbour among the gathered points (widened by the rounding margin) is nearer than the
- * halo box's edge (haloReach, tile_certificate.h), as the fit's own search finds it; the others come back uncertified,
- * with how far they looked, for a wider gather. "all": every own point is fitted. Radius searches
- * are certified by a halo of the radius, so the check applies to k only.
+ * halo box's edge (haloReach, tile_certificate.h), as the fit's own search finds it; the others
+ * come back uncertified, with how far they looked, for a wider gather. "all": every own point is
+ * fitted. Radius searches are certified by a halo of the radius, so the check applies to k only.
  * Returns (records (n_own, 4 or 9) float32: nx ny nz curvature [pc1 pc2 k1 direction],
  * certified, looking distance, reach (how far each point may look inside the halo box; infinity
  * unchecked), failed, fallback).
@@ -337,8 +340,8 @@ std::int64_t writeOutput(const std::vector<std::string>& inputs, const std::stri
                          const std::string& tool, const std::string& precision_name,
                          std::int64_t piece_points, bool stream_pcd) {
   const std::string ext = fileExtension(output);
-  if (ext != "ply" && ext != "pcd" && ext != "las")
-    throw FileFormatException(output + ": the output must be .ply, .pcd or .las");
+  if (ext != "ply" && ext != "pcd" && ext != "las" && ext != "laz")
+    throw FileFormatException(output + ": the output must be .ply, .pcd, .las or .laz");
   choice("tool", tool, {"normals", "curvature"});
   const FieldPrecision precision =
       choice("precision", precision_name, {"float", "double"}) == "double" ? FieldPrecision::Double
@@ -458,8 +461,9 @@ void bindDistributed(py::module_& m) {
         py::arg("max_nn"), py::arg("orient"), py::arg("viewpoint"), py::arg("up"),
         "The runner's (k, max_nn), checked as the tools check them.");
   m.def("_cloud_layout", &cloudLayout, py::arg("path"),
-        "How a binary PCD/PLY cloud lies on disk (header only): points, header_bytes, "
-        "point_bytes, width, height, viewpoint, orientation, fields.");
+        "How a binary PCD/PLY or LAS/LAZ cloud lies on disk (header only): points, "
+        "header_bytes, point_bytes, width, height, viewpoint, orientation, fields, chunks (a LAZ "
+        "file's (first, count) per chunk, else None).");
   m.def("_read_positions", &readPositions, py::arg("path"), py::arg("first"), py::arg("count"),
         "Points [first, first + count) of a cloud file as float64 (n, 3), read by their byte "
         "range, exact (LAS: X * scale + offset).");

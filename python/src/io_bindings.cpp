@@ -243,18 +243,14 @@ py::dict lasHeader(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     in.read(head.data(), static_cast<std::streamsize>(head.size()));
     compressed = in.gcount() == static_cast<std::streamsize>(head.size()) &&
-                 head.compare(0, 4, "LASF") == 0 &&
-                 (lasIsCompressed(head) || fileExtension(path) == "laz");
-    if (!compressed) {
-      CloudPieceReader pieces(path);
-      file = pieces.layout();
-      las = pieces.lasLayout();
-      if (las == nullptr) throw FileFormatException(path + ": not a LAS file (no LASF signature)");
-    }
+                 head.compare(0, 4, "LASF") == 0 && lasIsCompressed(head);
+    CloudPieceReader pieces(path);  // LAZ: the header of the LAS file it stands for
+    file = pieces.layout();
+    las = pieces.lasLayout();
+    if (las == nullptr) throw FileFormatException(path + ": not a LAS file (no LASF signature)");
   }
   py::dict d;
   d["compressed"] = compressed;
-  if (compressed) return d;
   d["version"] = std::to_string(las->version_major) + "." + std::to_string(las->version_minor);
   d["point_format"] = las->point_format;
   d["record_length"] = las->record_length;
@@ -347,10 +343,10 @@ void bindIO(py::module_& m) {
       });
 
   m.def("_las_header", &lasHeader, py::arg("path"),
-        "A LAS file's header and VLRs as the library reads them (no point is read): compressed, "
+        "A LAS file's header and VLRs as the library reads them (no point is read): "
         "version, point_format, record_length, points, scale, offset, bounds (min x y z, max x y "
-        "z), data_offset, vlrs [(user_id bytes, record_id, data bytes)]; a LAZ file gives "
-        "{'compressed': True} alone.");
+        "z), data_offset, vlrs [(user_id bytes, record_id, data bytes)], compressed (LAZ: the "
+        "header of the LAS file it stands for).");
 
   m.def(
       "read",

@@ -6,11 +6,15 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "las_format.h"
+#include "laz/laz_codec.h"
+#include "loader_threads.h"
 #include "mesh_formats.h"
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/atomic_file.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
 
 namespace pcl_ddg {
@@ -31,6 +35,20 @@ void putLE(std::string& bytes, std::size_t at, T value) {
   std::memcpy(bytes.data() + at, &value, sizeof(T));
 }
 
+/** Whether a LAS file's header and VLRs hold COPC's info VLR (its one EVLR is then the
+ *  hierarchy, which no output keeps: las_plan.cpp). */
+bool isCopcPrefix(const std::string& prefix) {
+  const std::uint32_t vlrs = getLE<std::uint32_t>(prefix, 100);
+  std::size_t at = getLE<std::uint16_t>(prefix, 94);
+  for (std::uint32_t i = 0; i < vlrs && at + 54 <= prefix.size(); ++i) {
+    if (prefix.compare(at + 2, 5, std::string("copc\0", 5)) == 0 &&
+        getLE<std::uint16_t>(prefix, at + 18) == 1)
+      return getLE<std::uint32_t>(prefix, 243) == 1;
+    at += 54 + getLE<std::uint16_t>(prefix, at + 20);
+  }
+  return false;
+}
+
 bool declaresDoubleCoordinates(const pcl::PCLPointCloud2& cloud) {
   return std::any_of(cloud.fields.begin(), cloud.fields.end(), [](const pcl::PCLPointField& f) {
     return (f.name == "x" || f.name == "y" || f.name == "z") &&
@@ -47,6 +65,11 @@ struct CloudPieceReader::Format {
   std::string (*header_for)(const std::string&, std::int64_t) = nullptr;
   std::uint8_t las_minor = 0;
   bool las_legacy_count = false;
+  /** A LAZ file: its chunks, and the records of the last run of chunks decoded (consecutive
+   *  pieces often share a chunk). */
+  std::optional<detail::LazChunkIndex> laz;
+  std::size_t decoded_first = 0, decoded_last = 0;
+  std::string decoded;  // empty: none yet
 
   std::string headerFor(std::int64_t count) const {
     if (!las) return header_for(header, count);
@@ -79,12 +102,26 @@ CloudPieceReader::CloudPieceReader(const std::string& path)
     in_.read(head.data(), static_cast<std::streamsize>(head.size()));
     if (in_.gcount() < 227 || head.compare(0, 4, "LASF") != 0)
       throw FileFormatException(path + ": not a LAS file (no LASF signature)");
-    if (lasIsCompressed(head)) {
-      throw FileFormatException(path +
-                                ": LAZ (compressed LAS) is not read in pieces: run without "
-                                "-memory (LAZ is read whole), or write it as .las first");
-    }
     Format& f = *format_;
+    if (lasIsCompressed(head)) {
+      // LAZ: its chunks found from the chunk table, the pieces' header that of the LAS file it
+      // stands for, their records decoded chunk by chunk.
+      try {
+        f.laz = detail::indexLazChunks(
+            [&](std::uint64_t offset, std::uint64_t count) { return readBytes(offset, count); },
+            static_cast<std::uint64_t>(size));
+      } catch (const pcl::PCLException& e) {
+        throw FileFormatException(path + ": " + errorDescription(e));
+      }
+      if (getLE<std::uint8_t>(head, 25) >= 4 && head.size() >= 375 &&
+          getLE<std::uint32_t>(head, 243) != 0 && !isCopcPrefix(f.laz->prefix))
+        throw FileFormatException(path + ": a LAS file with EVLRs is not read in pieces");
+      // Its header as the LAS file's (the prefix counts no points: the counts are the file's).
+      const std::string counts = head;
+      head = f.laz->las_prefix.substr(0, head.size());
+      head.replace(107, 4, counts, 107, 4);
+      if (head.size() >= 255) head.replace(247, 8, counts, 247, 8);
+    }
     f.las = true;
     f.las_minor = static_cast<std::uint8_t>(head[25]);
     const auto point_offset = getLE<std::uint32_t>(head, 96);
@@ -97,14 +134,14 @@ CloudPieceReader::CloudPieceReader(const std::string& path)
       if (getLE<std::uint32_t>(head, 243) != 0)
         throw FileFormatException(path + ": a LAS file with EVLRs is not read in pieces");
     }
-    if (point_offset > size || layout_.point_bytes == 0 || layout_.points < 0 ||
-        (size - point_offset) / layout_.point_bytes < layout_.points)
-      throw FileFormatException(path + ": shorter than its points (truncated?)");
-    f.header.resize(point_offset);
-    in_.seekg(0);
-    in_.read(f.header.data(), static_cast<std::streamsize>(point_offset));
-    if (in_.gcount() != static_cast<std::streamsize>(point_offset))
-      throw FileFormatException(path + ": cannot read its header");
+    if (f.laz) {
+      f.header = f.laz->las_prefix;
+    } else {
+      if (point_offset > size || layout_.point_bytes == 0 || layout_.points < 0 ||
+          (size - point_offset) / layout_.point_bytes < layout_.points)
+        throw FileFormatException(path + ": shorter than its points (truncated?)");
+      f.header = readBytes(0, point_offset);
+    }
     layout_.width = static_cast<std::uint32_t>(layout_.points);
     layout_.height = 1;
     try {  // the layout, from the header and VLRs as a file of no points
@@ -160,12 +197,13 @@ CloudPiece CloudPieceReader::read(std::int64_t first, std::int64_t count) {
   }
   std::string file = format_->headerFor(count);
   const std::size_t header = file.size();
-  file.resize(header + static_cast<std::size_t>(count * layout_.point_bytes));
-  in_.clear();
-  in_.seekg(layout_.header_bytes + first * layout_.point_bytes);
-  in_.read(file.data() + header, static_cast<std::streamsize>(file.size() - header));
-  if (in_.gcount() != static_cast<std::streamsize>(file.size() - header))
-    throw FileFormatException(path_ + ": cannot read points " + std::to_string(first) + "..");
+  const auto bytes = static_cast<std::size_t>(count * layout_.point_bytes);
+  if (format_->laz) {
+    file += lazRecords(first, count);
+  } else {
+    file += readBytes(
+        static_cast<std::uint64_t>(layout_.header_bytes + first * layout_.point_bytes), bytes);
+  }
   CloudPiece piece;
   try {
     if (format_->las) {
@@ -184,8 +222,96 @@ CloudPiece CloudPieceReader::read(std::int64_t first, std::int64_t count) {
   return piece;
 }
 
+std::vector<std::pair<std::int64_t, std::int64_t>> CloudPieceReader::lazChunks() const {
+  std::vector<std::pair<std::int64_t, std::int64_t>> chunks;
+  if (format_->laz)
+    for (const auto& c : format_->laz->chunks)
+      chunks.emplace_back(static_cast<std::int64_t>(c.first_point),
+                          static_cast<std::int64_t>(c.points));
+  return chunks;
+}
+
+std::string CloudPieceReader::readBytes(std::uint64_t offset, std::uint64_t count) {
+  std::string bytes(static_cast<std::size_t>(count), '\0');
+  in_.clear();
+  in_.seekg(static_cast<std::streamoff>(offset));
+  in_.read(bytes.data(), static_cast<std::streamsize>(count));
+  if (in_.gcount() != static_cast<std::streamsize>(count))
+    throw FileFormatException(path_ + ": cannot read bytes " + std::to_string(offset) + ".." +
+                              std::to_string(offset + count) + " (truncated?)");
+  return bytes;
+}
+
+std::string CloudPieceReader::lazRecords(std::int64_t first, std::int64_t count) {
+  Format& f = *format_;
+  const auto& chunks = f.laz->chunks;
+  if (count == 0) return {};
+  // The chunks holding the first and the last point.
+  const auto chunkOf = [&](std::uint64_t point) {
+    return static_cast<std::size_t>(
+        std::upper_bound(chunks.begin(), chunks.end(), point,
+                         [](std::uint64_t p, const auto& c) { return p < c.first_point; }) -
+        chunks.begin() - 1);
+  };
+  const std::size_t a = chunkOf(static_cast<std::uint64_t>(first));
+  const std::size_t b = chunkOf(static_cast<std::uint64_t>(first + count - 1));
+  if (f.decoded.empty() || a < f.decoded_first || b > f.decoded_last) {
+    const std::string bytes = readBytes(chunks[a].begin, chunks[b].end - chunks[a].begin);
+    try {
+      f.decoded = detail::decodeLazChunks(*f.laz, a, b, bytes, detail::loaderThreads());
+    } catch (const pcl::PCLException& e) {
+      throw FileFormatException(path_ + ": " + errorDescription(e));
+    }
+    f.decoded_first = a;
+    f.decoded_last = b;
+  }
+  const std::uint64_t skip =
+      static_cast<std::uint64_t>(first) - chunks[f.decoded_first].first_point;
+  return f.decoded.substr(static_cast<std::size_t>(skip * layout_.point_bytes),
+                          static_cast<std::size_t>(count * layout_.point_bytes));
+}
+
+/** A LAS output written in pieces; a LAZ one is that LAS file, next to it (removed whatever
+ *  happens, Ctrl-C included: an uncommitted AtomicFile), compressed at close a chunk at a time. */
 struct CloudPieceWriter::Las {
-  Las(const std::string& path, const LasLayout& layout) : writer(path, layout) {}
+  Las(const std::string& path, const LasLayout& layout, bool compressed)
+      : laz_path(compressed ? path : std::string()),
+        records(compressed ? std::make_unique<AtomicFile>(path + ".las") : nullptr),
+        writer(records ? records->temporaryPath() : path, layout) {}
+
+  void close() {
+    writer.close();
+    if (!records) return;
+    std::ifstream las(records->temporaryPath(), std::ios::binary);
+    std::ofstream laz(laz_path, std::ios::binary | std::ios::trunc);
+    if (!las || !laz) failSystem("cannot write " + laz_path);
+    const auto size =
+        static_cast<std::uint64_t>(std::filesystem::file_size(records->temporaryPath()));
+    detail::lasToLaz(
+        [&](std::uint64_t offset, std::uint64_t count) {
+          std::string bytes(static_cast<std::size_t>(count), '\0');
+          las.seekg(static_cast<std::streamoff>(offset));
+          las.read(bytes.data(), static_cast<std::streamsize>(count));
+          if (las.gcount() != static_cast<std::streamsize>(count))
+            failSystem("cannot read back " + records->temporaryPath());
+          return bytes;
+        },
+        size,
+        {[&](std::string_view bytes) {
+           laz.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+         },
+         [&](std::uint64_t at, std::string_view bytes) {
+           const std::streampos end = laz.tellp();
+           laz.seekp(static_cast<std::streamoff>(at));
+           laz.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+           laz.seekp(end);
+         }});
+    laz.close();
+    if (!laz) failSystem("cannot write " + laz_path);
+  }
+
+  std::string laz_path;                 // empty: a .las output
+  std::unique_ptr<AtomicFile> records;  // a .laz output's LAS records, never committed
   detail::LasPieceWriter writer;
 };
 
@@ -198,14 +324,15 @@ CloudPieceWriter::CloudPieceWriter(const std::string& path, const std::string& f
       width_(width),
       height_(height),
       sensor_pose_(sensor_pose) {
-  if (format != "ply" && format != "pcd" && format != "las")
-    throw FileFormatException(path + ": pieces are written as .ply, .pcd or .las");
-  if (format == "las") {
+  if (format != "ply" && format != "pcd" && format != "las" && format != "laz")
+    throw FileFormatException(path + ": pieces are written as .ply, .pcd, .las or .laz");
+  if (format == "las" || format == "laz") {
     if (!las) {
-      throw FileFormatException(
-          "a .las output written in pieces keeps a LAS input's layout: the input is not LAS");
+      throw FileFormatException("a ." + format +
+                                " output written in pieces keeps a LAS input's layout: the input "
+                                "is not LAS");
     }
-    las_ = std::make_unique<Las>(path, *las);
+    las_ = std::make_unique<Las>(path, *las, format == "laz");
     return;
   }
   out_.open(path, std::ios::binary);
@@ -259,7 +386,7 @@ void CloudPieceWriter::write(pcl::PCLPointCloud2& piece) {
 
 void CloudPieceWriter::close() {
   if (las_) {
-    las_->writer.close();
+    las_->close();
     return;
   }
   out_.close();

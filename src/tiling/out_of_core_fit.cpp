@@ -191,12 +191,13 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
   if (options.neighbourhood != NeighbourhoodKind::KdTree)
     throw pcl::BadArgumentException("a cloud out of core is fitted with kd-tree neighbourhoods");
   const std::string output_format = fileExtension(output);
-  if (output_format != "ply" && output_format != "pcd" && output_format != "las")
-    throw FileFormatException(output + ": the output must be .ply, .pcd or .las");
+  if (output_format != "ply" && output_format != "pcd" && output_format != "las" &&
+      output_format != "laz")
+    throw FileFormatException(output + ": the output must be .ply, .pcd, .las or .laz");
   CloudPieceReader pieces(input);
-  if (output_format == "las" && !pieces.lasLayout())
-    throw FileFormatException(output +
-                              ": a .las output out of core needs a .las input (its layout)");
+  if ((output_format == "las" || output_format == "laz") && !pieces.lasLayout())
+    throw FileFormatException(output + ": a ." + output_format +
+                              " output out of core needs a .las or .laz input (its layout)");
   const CloudFileLayout& layout = pieces.layout();
   OutOfCoreReport report;
   report.points = layout.points;

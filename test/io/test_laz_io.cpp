@@ -3,6 +3,7 @@
 // same points in octree order; our encoder's files decode bit for bit to what it encoded; corrupt
 // and truncated files are refused with one line, never read past their bytes.
 #include <gtest/gtest.h>
+#include <pcl/exceptions.h>
 
 #include <algorithm>
 #include <array>
@@ -18,6 +19,7 @@
 
 #include "io/laz/laz_codec.h"
 #include "pcl_ddg/exceptions.h"
+#include "pcl_ddg/io/cloud_pieces.h"
 #include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
@@ -208,6 +210,53 @@ TEST(LazIO, IdenticalPointsAndAStaleLaszipRecordRoundTrip) {
 
 // Truncated anywhere, or with a chunk table that lies, a LAZ file is refused, never read past
 // its end (the sanitizer build runs this too).
+// A LAZ file read in pieces (the out-of-core fit, the Dask runner): each piece decodes the chunks
+// holding its points, and is the piece of the uncompressed twin, field for field. Ranges within a
+// chunk, across chunk ends, the whole file, in any order (a decoded run is reused or replaced).
+TEST(LazIO, PiecesOfALazFileAreThePiecesOfItsTwin) {
+  CloudPieceReader laz(sharedData("las/laz/autzen_trim.laz")),
+      las(sharedData("las/autzen_trim.las"));
+  ASSERT_EQ(laz.layout().points, 110000);
+  EXPECT_EQ(laz.layout().point_bytes, las.layout().point_bytes);
+  ASSERT_TRUE(laz.lasLayout() && las.lasLayout());
+  EXPECT_EQ(laz.lasLayout()->vlrs.size(), las.lasLayout()->vlrs.size());
+  const std::pair<std::int64_t, std::int64_t> ranges[] = {
+      {0, 10},     {49990, 20},     {49990, 10}, {50000, 1}, {20000, 80000}, {0, 110000},
+      {109999, 1}, {100000, 10000}, {5, 0},      {60000, 5}, {12345, 54321}};
+  for (const auto& [first, count] : ranges) {
+    const CloudPiece a = laz.read(first, count), b = las.read(first, count);
+    ASSERT_EQ(a.positions.cols(), count) << first;
+    EXPECT_TRUE(a.positions == b.positions) << first << " " << count;
+    EXPECT_TRUE(a.cloud.data == b.cloud.data) << first << " " << count;
+  }
+  EXPECT_THROW(laz.read(109999, 2), pcl::BadArgumentException);
+  // The COPC file's 65 chunks of variable size: the same points as the file read whole.
+  CloudPieceReader copc(sharedData("las/laz/1.2-with-color.copc.laz"));
+  const MeshFile whole = readMeshFile(sharedData("las/laz/1.2-with-color.copc.laz"));
+  for (std::int64_t first = 0; first < 1065; first += 100) {
+    const std::int64_t count = std::min<std::int64_t>(137, 1065 - first);
+    EXPECT_TRUE(copc.read(first, count).positions == whole.positions.middleCols(first, count))
+        << first;
+  }
+}
+
+TEST(LazIO, AFileWithoutAUsableChunkTableIsNotReadInPieces) {
+  const std::string folder = scratchFolder("laz_pieces_refused");
+  std::string b = readBytes(sharedData("las/laz/autzen_trim.laz"));
+  const auto point_offset = at<std::uint32_t>(b, 96);
+  const std::int64_t beyond = static_cast<std::int64_t>(b.size()) + 100;
+  std::memcpy(&b[point_offset], &beyond, 8);  // the table's offset past the end
+  writeText(folder + "/lost.laz", b);
+  try {
+    CloudPieceReader reader(folder + "/lost.laz");
+    ADD_FAILURE() << "read in pieces";
+  } catch (const FileFormatException& e) {
+    EXPECT_NE(std::string(e.what()).find("chunk table is unusable"), std::string::npos) << e.what();
+  }
+  // Read whole, the chunks are found one after another.
+  EXPECT_EQ(readMeshFile(folder + "/lost.laz").positions.cols(), 110000);
+}
+
 TEST(LazIO, TruncatedAndLyingFilesAreRefused) {
   const std::string laz = readBytes(sharedData("las/laz/autzen_trim.laz"));
   const auto points_at = at<std::uint32_t>(laz, 96);

@@ -353,10 +353,11 @@ int fitEachInputOutOfCore(const char* tool_name, const ToolArguments& args,
                           const LocalFitOptions& options, FieldPrecision precision,
                           const PieceFields& add) {
   memoryArgument(args);  // checked before any file is read
-  return forEachInput(args, tool_name, {"ply", "pcd", "las"},
+  return forEachInput(args, tool_name, {"ply", "pcd", "las", "laz"},
                       [&](const std::string& input, const std::string& output) {
                         LocalFitOptions for_input = options;
-                        orientLasUp(tool_name, args, fileExtension(input) == "las", for_input);
+                        const std::string ext = fileExtension(input);
+                        orientLasUp(tool_name, args, ext == "las" || ext == "laz", for_input);
                         fitOutOfCore(tool_name, args, input, output, for_input,
                                      outOfCoreFields(output, precision, add));
                       });

@@ -5,9 +5,10 @@
  * (the Python module's Dask runner). A piece is parsed by the same parser as the whole file would
  * be, so every value converts exactly as it does when the file is read at once.
  *
- * Read: binary PCD (uncompressed), binary PLY clouds (one vertex element, no faces) and LAS 1.0-1.4
- * without EVLRs. Written: binary PCD, binary PLY, or LAS in the layout of a LAS input, with the
- * header of the whole.
+ * Read: binary PCD (uncompressed), binary PLY clouds (one vertex element, no faces), LAS 1.0-1.4
+ * without EVLRs, and LAZ with a chunk table (a piece decodes the chunks that hold its points; a
+ * COPC file's hierarchy EVLR is allowed). Written: binary PCD, binary PLY, or LAS in the layout of
+ * a LAS input, with the header of the whole.
  */
 #include <pcl/PCLPointCloud2.h>
 
@@ -16,6 +17,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pcl_ddg/io/las_layout.h"
@@ -54,9 +56,16 @@ class CloudPieceReader {
   const std::shared_ptr<const LasLayout>& lasLayout() const;
   /** pcl::BadArgumentException when the range is not in the file. */
   CloudPiece read(std::int64_t first, std::int64_t count);
+  /** A LAZ file's chunks as (first point, points), in file order (a COPC file's: its nodes);
+   *  empty for other files. A piece within a chunk decodes that chunk only. */
+  std::vector<std::pair<std::int64_t, std::int64_t>> lazChunks() const;
 
  private:
   struct Format;
+  /** The file's bytes [offset, offset + count); FileFormatException when it holds fewer. */
+  std::string readBytes(std::uint64_t offset, std::uint64_t count);
+  /** A LAZ file's records of points [first, first + count), from the chunks that hold them. */
+  std::string lazRecords(std::int64_t first, std::int64_t count);
   std::string path_;
   std::ifstream in_;
   CloudFileLayout layout_;
@@ -65,10 +74,11 @@ class CloudPieceReader {
 };
 
 /** Writes a cloud of `points` points a piece at a time into `path` (the caller's temporary file:
- *  see atomic_file.h) in `format` ("ply", "pcd" or "las"), as saveMesh writes it: binary PLY,
- *  binary PCD (colours in the format's layout, no padding fields), or LAS in the layout `las`
- *  (required for "las": a LAS input's, whose scale and offset hold the points). The first piece's
- *  fields make the header; every piece must have them. */
+ *  see atomic_file.h) in `format` ("ply", "pcd", "las" or "laz"), as saveMesh writes it: binary
+ *  PLY, binary PCD (colours in the format's layout, no padding fields), or LAS in the layout `las`
+ *  (required for "las" and "laz": a LAS input's, whose scale and offset hold the points); LAZ is
+ *  the LAS file, written beside `path` and compressed into it at close(), a chunk at a time.
+ *  The first piece's fields make the header; every piece must have them. */
 class CloudPieceWriter {
  public:
   CloudPieceWriter(const std::string& path, const std::string& format, std::int64_t points,

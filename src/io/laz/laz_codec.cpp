@@ -60,7 +60,9 @@ struct LasHeader {
   bool has_evlrs = false;
 };
 
-LasHeader parseHeader(std::string_view file) {
+/** The header of a file of file_size bytes from its first bytes `file` (the header and VLRs at
+ *  least, or the whole file). */
+LasHeader parseHeader(std::string_view file, std::uint64_t file_size) {
   const auto* p = reinterpret_cast<const std::uint8_t*>(file.data());
   if (file.size() < 227 || file.substr(0, 4) != "LASF")
     fail("not a LAS/LAZ file (no \"LASF\" signature and 227-byte header)");
@@ -74,22 +76,26 @@ LasHeader parseHeader(std::string_view file) {
   h.point_count = load<std::uint32_t>(p + 107);
   if (h.header_size < 227 || h.header_size > file.size())
     fail("header size " + std::to_string(h.header_size) + " is not within the file");
-  if (h.point_offset < h.header_size || h.point_offset > file.size())
+  if (h.point_offset < h.header_size || h.point_offset > file_size)
     fail("offset to point data " + std::to_string(h.point_offset) + " is not within the file");
-  h.points_end = file.size();
+  h.points_end = file_size;
   if (h.minor >= 4 && h.header_size >= 375) {
     const std::uint64_t count = load<std::uint64_t>(p + 247);
     if (count != 0 || h.point_count == 0) h.point_count = count;
     const std::uint64_t evlr_start = load<std::uint64_t>(p + 235);
     const std::uint32_t evlr_count = load<std::uint32_t>(p + 243);
     if (evlr_count > 0) {
-      if (evlr_start < h.point_offset || evlr_start > file.size())
+      if (evlr_start < h.point_offset || evlr_start > file_size)
         fail("start of the EVLRs " + std::to_string(evlr_start) + " is not after the points");
       h.points_end = evlr_start;
       h.has_evlrs = true;
     }
   }
   return h;
+}
+
+LasHeader parseHeader(std::string_view file) {
+  return parseHeader(file, file.size());
 }
 
 struct Vlr {
@@ -365,19 +371,28 @@ std::string chunkName(std::size_t index, std::size_t count) {
  * The chunk table at `table_offset`, checked against the point data [data_begin, data_end) and
  * the point count; nullopt (with the reason) when missing or unusable.
  */
-std::optional<std::vector<Chunk>> readChunkTable(const std::uint8_t* file, std::uint64_t data_begin,
-                                                 std::uint64_t data_end, std::int64_t table_offset,
-                                                 const LaszipInfo& info, std::uint64_t point_count,
-                                                 std::uint16_t record_length, std::string& why) {
-  const std::uint64_t chunks_begin = data_begin + 8;
-  if (table_offset < 0 || static_cast<std::uint64_t>(table_offset) < chunks_begin ||
+/** Whether a chunk table may start at table_offset: after the chunks, 8 bytes before data_end. */
+bool tableOffsetValid(std::uint64_t data_begin, std::uint64_t data_end, std::int64_t table_offset,
+                      std::string& why) {
+  if (table_offset < 0 || static_cast<std::uint64_t>(table_offset) < data_begin + 8 ||
       static_cast<std::uint64_t>(table_offset) + 8 > data_end) {
     why = "its offset " + std::to_string(table_offset) + " is not after the chunks";
-    return std::nullopt;
+    return false;
   }
-  const std::uint64_t table = static_cast<std::uint64_t>(table_offset);
-  const std::uint32_t version = load<std::uint32_t>(file + table);
-  const std::uint32_t count = load<std::uint32_t>(file + table + 4);
+  return true;
+}
+
+/** The chunks, from the table's bytes [table_bytes, table_end) (the file's from `table`, a valid
+ *  offset, to the end of the point data); the chunks start at data_begin + 8. */
+std::optional<std::vector<Chunk>> decodeChunkTable(const std::uint8_t* table_bytes,
+                                                   const std::uint8_t* table_end,
+                                                   std::uint64_t data_begin, std::uint64_t table,
+                                                   const LaszipInfo& info,
+                                                   std::uint64_t point_count,
+                                                   std::uint16_t record_length, std::string& why) {
+  const std::uint64_t chunks_begin = data_begin + 8;
+  const std::uint32_t version = load<std::uint32_t>(table_bytes);
+  const std::uint32_t count = load<std::uint32_t>(table_bytes + 4);
   if (version != 0) {
     why = "its version is " + std::to_string(version) + ", not 0";
     return std::nullopt;
@@ -393,7 +408,7 @@ std::optional<std::vector<Chunk>> readChunkTable(const std::uint8_t* file, std::
   try {
     if (count > 0) {
       laz::ArithmeticDecoder dec;
-      dec.init(file + table + 8, file + data_end);
+      dec.init(table_bytes + 8, table_end);
       laz::IntegerCompressor ic(32, 2, true);
       std::int32_t last_count = 0, last_size = 0;
       for (std::uint32_t i = 0; i < count; ++i) {
@@ -431,6 +446,16 @@ std::optional<std::vector<Chunk>> readChunkTable(const std::uint8_t* file, std::
     return std::nullopt;
   }
   return chunks;
+}
+
+std::optional<std::vector<Chunk>> readChunkTable(const std::uint8_t* file, std::uint64_t data_begin,
+                                                 std::uint64_t data_end, std::int64_t table_offset,
+                                                 const LaszipInfo& info, std::uint64_t point_count,
+                                                 std::uint16_t record_length, std::string& why) {
+  if (!tableOffsetValid(data_begin, data_end, table_offset, why)) return std::nullopt;
+  const auto table = static_cast<std::uint64_t>(table_offset);
+  return decodeChunkTable(file + table, file + data_end, data_begin, table, info, point_count,
+                          record_length, why);
 }
 
 /** Decodes the chunks into out (record k of the file at out + k * record_length). */
@@ -665,18 +690,14 @@ class ChunkEncoder {
   laz::ArithmeticEncoder enc_;
 };
 
-/** Appends the chunk table (version 0, count, then each chunk's point count when `points` is
- *  given, a variable-chunk file's, and byte count, coded from the previous chunk's) and stores
- *  its offset at the start of the point data. */
-void appendChunkTable(std::string& laz, std::uint64_t point_offset,
-                      const std::vector<std::uint32_t>& points,
-                      const std::vector<std::uint32_t>& bytes) {
-  const std::uint64_t table_offset = laz.size();
-  store<std::int64_t>(reinterpret_cast<std::uint8_t*>(&laz[point_offset]),
-                      static_cast<std::int64_t>(table_offset));
-  ChunkEncoder::appendU32(laz, 0);
-  ChunkEncoder::appendU32(laz, static_cast<std::uint32_t>(bytes.size()));
-  if (bytes.empty()) return;
+/** The chunk table: version 0, count, then each chunk's point count when `points` is given (a
+ *  variable-chunk file's) and byte count, coded from the previous chunk's. */
+std::string chunkTable(const std::vector<std::uint32_t>& points,
+                       const std::vector<std::uint32_t>& bytes) {
+  std::string table;
+  ChunkEncoder::appendU32(table, 0);
+  ChunkEncoder::appendU32(table, static_cast<std::uint32_t>(bytes.size()));
+  if (bytes.empty()) return table;
   laz::ArithmeticEncoder enc;
   enc.init();
   laz::IntegerCompressor ic(32, 2, false);
@@ -690,7 +711,8 @@ void appendChunkTable(std::string& laz, std::uint64_t point_offset,
     last_bytes = static_cast<std::int32_t>(bytes[i]);
   }
   enc.done();
-  laz.append(reinterpret_cast<const char*>(enc.bytes().data()), enc.bytes().size());
+  table.append(reinterpret_cast<const char*>(enc.bytes().data()), enc.bytes().size());
+  return table;
 }
 
 std::string laszipVlr(const std::vector<Item>& items, bool layered) {
@@ -723,10 +745,15 @@ std::string laszipVlr(const std::vector<Item>& items, bool layered) {
 
 }  // namespace
 
-std::string lasToLaz(std::string_view las_file_bytes) {
-  const std::string_view file = las_file_bytes;
-  const auto* bytes = reinterpret_cast<const std::uint8_t*>(file.data());
-  const LasHeader h = parseHeader(file);
+void lasToLaz(const ByteReader& read, std::uint64_t las_size, const LazSink& out) {
+  if (las_size < 227) fail("not a LAS/LAZ file (no \"LASF\" signature and 227-byte header)");
+  const std::string head = read(0, 227);
+  std::uint32_t header_offset;
+  std::memcpy(&header_offset, head.data() + 96, 4);
+  if (header_offset < 227 || header_offset > las_size)
+    fail("offset to point data " + std::to_string(header_offset) + " is not within the file");
+  const std::string file = read(0, header_offset);  // header and VLRs
+  const LasHeader h = parseHeader(file, las_size);
   if (h.format_byte & 0xC0) fail("the file is already compressed (LAZ)");
   const int format = h.format_byte;
   if (!(format <= 3 || (format >= 6 && format <= 8))) {
@@ -756,36 +783,59 @@ std::string lasToLaz(std::string_view las_file_bytes) {
 
   // Header, VLRs, the LASzip VLR, any bytes before the points, then the compressed points.
   const std::size_t vlr_end = vlrsEnd(h, vlrs);
-  std::string laz;
-  laz.reserve(file.size() / 4 + h.point_offset + vlr.size());
-  laz.append(file.substr(0, vlr_end));
-  laz.append(vlr);
-  laz.append(file.substr(vlr_end, h.point_offset - vlr_end));
-  const std::uint64_t point_offset = laz.size();
-  auto* header = reinterpret_cast<std::uint8_t*>(&laz[0]);
+  std::string prefix = file.substr(0, vlr_end) + vlr + file.substr(vlr_end);
+  const std::uint64_t point_offset = prefix.size();
+  auto* header = reinterpret_cast<std::uint8_t*>(&prefix[0]);
   header[104] = static_cast<std::uint8_t>(format | 0x80);
   store<std::uint32_t>(header + 96, static_cast<std::uint32_t>(point_offset));
   store<std::uint32_t>(header + 100, h.vlr_count + 1);
+  out.append(prefix);
+  out.append(std::string(8, '\0'));  // the chunk table's offset, written back below
+  std::uint64_t position = point_offset + 8;
 
-  laz.append(8, '\0');  // chunk table offset, filled in below
   ChunkEncoder encoder(items, h.record_length, layered);
   std::vector<std::uint32_t> chunk_bytes;
-  const std::uint8_t* records = bytes + h.point_offset;
+  std::string chunk;
   for (std::uint64_t done = 0; done < h.point_count;) {
     const std::uint32_t count =
         static_cast<std::uint32_t>(std::min<std::uint64_t>(kChunkSize, h.point_count - done));
-    const std::size_t start = laz.size();
-    encoder.encode(records + done * h.record_length, count, laz);
-    if (laz.size() - start > std::numeric_limits<std::uint32_t>::max())
-      fail("a chunk exceeds 4 GiB");
-    chunk_bytes.push_back(static_cast<std::uint32_t>(laz.size() - start));
+    const std::string records =
+        read(h.point_offset + done * h.record_length, std::uint64_t{count} * h.record_length);
+    chunk.clear();
+    encoder.encode(reinterpret_cast<const std::uint8_t*>(records.data()), count, chunk);
+    if (chunk.size() > std::numeric_limits<std::uint32_t>::max()) fail("a chunk exceeds 4 GiB");
+    chunk_bytes.push_back(static_cast<std::uint32_t>(chunk.size()));
+    out.append(chunk);
+    position += chunk.size();
     done += count;
   }
-  appendChunkTable(laz, point_offset, {}, chunk_bytes);
+  std::string offset(8, '\0');
+  store<std::int64_t>(reinterpret_cast<std::uint8_t*>(&offset[0]),
+                      static_cast<std::int64_t>(position));
+  out.patch(point_offset, offset);
+  const std::string table = chunkTable({}, chunk_bytes);
+  out.append(table);
+  position += table.size();
   if (h.has_evlrs) {
-    store<std::uint64_t>(reinterpret_cast<std::uint8_t*>(&laz[235]), laz.size());
-    laz.append(file.substr(h.points_end));
+    std::string start(8, '\0');
+    store<std::uint64_t>(reinterpret_cast<std::uint8_t*>(&start[0]), position);
+    out.patch(235, start);
+    constexpr std::uint64_t kBlock = std::uint64_t{1} << 24;
+    for (std::uint64_t at = h.points_end; at < las_size; at += kBlock)
+      out.append(read(at, std::min(kBlock, las_size - at)));
   }
+}
+
+std::string lasToLaz(std::string_view las_file_bytes) {
+  std::string laz;
+  laz.reserve(las_file_bytes.size() / 4 + 4096);
+  lasToLaz(
+      [&](std::uint64_t offset, std::uint64_t count) {
+        return std::string(las_file_bytes.substr(offset, count));
+      },
+      las_file_bytes.size(),
+      {[&](std::string_view bytes) { laz.append(bytes); },
+       [&](std::uint64_t at, std::string_view bytes) { laz.replace(at, bytes.size(), bytes); }});
   return laz;
 }
 
@@ -808,25 +858,115 @@ std::string lazOfChunks(std::string_view prefix, const std::vector<LazChunk>& ch
   const LaszipInfo info = parseLaszipVlr(
       std::string_view(laz).substr(laszip->offset + kVlrHeaderSize, laszip->size - kVlrHeaderSize),
       h.format_byte & 0x3F, h.record_length);
-  if (info.compressor == 1 || !(info.chunk_size == kVariableChunks || info.chunk_size == 0))
-    fail("chunks are taken apart only from a file of variable-size chunks (COPC's)");
+  if (info.compressor == 1) fail("a pointwise-compressed file has no chunks to take apart");
+  const bool variable = info.chunk_size == kVariableChunks || info.chunk_size == 0;
   std::vector<std::uint32_t> points, bytes;
   std::uint64_t total = 0;
   laz.append(8, '\0');  // chunk table offset
-  for (const LazChunk& chunk : chunks) {
+  for (std::size_t i = 0; i < chunks.size(); ++i) {
+    const LazChunk& chunk = chunks[i];
     if (chunk.points == 0) continue;  // an empty node has no chunk
+    // Fixed-size chunks: the table has no counts, every chunk but the last is full.
+    if (!variable && (chunk.points > info.chunk_size ||
+                      (chunk.points < info.chunk_size && i + 1 < chunks.size())))
+      fail("chunk of " + std::to_string(chunk.points) + " points among chunks of " +
+           std::to_string(info.chunk_size));
     points.push_back(chunk.points);
     bytes.push_back(static_cast<std::uint32_t>(chunk.bytes.size()));
     laz.append(chunk.bytes);
     total += chunk.points;
   }
+  if (!variable) points.clear();
   header = reinterpret_cast<std::uint8_t*>(&laz[0]);
   const int format = h.format_byte & 0x3F;
   store<std::uint32_t>(header + 107,
                        format < 6 && total <= 0xFFFFFFFFu ? static_cast<std::uint32_t>(total) : 0u);
   if (h.minor >= 4 && h.header_size >= 375) store<std::uint64_t>(header + 247, total);
-  appendChunkTable(laz, h.point_offset, points, bytes);
+  store<std::int64_t>(reinterpret_cast<std::uint8_t*>(&laz[h.point_offset]),
+                      static_cast<std::int64_t>(laz.size()));
+  laz.append(chunkTable(points, bytes));
   return laz;
+}
+
+LazChunkIndex indexLazChunks(const ByteReader& read, std::uint64_t file_size) {
+  if (file_size < 227) fail("not a LAS/LAZ file (shorter than a header)");
+  std::string head = read(0, std::min<std::uint64_t>(375, file_size));
+  const std::uint64_t point_offset =
+      load<std::uint32_t>(reinterpret_cast<const std::uint8_t*>(head.data()) + 96);
+  if (point_offset < 227 || point_offset > file_size)
+    fail("offset to point data " + std::to_string(point_offset) + " is not within the file");
+  LazChunkIndex index;
+  index.prefix = read(0, point_offset);
+  // The points end where the EVLRs begin (LAS 1.4), else at the end of the file.
+  std::string parsed = index.prefix;
+  auto* p = reinterpret_cast<std::uint8_t*>(&parsed[0]);
+  std::uint64_t data_end = file_size;
+  if (parsed.size() >= 375 && p[25] >= 4 && load<std::uint16_t>(p + 94) >= 375 &&
+      load<std::uint32_t>(p + 243) > 0) {
+    data_end = load<std::uint64_t>(p + 235);
+    if (data_end < point_offset || data_end > file_size)
+      fail("start of the EVLRs " + std::to_string(data_end) + " is not after the points");
+    store<std::uint64_t>(p + 235, 0);
+    store<std::uint32_t>(p + 243, 0);
+  }
+  const LasHeader h = parseHeader(parsed);
+  if ((h.format_byte & 0xC0) == 0) fail("the file is not compressed");
+  const std::vector<Vlr> vlrs = walkVlrs(parsed, h);
+  const auto laszip = std::find_if(vlrs.begin(), vlrs.end(), [](const Vlr& v) { return v.laszip; });
+  if (laszip == vlrs.end())
+    fail("the compressed file has no LASzip VLR (\"laszip encoded\", 22204)");
+  const LaszipInfo info =
+      parseLaszipVlr(std::string_view(parsed).substr(laszip->offset + kVlrHeaderSize,
+                                                     laszip->size - kVlrHeaderSize),
+                     h.format_byte & 0x3F, h.record_length);
+  if (info.compressor == 1)
+    fail("its points are one stream (the pointwise compressor): it has no chunks to read apart");
+  if (data_end - point_offset < 8) fail("the point data ends before the chunk table's offset");
+  const auto offsetAt = [&](std::uint64_t at) {
+    const std::string bytes = read(at, 8);
+    return load<std::int64_t>(reinterpret_cast<const std::uint8_t*>(bytes.data()));
+  };
+  std::int64_t table_offset = offsetAt(point_offset);
+  std::uint64_t table_end = data_end;
+  if (table_offset == -1 && data_end - point_offset >= 16) {
+    table_end = data_end - 8;
+    table_offset = offsetAt(table_end);
+  }
+  std::string why;
+  std::optional<std::vector<Chunk>> chunks;
+  if (tableOffsetValid(point_offset, table_end, table_offset, why)) {
+    const auto table = static_cast<std::uint64_t>(table_offset);
+    const std::string bytes = read(table, table_end - table);
+    const auto* b = reinterpret_cast<const std::uint8_t*>(bytes.data());
+    chunks = decodeChunkTable(b, b + bytes.size(), point_offset, table, info, h.point_count,
+                              h.record_length, why);
+  }
+  if (!chunks) fail("its chunk table is unusable (" + why + "): the file is read only whole");
+  std::uint64_t first = 0;
+  for (const Chunk& c : *chunks) {
+    index.chunks.push_back({c.begin, c.end, first, c.points});
+    first += c.points;
+  }
+  index.record_length = h.record_length;
+  index.las_prefix = lazToLas(lazOfChunks(index.prefix, {}), 1);
+  return index;
+}
+
+std::string decodeLazChunks(const LazChunkIndex& index, std::size_t first, std::size_t last,
+                            std::string_view bytes, int threads) {
+  if (first > last || last >= index.chunks.size() ||
+      bytes.size() != index.chunks[last].end - index.chunks[first].begin)
+    fail("chunks " + std::to_string(first) + ".." + std::to_string(last) +
+         " are not the bytes given");
+  std::vector<LazChunk> parts;
+  for (std::size_t i = first; i <= last; ++i) {
+    const LazChunkIndex::Span& c = index.chunks[i];
+    parts.push_back({static_cast<std::uint32_t>(c.points),
+                     bytes.substr(c.begin - index.chunks[first].begin, c.end - c.begin)});
+  }
+  std::string las = lazToLas(lazOfChunks(index.prefix, parts), threads);
+  las.erase(0, index.las_prefix.size());
+  return las;
 }
 
 }  // namespace detail

@@ -35,6 +35,7 @@
  * exceed 256 MiB each.
  */
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -59,6 +60,20 @@ std::string lazToLas(std::string_view laz_file_bytes, int threads);
  */
 std::string lasToLaz(std::string_view las_file_bytes);
 
+/** Bytes [offset, offset + count) of a file, which the caller has checked lie within it. */
+using ByteReader = std::function<std::string(std::uint64_t offset, std::uint64_t count)>;
+
+/** Where the streaming lasToLaz writes: bytes appended in order, and a few written back over
+ *  bytes appended before (the chunk table's offset, the EVLRs' start) once they are known. */
+struct LazSink {
+  std::function<void(std::string_view bytes)> append;
+  std::function<void(std::uint64_t at, std::string_view bytes)> patch;
+};
+
+/** lasToLaz of the LAS file of las_size bytes that `read` gives, a chunk of records at a time
+ *  (nothing the size of the file is held). */
+void lasToLaz(const ByteReader& read, std::uint64_t las_size, const LazSink& out);
+
 /** A chunk of a LAZ file of variable chunks: its point count and its bytes. */
 struct LazChunk {
   std::uint32_t points = 0;
@@ -73,6 +88,32 @@ struct LazChunk {
  * @throws pcl_ddg::FileFormatException if prefix is not such a file's beginning.
  */
 std::string lazOfChunks(std::string_view prefix, const std::vector<LazChunk>& chunks);
+
+/** Where a LAZ file's chunks lie, from its chunk table: for reading it a few chunks at a time. */
+struct LazChunkIndex {
+  std::string prefix;      ///< the file's bytes up to its point data (header and VLRs)
+  std::string las_prefix;  ///< the LAS file it stands for up to its points (counting none)
+  std::uint16_t record_length = 0;
+  struct Span {
+    std::uint64_t begin = 0, end = 0;  ///< the chunk's bytes in the file
+    std::uint64_t first_point = 0, points = 0;
+  };
+  std::vector<Span> chunks;
+};
+
+/**
+ * The chunks of the LAZ file of file_size bytes that read gives: its header and VLRs, the chunk
+ * table's offset and the table are read, nothing else.
+ * @throws pcl_ddg::FileFormatException for a file that is not LAZ, is corrupt, or whose points
+ * cannot be read apart: the pointwise compressor's one stream, a missing or broken chunk table
+ * (lazToLas reads such a file whole).
+ */
+LazChunkIndex indexLazChunks(const ByteReader& read, std::uint64_t file_size);
+
+/** The LAS point records of chunks first..last of index (consecutive), decoded from `bytes`, the
+ *  file's from chunk first's begin to chunk last's end, on up to `threads` threads. */
+std::string decodeLazChunks(const LazChunkIndex& index, std::size_t first, std::size_t last,
+                            std::string_view bytes, int threads);
 
 }  // namespace detail
 }  // namespace pcl_ddg
