@@ -140,8 +140,14 @@ std::string lasReport(const std::string& path, const pcl_ddg::LasLayout& las,
   char head[105] = {};
   std::ifstream(path, std::ios::binary).read(head, sizeof head);
   const bool compressed = pcl_ddg::lasIsCompressed(std::string_view(head, sizeof head));
+  // A COPC file whose hierarchy does not hold is still reported on (its points read as LAZ).
   std::optional<pcl_ddg::CopcInfo> copc;
-  if (compressed && pcl_ddg::isCopcFile(path)) copc = pcl_ddg::readCopcInfo(path);
+  std::string copc_error;
+  try {
+    if (compressed && pcl_ddg::isCopcFile(path)) copc = pcl_ddg::readCopcInfo(path);
+  } catch (const pcl_ddg::FileFormatException& e) {
+    copc_error = pcl_ddg::errorDescription(e);
+  }
   std::map<int, long long> histogram;
   const auto field =
       std::find_if(cloud.fields.begin(), cloud.fields.end(),
@@ -174,8 +180,10 @@ std::string lasReport(const std::string& path, const pcl_ddg::LasLayout& las,
     };
     const char* agree = "null";
     if (compared) agree = mismatches.empty() ? "true" : "false";
-    out << "\"las\": {\"storage\": " << (compressed ? "\"laz\"" : "\"las\"")
-        << ", \"copc\": " << (copc ? copcReport(*copc, true) : "null")
+    out << "\"las\": {\"storage\": " << (compressed ? "\"laz\"" : "\"las\"") << ", \"copc\": "
+        << (copc                 ? copcReport(*copc, true)
+            : copc_error.empty() ? std::string("null")
+                                 : "{\"error\": " + jsonText(copc_error) + "}")
         << ", \"version\": " << jsonText(version) << ", \"point_format\": " << int(las.point_format)
         << ", \"record_length\": " << las.record_length << ", \"scale\": " << array(las.scale)
         << ", \"offset\": " << array(las.offset) << ", \"header_bounds_min\": " << array(las.min)
@@ -223,6 +231,7 @@ std::string lasReport(const std::string& path, const pcl_ddg::LasLayout& las,
         << number(m.records) << ")\n";
   }
   if (copc) out << copcReport(*copc, false);
+  if (!copc_error.empty()) out << "COPC octree:       not read: " << copc_error << "\n";
   for (const auto& r : las.vlrs) out << "VLR:               " << record(r) << "\n";
   for (const auto& r : las.evlrs) out << "EVLR:              " << record(r) << "\n";
   if (!las.extra_bytes.empty()) {
@@ -254,15 +263,15 @@ int run(int argc, char** argv) {
     if (args.has("input_dir") && !json) std::cout << "== " << path << "\n";
     if (mesh.polygons.empty()) {
       const CloudReport report = makeCloudReport(mesh.cloud, file.positions);
+      // The LAS report first: nothing is printed of a file that cannot be reported on.
+      const std::string las =
+          file.las ? lasReport(path, *file.las, mesh.cloud, report.bounding_box, json) : "";
       if (file.las && json) {
         std::string text = report.toJson();  // one object: the LAS layout goes inside it
         text.pop_back();
-        std::cout << text << ", "
-                  << lasReport(path, *file.las, mesh.cloud, report.bounding_box, true) << "}\n";
+        std::cout << text << ", " << las << "}\n";
       } else {
-        std::cout << (json ? report.toJson() + "\n" : report.toText());
-        if (file.las)
-          std::cout << lasReport(path, *file.las, mesh.cloud, report.bounding_box, false);
+        std::cout << (json ? report.toJson() + "\n" : report.toText()) << las;
       }
       tools::warnAboutQuantisation(kName, *makeLocalCloud(file.positions).points);
       return;

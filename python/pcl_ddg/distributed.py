@@ -282,9 +282,11 @@ def _grid_dims(extent: np.ndarray, tiles: int) -> Tuple[int, int, int]:
 def make_plan(client: Any, clouds: List[CloudInput], points_per_tile: int,
               options: Dict[str, Any]) -> Plan:
     chunk = max(4096, min(CHUNK_POINTS_MAX, points_per_tile // 8))
-    jobs = [(c.path, i, first, count) for i, c in enumerate(clouds)
-            for first, count in (c.chunks or
-                                 [(f, min(chunk, c.points - f)) for f in range(0, c.points, chunk)])]
+    # A LAZ file's chunks are its compressed chunks, cut where larger than a chunk (each part
+    # then decodes its whole compressed chunk, but holds only its own points).
+    jobs = [(c.path, i, f, min(chunk, first + count - f)) for i, c in enumerate(clouds)
+            for first, count in (c.chunks or [(0, c.points)])
+            for f in range(first, first + count, chunk)]
     futures = client.map(_chunk_bounds, *zip(*jobs), pure=False, key=[
         f"pcl_ddg-bounds-{uuid.uuid4().hex[:8]}-{j}" for j in range(len(jobs))])
     results = client.gather(futures)
@@ -744,6 +746,13 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
             raise ValueError(f"--merge {merge}: a LAS or LAZ output keeps a LAS input's layout "
                              "(scale, offset, VLRs): the inputs are not LAS")
         outputs = [merge]
+    # Before any tile is fitted: LAZ holds no waveform formats (4, 5, 9, 10).
+    laz_outputs = [o for o in outputs if o.lower().endswith(".laz")]
+    if laz_outputs and clouds[0].path.lower().endswith((".las", ".laz")):
+        point_format = las_header(clouds[0].path)["point_format"]
+        if not _pcl_ddg._laz_compressible(point_format):
+            raise ValueError(f"{laz_outputs[0]}: point format {point_format} cannot be written as "
+                             "LAZ (formats 0-3 and 6-8 can): write .las (--format las)")
     os.makedirs(output_dir, exist_ok=True)
     state = os.path.join(output_dir, STATE_FOLDER, tool)
     config_path = os.path.join(state, "run.json")
@@ -1144,7 +1153,8 @@ def _parser(tool: str) -> argparse.ArgumentParser:
     p.add_argument("--memory-per-worker", default="2G")
     p.add_argument("--retries", type=int, default=3)
     p.add_argument("--merge", metavar="FILE", help="one output file in the inputs' order")
-    p.add_argument("--format", choices=["ply", "pcd", "las"], help="per-input outputs' format")
+    p.add_argument("--format", choices=["ply", "pcd", "las", "laz"],
+                   help="per-input outputs' format")
     p.add_argument("--resume", action=argparse.BooleanOptionalAction, default=True)
     p.add_argument("--allow-mixed-crs", action="store_true")
     p.add_argument("--connect-timeout", type=float, default=5.0)

@@ -342,6 +342,9 @@ void bindIO(py::module_& m) {
                ", vlrs=" + std::to_string(l.vlrs.size()) + ")";
       });
 
+  m.def("_laz_compressible", &lazCompressible, py::arg("point_format"),
+        "Whether LAZ holds records of this point format (0-3 and 6-8).");
+
   m.def("_las_header", &lasHeader, py::arg("path"),
         "A LAS file's header and VLRs as the library reads them (no point is read): "
         "version, point_format, record_length, points, scale, offset, bounds (min x y z, max x y "

@@ -33,15 +33,26 @@ struct Plane {
   Eigen::Vector3d centroid;
 };
 
-/** Median of |n . (x_i - c)| over the first count columns of x. */
-double medianResidual(const Eigen::Matrix3Xd& x, int count, const Plane& plane,
-                      std::vector<double>& residuals) {
+/** The median of |n . (x_i - c)| over the first count columns of x (element count / 2 of them
+ *  sorted) when it is below `below`, else infinity. Most planes tried are worse than the best so
+ *  far: counting the residuals below it tells so (fewer than count / 2 + 1 of them) without the
+ *  selection, and the planes kept get the same median as a full selection gives. */
+double medianResidualBelow(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double below,
+                           std::vector<double>& residuals) {
   residuals.resize(static_cast<std::size_t>(count));
   const double offset = plane.normal.dot(plane.centroid);
-  for (int i = 0; i < count; ++i) residuals[i] = std::abs(plane.normal.dot(x.col(i)) - offset);
+  int under = 0;
+  bool nan = false;
+  for (int i = 0; i < count; ++i) {
+    const double r = std::abs(plane.normal.dot(x.col(i)) - offset);
+    residuals[i] = r;
+    under += r < below;
+    nan = nan || std::isnan(r);
+  }
+  if (!nan && under <= count / 2) return std::numeric_limits<double>::infinity();
   const auto middle = residuals.begin() + count / 2;
   std::nth_element(residuals.begin(), middle, residuals.end());
-  return *middle;
+  return *middle < below ? *middle : std::numeric_limits<double>::infinity();
 }
 
 using detail::PointMoments;
@@ -177,7 +188,7 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   double best_median = std::numeric_limits<double>::infinity();
   Plane plane;
   for (int j = 0; j <= chosen; ++j) {
-    const double median = medianResidual(x, scored, scales[j].plane, residuals);
+    const double median = medianResidualBelow(x, scored, scales[j].plane, best_median, residuals);
     if (median < best_median) {
       best_median = median;
       plane = scales[j].plane;
@@ -195,7 +206,8 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
       const double size = x.col(i).norm() * x.col(j).norm();
       if (!(n.norm() > 1e-9 * size)) continue;  // the query itself, a duplicate, or collinear
       const Plane through{n.normalized(), Eigen::Vector3d::Zero()};
-      const double median = medianResidual(x, scored, through, residuals);
+      const double median = medianResidualBelow(
+          x, scored, through, std::min(best_median, kThroughQuery * nested_median), residuals);
       if (median < best_median && median < kThroughQuery * nested_median) {
         best_median = median;
         plane = through;

@@ -332,6 +332,9 @@ CloudPieceWriter::CloudPieceWriter(const std::string& path, const std::string& f
                                 " output written in pieces keeps a LAS input's layout: the input "
                                 "is not LAS");
     }
+    if (format == "laz" && !lazCompressible(las->point_format))
+      throw FileFormatException("point format " + std::to_string(las->point_format) +
+                                " cannot be written as LAZ (formats 0-3 and 6-8 can): write .las");
     las_ = std::make_unique<Las>(path, *las, format == "laz");
     return;
   }

@@ -11,6 +11,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <set>
 #include <tuple>
 #include <utility>
@@ -90,8 +91,8 @@ bool isCopc(ByteRanges& file) {
 }
 
 /** Reads the pages from the root on, each once (a page named twice is a cycle or a lie). */
-void readHierarchy(ByteRanges& file, std::uint64_t root_offset, std::uint64_t root_size,
-                   CopcInfo& info) {
+void readHierarchy(ByteRanges& file, std::uint64_t points_begin, std::uint64_t root_offset,
+                   std::uint64_t root_size, CopcInfo& info) {
   std::vector<std::pair<std::uint64_t, std::uint64_t>> pending{{root_offset, root_size}};
   std::set<std::uint64_t> seen;
   std::set<std::tuple<int, int, int, int>> keys;
@@ -135,7 +136,7 @@ void readHierarchy(ByteRanges& file, std::uint64_t root_offset, std::uint64_t ro
       node.points = static_cast<std::uint32_t>(points);
       sum += node.points;
       // Chunks do not overlap: more than the file's bytes in all is a lie (and reading every
-      // node would hold more than the file).
+      // node would hold more than the file), found before the pages go on.
       chunk_bytes += node.points > 0 ? node.bytes : 0;
       if (chunk_bytes > file.size()) fail("the nodes' chunks add up to more than the file");
       info.nodes.push_back(node);
@@ -144,6 +145,18 @@ void readHierarchy(ByteRanges& file, std::uint64_t root_offset, std::uint64_t ro
   if (sum != info.point_count)
     fail("the hierarchy's nodes hold " + std::to_string(sum) + " points, the header " +
          std::to_string(info.point_count));
+  // ... and none shares bytes with another or with the header and VLRs.
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> chunks;  // begin, end
+  for (const CopcNode& node : info.nodes)
+    if (node.points > 0) chunks.emplace_back(node.offset, node.offset + node.bytes);
+  std::sort(chunks.begin(), chunks.end());
+  std::uint64_t end = points_begin;
+  for (const auto& [begin, chunk_end] : chunks) {
+    if (begin < end)
+      fail("a node's chunk at " + std::to_string(begin) +
+           " overlaps another chunk or the header and VLRs");
+    end = chunk_end;
+  }
 }
 
 /** In place: keeps the records of an uncompressed LAS file whose coordinates lie in box. */
@@ -181,9 +194,8 @@ class FileRanges : public ByteRanges {
   explicit FileRanges(const std::string& path)
       : fd_(open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK)) {
     struct stat status {};
-    if (fd_ < 0 || fstat(fd_, &status) != 0)
-      throw FileFormatException(path + ": cannot open: " + std::strerror(errno));
-    if (!S_ISREG(status.st_mode)) {
+    if (fd_ < 0) throw FileFormatException(path + ": cannot open: " + std::strerror(errno));
+    if (fstat(fd_, &status) != 0 || !S_ISREG(status.st_mode)) {
       close(fd_);
       throw FileFormatException(path + ": not a regular file");
     }
@@ -239,21 +251,26 @@ CopcInfo readCopcInfo(ByteRanges& file) {
   if (!info.center.allFinite() || !(info.halfsize > 0.0) || !std::isfinite(info.halfsize))
     fail("the octree's centre and half size are not finite and positive");
   info.point_count = load<std::uint64_t>(prefix, 247);
-  readHierarchy(file, root_offset, root_size, info);
+  for (int d = 0; d < 3; ++d) info.scale[d] = load<double>(prefix, 131 + 8 * d);
+  // The chunks start after the chunk table's offset (8 bytes at the start of the point data).
+  readHierarchy(file, prefix.size() + 8, root_offset, root_size, info);
   return info;
 }
 
 std::string copcNodesAsLas(ByteRanges& file, const CopcInfo& info,
                            const std::vector<CopcKey>& keys) {
   const std::string prefix = readPrefix(file);
+  std::map<std::tuple<int, int, int, int>, const CopcNode*> by_key;
+  for (const CopcNode& node : info.nodes)
+    by_key.emplace(std::make_tuple(node.key.depth, node.key.x, node.key.y, node.key.z), &node);
   std::vector<std::string> chunks;
   std::vector<LazChunk> parts;
   chunks.reserve(keys.size());
   for (const CopcKey& key : keys) {
-    const auto node = std::find_if(info.nodes.begin(), info.nodes.end(),
-                                   [&](const CopcNode& n) { return n.key == key; });
-    if (node == info.nodes.end())
+    const auto found = by_key.find(std::make_tuple(key.depth, key.x, key.y, key.z));
+    if (found == by_key.end())
       throw pcl::BadArgumentException("no node " + keyName(key) + " in the COPC hierarchy");
+    const CopcNode* node = found->second;
     if (node->points == 0) continue;
     chunks.push_back(file.read(node->offset, node->bytes));
     parts.push_back({node->points, chunks.back()});
@@ -285,6 +302,8 @@ auto onFile(const std::string& path, F f) {
     return f(file);
   } catch (const FileFormatException& e) {
     throw FileFormatException(path + ": " + errorDescription(e));
+  } catch (const pcl::BadArgumentException& e) {
+    throw pcl::BadArgumentException(path + ": " + errorDescription(e));
   }
 }
 
@@ -307,7 +326,12 @@ CopcPoints readCopcBox(const std::string& path, const Eigen::AlignedBox3d& box, 
     std::vector<CopcKey> keys;
     for (const CopcNode& node : info.nodes) {
       if (max_depth >= 0 && node.key.depth > max_depth) continue;
-      if (node.points > 0 && info.bounds(node.key).intersects(box)) keys.push_back(node.key);
+      // A point may lie up to half a scale step outside its node's cube (its coordinates are
+      // rounded to the scale): the cubes are widened by a step, the points then kept exactly.
+      Eigen::AlignedBox3d cube = info.bounds(node.key);
+      cube.min() -= info.scale.cwiseAbs();
+      cube.max() += info.scale.cwiseAbs();
+      if (node.points > 0 && cube.intersects(box)) keys.push_back(node.key);
     }
     std::string las = detail::copcNodesAsLas(file, info, keys);
     detail::keepRecordsWithin(las, box);

@@ -20,6 +20,10 @@ bool lasIsCompressed(std::string_view head) {
   return head.size() > 104 && (static_cast<std::uint8_t>(head[104]) & 0xC0) != 0;
 }
 
+bool lazCompressible(int point_format) {
+  return (point_format >= 0 && point_format <= 3) || (point_format >= 6 && point_format <= 8);
+}
+
 namespace detail {
 namespace {
 

@@ -198,6 +198,10 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
   if ((output_format == "las" || output_format == "laz") && !pieces.lasLayout())
     throw FileFormatException(output + ": a ." + output_format +
                               " output out of core needs a .las or .laz input (its layout)");
+  if (output_format == "laz" && !lazCompressible(pieces.lasLayout()->point_format))
+    throw FileFormatException(output + ": point format " +
+                              std::to_string(pieces.lasLayout()->point_format) +
+                              " cannot be written as LAZ (formats 0-3 and 6-8 can): write .las");
   const CloudFileLayout& layout = pieces.layout();
   OutOfCoreReport report;
   report.points = layout.points;

@@ -96,17 +96,21 @@ TEST(Copc, ABoxReadsOnlyTheNodesMeetingItAndGivesExactlyThePointsInside) {
   for (const Eigen::AlignedBox3d& box : {quarter, small}) {
     for (const int depth : {-1, 1}) {
       const CopcPoints read = readCopcBox(copcFile(), box, depth);
+      // Expected: every node of those levels read alone, its points in the box kept.
       std::vector<Point> expected;
       std::uint64_t node_bytes = 0;
       for (const CopcNode& node : info.nodes) {
         if (depth >= 0 && node.key.depth > depth) continue;
-        if (!info.bounds(node.key).intersects(box)) continue;
-        node_bytes += node.bytes;
         const CopcPoints points = readCopcNodes(copcFile(), {node.key});
         for (Eigen::Index i = 0; i < points.file.positions.cols(); ++i)
           if (box.contains(points.file.positions.col(i)))
             expected.push_back({points.file.positions(0, i), points.file.positions(1, i),
                                 points.file.positions(2, i)});
+        // What is read (docs/las.md): the nodes whose cubes, widened by a scale step, meet it.
+        Eigen::AlignedBox3d cube = info.bounds(node.key);
+        cube.min() -= info.scale;
+        cube.max() += info.scale;
+        if (cube.intersects(box)) node_bytes += node.bytes;
       }
       std::sort(expected.begin(), expected.end());
       EXPECT_EQ(sortedPoints(read.file.positions), expected) << depth;
@@ -119,11 +123,22 @@ TEST(Copc, ABoxReadsOnlyTheNodesMeetingItAndGivesExactlyThePointsInside) {
         EXPECT_GT(inside.size(), 50u);
         EXPECT_LT(inside.size(), 1065u);
       }
-      // What was read: header and VLRs (twice: the octree, then the points), the hierarchy, the
-      // chosen chunks; not the others.
-      const std::uint64_t point_offset = at<std::uint32_t>(readBytes(copcFile()), 96);
+      // Read: the header and VLRs (twice: the octree, then the points), the hierarchy, the
+      // chosen chunks; less than the file.
+      const std::string bytes = readBytes(copcFile());
+      const std::uint64_t point_offset = at<std::uint32_t>(bytes, 96);
       EXPECT_EQ(read.bytes_read, 2 * point_offset + 65 * 32 + node_bytes);
+      EXPECT_LT(read.bytes_read, bytes.size());
     }
+  }
+  // A box around one point gives that point, though a point may lie up to half a scale step
+  // outside its node's cube (one in the file lies 1.1e-13 below node 3-0-0-0's).
+  for (Eigen::Index i = 0; i < whole.positions.cols(); i += 7) {
+    const Eigen::Vector3d p = whole.positions.col(i);
+    const CopcPoints one = readCopcBox(copcFile(), Eigen::AlignedBox3d(p, p));
+    ASSERT_GE(one.file.positions.cols(), 1) << i;
+    for (Eigen::Index j = 0; j < one.file.positions.cols(); ++j)
+      EXPECT_TRUE(one.file.positions.col(j) == p) << i;
   }
 }
 
@@ -191,6 +206,14 @@ TEST(Copc, ChildPagesAreFollowedAndLyingHierarchiesRefused) {
   std::string twice = two;  // two entries of one key
   twice.replace(root + 32, 16, twice.substr(root, 16));
   refused(twice, "is listed twice");
+  std::string shared = two;  // nodes 2 and 3 share node 2's chunk (the header counts them)
+  put<std::uint64_t>(shared, root + 64 + 16, at<std::uint64_t>(shared, root + 32 + 16));
+  put<std::int32_t>(shared, root + 64 + 24, at<std::int32_t>(shared, root + 32 + 24));
+  const std::int32_t moved =
+      at<std::int32_t>(shared, root + 32 + 28) - at<std::int32_t>(shared, root + 64 + 28);
+  put<std::int32_t>(shared, root + 64 + 28, at<std::int32_t>(shared, root + 32 + 28));
+  put<std::uint64_t>(shared, 247, 1065 + static_cast<std::int64_t>(moved));
+  refused(shared, "overlaps another chunk");
   std::string overlapping = two;  // every chunk the whole file
   for (std::size_t e = root; e < pointer; e += 32) {
     put<std::uint64_t>(overlapping, e + 16, 0);

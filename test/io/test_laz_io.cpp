@@ -208,8 +208,6 @@ TEST(LazIO, IdenticalPointsAndAStaleLaszipRecordRoundTrip) {
   EXPECT_GT(n / point_data, 128.0) << point_data;  // the bound this file once broke
 }
 
-// Truncated anywhere, or with a chunk table that lies, a LAZ file is refused, never read past
-// its end (the sanitizer build runs this too).
 // A LAZ file read in pieces (the out-of-core fit, the Dask runner): each piece decodes the chunks
 // holding its points, and is the piece of the uncompressed twin, field for field. Ranges within a
 // chunk, across chunk ends, the whole file, in any order (a decoded run is reused or replaced).
@@ -257,6 +255,8 @@ TEST(LazIO, AFileWithoutAUsableChunkTableIsNotReadInPieces) {
   EXPECT_EQ(readMeshFile(folder + "/lost.laz").positions.cols(), 110000);
 }
 
+// Truncated anywhere, or with a chunk table that lies, a LAZ file is refused, never read past
+// its end (the sanitizer build runs this too).
 TEST(LazIO, TruncatedAndLyingFilesAreRefused) {
   const std::string laz = readBytes(sharedData("las/laz/autzen_trim.laz"));
   const auto points_at = at<std::uint32_t>(laz, 96);

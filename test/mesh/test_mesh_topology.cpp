@@ -289,7 +289,7 @@ TEST(MeshTopology, NeighbourRowsBuiltOnFirstUseAreTheBruteForceRows) {
   for (int v = 0; v < n; ++v) {
     ASSERT_EQ(rows[v], std::vector<int>(expected[v].begin(), expected[v].end())) << v;
     const IndexSpan row = copy.neighbours(v);
-    ASSERT_EQ(std::vector<int>(row.begin(), row.end()), rows[v]) << v;
+    ASSERT_EQ(row.begin(), topology.neighbours(v).begin()) << v;  // the same rows, built once
   }
 }
 

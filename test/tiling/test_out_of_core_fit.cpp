@@ -47,8 +47,11 @@ class OutOfCore : public ::testing::Test {
         << tiled.err;
   }
   void expectNoScratchLeft() const {
-    for (const auto& entry : std::filesystem::directory_iterator(dir_))
-      EXPECT_EQ(entry.path().filename().string().find(".pcl_ddg_tiles_"), std::string::npos);
+    for (const auto& entry : std::filesystem::directory_iterator(dir_)) {
+      const std::string name = entry.path().filename().string();
+      EXPECT_EQ(name.find(".pcl_ddg_tiles_"), std::string::npos) << name;
+      EXPECT_EQ(name.find(".tmp."), std::string::npos) << name;  // an output's (a .laz's LAS)
+    }
   }
   std::string dir_;
 };

@@ -184,6 +184,23 @@ TEST(PclDdgInfo, CopcOctreeAndCompressionAreReported) {
   EXPECT_EQ(json(sharedData("las/laz/autzen_trim.laz")).get<std::string>("las.copc"), "null");
   EXPECT_EQ(json(sharedData("las/laz/autzen_trim.laz")).get<std::string>("las.storage"), "laz");
   EXPECT_EQ(json(sharedData("las/autzen_trim.las")).get<std::string>("las.storage"), "las");
+  // A hierarchy that does not hold (a node claims a point more): the file is still reported on,
+  // the octree's error in its place.
+  std::string lie = bytes;
+  std::int32_t points = 0;
+  std::memcpy(&points, lie.data() + root + 28, 4);
+  ++points;
+  std::memcpy(&lie[root + 28], &points, 4);
+  const std::string dir = scratchFolder("info_copc_lie");
+  writeText(dir + "/lie.copc.laz", lie);
+  const auto j_lie = json(dir + "/lie.copc.laz");
+  EXPECT_EQ(j_lie.get<int>("points"), 1065);
+  EXPECT_NE(j_lie.get<std::string>("las.copc.error").find("hold 1066 points, the header 1065"),
+            std::string::npos);
+  const ToolRun lie_text = runInfo(dir + "/lie.copc.laz");
+  EXPECT_EQ(lie_text.exit_code, 0) << lie_text.err;
+  EXPECT_NE(lie_text.out.find("COPC octree:       not read: "), std::string::npos) << lie_text.out;
+  EXPECT_NE(lie_text.out.find("class   2:"), std::string::npos) << lie_text.out;
 }
 
 TEST(PclDdgInfo, LasHeaderBoundsThatDisagreeWithTheRecordsAreNamed) {

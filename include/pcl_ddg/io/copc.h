@@ -14,8 +14,9 @@
  * size bytes) instead of a node, 0 a node without points.
  *
  * Every offset, size and count is checked against the file before anything is read or
- * allocated; the pages may not form a cycle, and the nodes' counts must add up to the header's
- * (pcl_ddg::FileFormatException otherwise). A node's points are decoded as any LAZ chunk.
+ * allocated; the pages may not form a cycle, the nodes' chunks may not overlap, and their counts
+ * must add up to the header's (pcl_ddg::FileFormatException otherwise). A node's points are
+ * decoded as any LAZ chunk.
  */
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -50,6 +51,9 @@ struct CopcInfo {
   double spacing = 0.0;  ///< of the root level's points
   double gpstime_min = 0.0, gpstime_max = 0.0;
   std::uint64_t point_count = 0;  ///< the header's (the nodes' sum)
+  /** The header's scale: a point's coordinates are rounded to it, so it may lie up to half a
+   *  step outside its node's cube. */
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();
   std::uint64_t hierarchy_pages = 0;
   std::vector<CopcNode> nodes;  ///< every node, in the order the pages list them
 
@@ -76,8 +80,8 @@ struct CopcPoints {
 CopcPoints readCopcNodes(const std::string& path, const std::vector<CopcKey>& keys);
 
 /** The points within box (closed, in the file's coordinates, X * scale + offset), from the nodes
- *  whose cubes meet it, down to max_depth (-1: every level; a smaller depth gives a coarser
- *  sample). Only those nodes' chunks are read. */
+ *  whose cubes, widened by a scale step, meet it, down to max_depth (-1: every level; a smaller
+ *  depth gives a coarser sample). Only those nodes' chunks are read. */
 CopcPoints readCopcBox(const std::string& path, const Eigen::AlignedBox3d& box, int max_depth = -1);
 
 namespace detail {

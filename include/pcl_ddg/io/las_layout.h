@@ -72,9 +72,12 @@ struct LasLayout {
 std::uint16_t lasPointFormatSize(int point_format);
 
 /** Whether a LAS file's first bytes (head) mark it as compressed (LAZ): the two high bits of the
- *  point format byte (104) set. The reader refuses such a file first, saying how to decompress it.
- */
+ *  point format byte (104) set (readMeshFile and CloudPieceReader then decompress it). */
 bool lasIsCompressed(std::string_view head);
+
+/** Whether LAZ holds records of this point format: 0-3 and 6-8, not the waveform formats 4, 5,
+ *  9 and 10 (a .laz output of them is refused). */
+bool lazCompressible(int point_format);
 
 /** The field holding a record's bytes that no Extra Bytes descriptor describes (UINT8, count n). */
 inline constexpr const char* kLasUndocumentedBytesField = "las_undocumented_bytes";

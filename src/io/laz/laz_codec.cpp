@@ -756,7 +756,7 @@ void lasToLaz(const ByteReader& read, std::uint64_t las_size, const LazSink& out
   const LasHeader h = parseHeader(file, las_size);
   if (h.format_byte & 0xC0) fail("the file is already compressed (LAZ)");
   const int format = h.format_byte;
-  if (!(format <= 3 || (format >= 6 && format <= 8))) {
+  if (!lazCompressible(format)) {
     fail("point format " + std::to_string(format) +
          " cannot be compressed here (formats 0-3 and "
          "6-8 can)");
