@@ -37,7 +37,7 @@ constexpr const char* kSyntax =
     "         [-color mean|gauss|k1|k2] [-percentile p (colour scale clamp, default 2)]\n"
     "         [-precision float|double]\n"
     "         [-memory SIZE (clouds larger than memory, quadric: fitted tile by tile within SIZE\n"
-    "                  like 2G; input binary PCD or PLY, output binary; no -smooth, no -color)]";
+    "                  like 2G; input binary PCD or PLY, LAS or LAZ; no -smooth, no -color)]";
 
 // The four curvature fields, as written.
 struct CurvatureFields {

@@ -62,7 +62,7 @@ constexpr const char* kSyntax =
     "RGB)]\n"
     "         [-precision float|double]\n"
     "         [-memory SIZE (clouds larger than memory: fitted tile by tile within SIZE, like 2G;\n"
-    "                  input binary PCD or PLY, output binary; the same values as in memory)]";
+    "                  input binary PCD or PLY, LAS or LAZ; the same values as in memory)]";
 
 /** Says how many normals the spanning tree turned. */
 void reportSpanningTree(const pcl_ddg::ConsistentOrientationReport& report) {

@@ -89,23 +89,10 @@ class CloudInput:
 
 
 def parse_size(text: str) -> int:
-    """Bytes of a size like 2G, 512M, 64k, 2GB or 1000000 (powers of 1024, as the tools'
-    -memory)."""
-    t = str(text).strip()
-    if t.upper().endswith("IB"):
-        t = t[:-2]
-    elif t.upper().endswith("B") and len(t) > 1 and not t[-2].isdigit():
-        t = t[:-1]
-    units = {"": 1, "B": 1, "K": 1 << 10, "M": 1 << 20, "G": 1 << 30, "T": 1 << 40}
-    number = t.rstrip("kKmMgGtTB")
-    unit = t[len(number):].upper()
-    try:
-        value = float(number)
-    except ValueError:
-        value = -1.0
-    if unit not in units or not value > 0 or not math.isfinite(value):
-        raise ValueError(f"a size like 2G, 512M or 64k, not '{text}'")
-    return int(value * units[unit])
+    """Bytes of a size like 2G, 512M, 64k, 2GB, 2GiB or 1000000 (powers of 1024): the tools'
+    -memory parser (pcl_ddg/tiling/byte_size.h), so that both take the same sizes. ValueError
+    for anything else."""
+    return int(_pcl_ddg._parse_byte_size(str(text)))
 
 
 def expand_inputs(inputs: Sequence[str],

@@ -28,6 +28,7 @@
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/result_warnings.h"
 #include "pcl_ddg/search/kd_tree_search.h"
+#include "pcl_ddg/tiling/byte_size.h"
 #include "pcl_ddg/tiling/tile_certificate.h"
 
 namespace pcl_ddg {
@@ -460,6 +461,8 @@ void bindDistributed(py::module_& m) {
   m.def("_fit_request", &fitRequest, py::arg("method"), py::arg("k"), py::arg("radius"),
         py::arg("max_nn"), py::arg("orient"), py::arg("viewpoint"), py::arg("up"),
         "The runner's (k, max_nn), checked as the tools check them.");
+  m.def("_parse_byte_size", &parseByteSize, py::arg("text"),
+        "Bytes of a size like 2G, 512MB or 64k (powers of 1024), as the tools' -memory reads it.");
   m.def("_cloud_layout", &cloudLayout, py::arg("path"),
         "How a binary PCD/PLY or LAS/LAZ cloud lies on disk (header only): points, "
         "header_bytes, point_bytes, width, height, viewpoint, orientation, fields, chunks (a LAZ "

@@ -784,3 +784,18 @@ def test_the_runs_warnings_are_the_tools(tmp_path, client, las_scene):
     assert message.startswith("the viewpoint (0, 0, 0) is ") and "-orient up" in message
     assert "pcl_ddg_normals: warning: " + message in tool.stderr, (message, tool.stderr)
     assert "pcl_ddg.distributed: warning: " + message in log.getvalue()
+
+
+@pytest.mark.parametrize("text,size", [("2G", 2 << 30), ("2GB", 2 << 30), ("2GiB", 2 << 30),
+                                       ("512m", 512 << 20), ("64k", 64 << 10), ("1.5G", 3 << 29),
+                                       ("1000000", 1000000), (" 3M ", 3 << 20)])
+def test_memory_sizes_are_the_tools(text, size):
+    # The runner's memory_per_worker and the tools' -memory share one parser (byte_size.h; the
+    # C++ table: test/tiling/test_byte_size.cpp): the same sizes, and the same refusals.
+    assert dd.parse_size(text) == size
+
+
+@pytest.mark.parametrize("text", ["", "lots", "0", "-1G", "1kk", "2 G", "inf", "1e19", "0x10"])
+def test_memory_sizes_the_tools_refuse_are_refused(text):
+    with pytest.raises(ValueError, match="a size like 2G"):
+        dd.parse_size(text)

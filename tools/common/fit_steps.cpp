@@ -19,6 +19,7 @@
 #include "pcl_ddg/mesh/vertex_positions.h"
 #include "pcl_ddg/result_warnings.h"
 #include "pcl_ddg/search/point_spacing.h"
+#include "pcl_ddg/tiling/byte_size.h"
 
 namespace pcl_ddg {
 namespace tools {

@@ -1,6 +1,6 @@
 #pragma once
-// The steps the fitting tools (pca, quadric, robust) share: the neighbourhood options, the checks of the
-// sampling before a fit, the out-of-core run (-memory) and the warnings after a fit.
+// The steps the fitting tools (pca, quadric, robust) share: the neighbourhood options, the checks
+// of the sampling before a fit, the out-of-core run (-memory) and the warnings after a fit.
 #include <pcl/PolygonMesh.h>
 #include <pcl/console/print.h>
 #include <pcl/point_cloud.h>

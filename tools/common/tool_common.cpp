@@ -336,27 +336,6 @@ int runTool(const char* name, const char* description, const char* syntax,
   return code;
 }
 
-std::uint64_t parseByteSize(const std::string& text) {
-  std::size_t used = 0;
-  double value = 0.0;
-  try {
-    value = std::stod(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  const std::string unit = text.substr(used);
-  const double scale = unit.empty() || unit == "B"  ? 1.0
-                       : unit == "k" || unit == "K" ? 1024.0
-                       : unit == "M"                ? 1024.0 * 1024.0
-                       : unit == "G"                ? 1024.0 * 1024.0 * 1024.0
-                       : unit == "T"                ? 1024.0 * 1024.0 * 1024.0 * 1024.0
-                                                    : -1.0;
-  if (used == 0 || scale < 0.0 || !(value > 0.0) || !std::isfinite(value * scale) ||
-      value * scale > 1e18)
-    throw pcl::BadArgumentException("a size like 2G, 512M or 64k, not '" + text + "'");
-  return static_cast<std::uint64_t>(value * scale);
-}
-
 void printError(const char* tool_name, const std::string& message) {
   const std::lock_guard<std::mutex> lock(stderrMutex());
   endOpenLine();

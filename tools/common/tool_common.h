@@ -96,10 +96,6 @@ void checkOutputFile(const std::string& output, const std::vector<std::string>& 
 int runTool(const char* name, const char* description, const char* syntax,
             const std::function<int()>& body);
 
-/** The number of bytes of a size written like "2G", "512M", "64k" or "1000000" (-memory);
- *  throws pcl::BadArgumentException for anything else. */
-std::uint64_t parseByteSize(const std::string& text);
-
 /** Prints "tool: error: message" as one line of its own on stderr (newlines in the message become
  *  spaces; an unfinished progress line is ended first). */
 void printError(const char* tool_name, const std::string& message);
