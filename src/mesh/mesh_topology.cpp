@@ -164,13 +164,6 @@ void MeshTopology::gatherRing(int v, std::vector<int>& ring) const {
   ring.erase(std::unique(ring.begin(), ring.end()), ring.end());
 }
 
-void MeshTopology::buildNeighbourRowsOnce() const {
-  std::call_once(neighbour_rows_->once, [this] {
-    neighbour_rows_->rows = buildNeighbourRows();
-    neighbour_rows_->built.store(true, std::memory_order_release);
-  });
-}
-
 MeshTopology::NeighbourRows MeshTopology::buildNeighbourRows() const {
   // A row is found twice, once to size the rows and once to fill them, in a buffer per thread:
   // no scratch of two ints per incidence (55 MB for the bench torus).
@@ -204,13 +197,6 @@ int MeshTopology::findEdge(int a, int b) const {
   const int* it = std::lower_bound(row_a.begin(), row_a.end(), b);
   if (it == row_a.end() || *it != b) return -1;
   return edgeMap().vv_edges[neighbourRows().offsets[a] + static_cast<int>(it - row_a.begin())];
-}
-
-void MeshTopology::buildEdgeMapOnce() const {
-  std::call_once(edge_map_->once, [this] {
-    edge_map_->map = buildEdgeMap();
-    edge_map_->built.store(true, std::memory_order_release);
-  });
 }
 
 MeshTopology::EdgeMap MeshTopology::buildEdgeMap() const {

@@ -188,38 +188,40 @@ class MeshTopology {
   struct NeighbourRows {
     std::vector<int> offsets, neighbours;
   };
-  /** Built at most once, by the first caller; shared by copies, which have the same rows. */
-  struct LazyNeighbourRows {
+  /** A value built at most once, by the first caller (thread-safe), and shared by copies of the
+   *  topology, which would build the same. */
+  template <typename T>
+  struct Lazy {
     std::once_flag once;
-    std::atomic<bool> built{false};  ///< the inline check: no call once the rows are there
-    NeighbourRows rows;
+    std::atomic<bool> built{false};  ///< the inline check: no call once the value is there
+    T value;
+    template <typename Build>
+    const T& get(const Build& build) {
+      if (!built.load(std::memory_order_acquire)) {
+        std::call_once(once, [&] {
+          value = build();
+          built.store(true, std::memory_order_release);
+        });
+      }
+      return value;
+    }
   };
   const NeighbourRows& neighbourRows() const {
-    if (!neighbour_rows_->built.load(std::memory_order_acquire)) buildNeighbourRowsOnce();
-    return neighbour_rows_->rows;
+    return neighbour_rows_->get([this] { return buildNeighbourRows(); });
   }
-  void buildNeighbourRowsOnce() const;
   /** From the incidence rows: each incident triangle offers its two other corners. */
   NeighbourRows buildNeighbourRows() const;
-  /** Built at most once, by the first caller; shared by copies, which have the same rows. */
-  struct LazyEdgeMap {
-    std::once_flag once;
-    std::atomic<bool> built{false};  ///< the inline check: no call once the map is there
-    EdgeMap map;
-  };
   const EdgeMap& edgeMap() const {
-    if (!edge_map_->built.load(std::memory_order_acquire)) buildEdgeMapOnce();
-    return edge_map_->map;
+    return edge_map_->get([this] { return buildEdgeMap(); });
   }
-  void buildEdgeMapOnce() const;
   EdgeMap buildEdgeMap() const;
 
   int num_vertices_ = 0;
   Eigen::Matrix3Xi triangles_;
   std::vector<int> triangle_source_;  ///< empty when triangle t is polygon t for all t
   int num_edges_ = 0;
-  std::shared_ptr<LazyEdgeMap> edge_map_ = std::make_shared<LazyEdgeMap>();
-  std::shared_ptr<LazyNeighbourRows> neighbour_rows_ = std::make_shared<LazyNeighbourRows>();
+  std::shared_ptr<Lazy<EdgeMap>> edge_map_ = std::make_shared<Lazy<EdgeMap>>();
+  std::shared_ptr<Lazy<NeighbourRows>> neighbour_rows_ = std::make_shared<Lazy<NeighbourRows>>();
   std::vector<int> vt_offsets_, vt_triangles_;
   std::vector<std::uint8_t> vertex_flags_;
   std::vector<int> vertex_component_;
