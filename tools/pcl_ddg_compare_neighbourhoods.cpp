@@ -56,6 +56,7 @@ int run(int argc, char** argv) {
           return compareNeighbourhoods(in.local(), in.topology, options);
         }();
         timer.done(in.points()->size());
+        in.releaseLocal();
         tools::warnAboutLocalFit(kName, c.topological);
         tools::warnAboutLocalFit(kName, c.kd_tree);
         const NeighbourhoodComparison::Summary& s = c.summary;
@@ -82,7 +83,7 @@ int run(int argc, char** argv) {
           tools::setColorMapFields(kName, in.mesh.cloud, output, color, c.overlap,
                                    colorize(c.overlap, ColorMap::Sequential, {0.0, 100.0}));
         }
-        tools::saveResult(kName, output, in.mesh, in.positions,
+        tools::saveResult(kName, output, in.mesh, in.positions(),
                           tools::coordinatePrecision(in.coordinate_precision, precision),
                           in.sensor_pose, in.las, in.outputFaces());
       });

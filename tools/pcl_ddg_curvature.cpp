@@ -123,8 +123,8 @@ int run(int argc, char** argv) {
           if (!in.topology)
             throw tools::UsageError("-method cotan needs a mesh; this input is a point cloud");
           tools::Timer timer("Computing curvatures");
-          const VertexCurvatures c = computeCurvatures(*in.topology, in.positions, mass);
-          timer.done(static_cast<std::size_t>(in.positions.cols()));
+          const VertexCurvatures c = computeCurvatures(*in.topology, in.positions(), mass);
+          timer.done(static_cast<std::size_t>(in.positions().cols()));
           for (const std::string& message : curvatureWarnings(c)) tools::warn(kName, message);
           if (c.clamped_vertices > 0) {
             std::fprintf(stderr, "%s: %lld vertices with H^2 < K (umbilic or noisy): k1 = k2 = H\n",
@@ -143,6 +143,7 @@ int run(int argc, char** argv) {
             return fitLocalSurfaces(in.local(), in.topology, options);
           }();
           timer.done(in.points()->size());
+          in.releaseLocal();
           result.failed_points -= left_out;  // -classes: not fitted by request
           tools::warnAboutLocalFit(kName, result);
           tools::warnAboutRadius(kName, sampling, options, result);
@@ -162,7 +163,7 @@ int run(int argc, char** argv) {
           Eigen::MatrixXd fields(curvatures.mean.size(), 4);
           fields << curvatures.mean, curvatures.gauss, curvatures.k1, curvatures.k2;
           tools::Timer timer("Smoothing curvatures");
-          fields = smoothScalarFields(*in.topology, in.positions, fields, heat);
+          fields = smoothScalarFields(*in.topology, in.positions(), fields, heat);
           timer.done(static_cast<std::size_t>(fields.rows()));
           curvatures = {fields.col(0), fields.col(1), fields.col(2), fields.col(3)};
         }
@@ -177,7 +178,7 @@ int run(int argc, char** argv) {
               color == "mean" || color == "gauss" ? color + "_curvature" : color, values,
               colorize(values, ColorMap::Diverging, {percentile, 100.0 - percentile}));
         }
-        tools::saveResult(kName, output, in.mesh, in.positions,
+        tools::saveResult(kName, output, in.mesh, in.positions(),
                           tools::coordinatePrecision(in.coordinate_precision, precision),
                           in.sensor_pose, in.las, in.outputFaces());
       });

@@ -79,6 +79,9 @@ void reportSpanningTree(const pcl_ddg::ConsistentOrientationReport& report) {
   std::cerr << "\n";
 }
 
+// Points fitted at a time (fitLocalSurfacesInSlices): 32 MB of pcl::Normal.
+constexpr std::size_t kSlicePoints = std::size_t{1} << 20;
+
 /** An organized cloud's normals as an image: (n + 1) / 2 as red, green, blue; black where none. */
 void saveNormalMap(const std::string& path, const pcl::PointCloud<pcl::Normal>& normals) {
   if (normals.height < 2) {
@@ -166,7 +169,7 @@ int run(int argc, char** argv) {
             options.epsilon = args.number("epsilon", -1.0);
             if (options.epsilon < 0.0) throw tools::UsageError("-epsilon must be >= 0");
           }
-          const Eigen::Matrix3Xd& positions = in.positions;
+          const Eigen::Matrix3Xd& positions = in.positions();
           tools::Timer timer("Computing " + method + " normals");
           const MeshNormals normals = computeMeshNormals(*in.topology, positions, options);
           timer.done(static_cast<std::size_t>(positions.cols()));
@@ -192,9 +195,17 @@ int run(int argc, char** argv) {
           tools::Timer timer("Computing " + method + " normals (" +
                              tools::describeNeighbourhood(options) +
                              (spanning_tree ? ", oriented along a spanning tree)" : ")"));
+          // Written into the output a slice at a time: never the whole cloud's pcl::Normal beside it.
+          tools::FitFieldWriter fields(in.mesh.cloud, output, precision, method == "robust");
+          pcl::PointCloud<pcl::Normal> map_normals;  // -normal_map: all of them (one slice)
           LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
-            return fitLocalSurfaces(in.local(), in.topology, options);
+            return fitLocalSurfacesInSlices(
+                in.local(), in.topology, options, args.has("normal_map") ? 0 : kSlicePoints,
+                [&](std::size_t first, LocalFitResult& slice) {
+                  fields.write(first, slice);
+                  if (args.has("normal_map")) map_normals = std::move(slice.normals);
+                });
           }();
           timer.done(in.points()->size());
           in.releaseLocal();
@@ -202,20 +213,9 @@ int run(int argc, char** argv) {
           tools::warnAboutLocalFit(kName, result);
           tools::warnAboutRadius(kName, sampling, options, result);
           if (spanning_tree) reportSpanningTree(result.orientation);
-          if (args.has("normal_map")) saveNormalMap(*args.value("normal_map"), result.normals);
-          tools::setNormalFields(in.mesh.cloud, output, result.normals, precision);
-          if (!result.scales.empty()) {  // robust: the neighbours it used, and its confidence
-            const auto field = [](const std::vector<float>& values) {
-              return Eigen::Map<const Eigen::VectorXf>(values.data(),
-                                                       static_cast<Eigen::Index>(values.size()))
-                  .cast<double>()
-                  .eval();
-            };
-            setVertexField(in.mesh.cloud, "scale", field(result.scales), precision);
-            setVertexField(in.mesh.cloud, "confidence", field(result.confidences), precision);
-          }
+          if (args.has("normal_map")) saveNormalMap(*args.value("normal_map"), map_normals);
         }
-        tools::saveResult(kName, output, in.mesh, in.positions,
+        tools::saveResult(kName, output, in.mesh, in.positions(),
                           tools::coordinatePrecision(in.coordinate_precision, precision),
                           in.sensor_pose, in.las, in.outputFaces());
       });

@@ -128,19 +128,19 @@ int run(int argc, char** argv) {
       args, kName, {"ply", "pcd", "las", "laz"},
       [&](const std::string& input, const std::string& output) {
         tools::ToolInput in(input, kName, tools::InputKind::Mesh);
-        const ResolvedSteps resolved = resolveSteps(*in.topology, in.positions, steps, p);
+        const ResolvedSteps resolved = resolveSteps(*in.topology, in.positions(), steps, p);
         std::cerr << kName << ": " << describeSteps(p, resolved) << "\n";
         if (resolved.unstable) {
           tools::warn(kName, "the steps exceed the stability bound: expect the surface to blow up");
         }
 
-        const std::size_t points = static_cast<std::size_t>(in.positions.cols());
+        const std::size_t points = static_cast<std::size_t>(in.positions().cols());
         tools::Timer timer("Smoothing");
         tools::ProgressBar progress("> Smoothing");  // redrawn over the Timer's line
         MeshSmoothingReport report;
         const Eigen::Matrix3Xd smoothed = [&] {
           try {
-            return smoothMeshPositions(*in.topology, in.positions, p, &report,
+            return smoothMeshPositions(*in.topology, in.positions(), p, &report,
                                        [&](int done, int total) { progress.update(done, total); });
           } catch (const SurfaceCollapseException& e) {
             std::ostringstream what;
@@ -174,7 +174,7 @@ int run(int argc, char** argv) {
           std::cerr << kName << ": -thickness_limit " << p.thickness_limit << ": "
                     << report.thin_vertices << " of " << points
                     << " vertices smoothed for < 90% of the time (inner radius < "
-                    << reach / meanEdgeLength(*in.topology, in.positions)
+                    << reach / meanEdgeLength(*in.topology, in.positions())
                     << " h, or next to such parts); mean time fraction "
                     << report.mean_time_fraction << "\n";
         }

@@ -2,6 +2,8 @@
 
 #include <pcl/exceptions.h>
 
+#include <numeric>
+
 #include "pcl_ddg/features/organized_normals.h"
 #include "pcl_ddg/features/pca_normal_estimation.h"
 #include "pcl_ddg/features/quadric_normal_estimation.h"
@@ -146,6 +148,36 @@ LocalFitResult fitLocalSurfaces(const LocalCloud& local,
     throw pcl::ComputeFailedException("normal estimation failed (see the PCL error above)");
   }
   return result;
+}
+
+LocalFitResult fitLocalSurfacesInSlices(const LocalCloud& cloud,
+                                        const std::shared_ptr<const MeshTopology>& topology,
+                                        const LocalFitOptions& options, std::size_t slice_points,
+                                        const LocalFitSlice& take) {
+  const std::size_t n = cloud.points ? cloud.points->size() : 0;
+  LocalFitResult total;
+  const auto add = [&](std::size_t first, LocalFitResult& slice) {
+    total.failed_points += slice.failed_points;
+    total.fallback_points += slice.fallback_points;
+    total.orientation = slice.orientation;
+    take(first, slice);
+  };
+  if (options.neighbourhood != NeighbourhoodKind::KdTree ||
+      options.orientation == NormalOrientation::SpanningTree || slice_points == 0 ||
+      n <= slice_points) {
+    LocalFitResult whole = fitLocalSurfaces(cloud, topology, options);
+    add(0, whole);
+    return total;
+  }
+  LocalFitOptions shared = options;  // one tree, built by the first slice
+  if (!shared.kd_tree_search) shared.kd_tree_search = std::make_shared<KdTreeSearch<pcl::PointXYZ>>();
+  for (std::size_t first = 0; first < n; first += slice_points) {
+    auto indices = std::make_shared<pcl::Indices>(std::min(slice_points, n - first));
+    std::iota(indices->begin(), indices->end(), static_cast<pcl::index_t>(first));
+    LocalFitResult slice = fitLocalSurfaces(cloud, topology, shared, indices);
+    add(first, slice);
+  }
+  return total;
 }
 
 }  // namespace pcl_ddg

@@ -344,6 +344,17 @@ void pwriteAll(int fd, const std::string& path, std::uint64_t at, const char* by
   }
 }
 
+// Takes the whole pages of [at, at + size), written, out of the process: the file's page cache
+// keeps what was written (a shared file mapping's pages are dirty there, not lost), but they no
+// longer count in the writer's resident memory, which would otherwise grow by the whole output.
+// The pages at the ends, which a neighbouring block may share, stay.
+void forgetWrittenPages(char* at, std::size_t size) {
+  const auto page = static_cast<std::uintptr_t>(::sysconf(_SC_PAGESIZE));
+  const std::uintptr_t begin = (reinterpret_cast<std::uintptr_t>(at) + page - 1) / page * page;
+  const std::uintptr_t end = (reinterpret_cast<std::uintptr_t>(at) + size) / page * page;
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_DONTNEED);
+}
+
 void writeLAS(const std::string& path, const pcl::PCLPointCloud2& cloud, const LasLayout* source) {
   const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
   const LasPlan plan = planLAS(cloud, source, [&] {
@@ -401,8 +412,10 @@ void writeLAS(const std::string& path, const pcl::PCLPointCloud2& cloud, const L
     try {
       const VertexColors colors =
           plan.convert_colors ? vertexColors(rowsOf(cloud, first, count)) : VertexColors();
-      encodeRecords(plan, cloud, first, blockPositions(cloud, first, count), colors,
-                    file + plan.point_offset + first * plan.record_length, block_stats[b]);
+      char* const records = file + plan.point_offset + first * plan.record_length;
+      encodeRecords(plan, cloud, first, blockPositions(cloud, first, count), colors, records,
+                    block_stats[b]);
+      forgetWrittenPages(records, count * plan.record_length);
     } catch (...) {
       errors[b] = std::current_exception();
     }

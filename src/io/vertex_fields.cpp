@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 
 #include <pcl/common/io.h>
 #include <pcl/exceptions.h>
@@ -135,6 +136,60 @@ void writeFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& nam
 }
 
 }  // namespace
+
+void addVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                     FieldPrecision precision) {
+  for (const std::string& name : names) removeVertexField(cloud, name);
+  const bool as_double = precision == FieldPrecision::Double;
+  const std::uint32_t first_offset = appendFields(
+      cloud, names, as_double ? pcl::PCLPointField::FLOAT64 : pcl::PCLPointField::FLOAT32);
+  const std::size_t bytes = names.size() * (as_double ? 8 : 4);
+  std::vector<std::uint8_t> nan_row(bytes);
+  for (std::size_t at = 0; at < bytes; at += as_double ? 8 : 4) {
+    if (as_double) {
+      const double nan = std::numeric_limits<double>::quiet_NaN();
+      std::memcpy(nan_row.data() + at, &nan, 8);
+    } else {
+      const float nan = std::numeric_limits<float>::quiet_NaN();
+      std::memcpy(nan_row.data() + at, &nan, 4);
+    }
+  }
+  const std::size_t n = pointCount(cloud);
+  for (std::size_t i = 0; i < n; ++i)
+    std::memcpy(cloud.data.data() + i * cloud.point_step + first_offset, nan_row.data(), bytes);
+}
+
+void setVertexFieldSlice(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                         std::size_t first,
+                         const Eigen::Ref<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>& values) {
+  const std::size_t count = static_cast<std::size_t>(values.cols());
+  if (static_cast<std::size_t>(values.rows()) != names.size() || first > pointCount(cloud) ||
+      count > pointCount(cloud) - first)
+    throw pcl::BadArgumentException("a slice of " + std::to_string(values.rows()) + " x " +
+                                     std::to_string(count) + " values from point " +
+                                     std::to_string(first) + " for " +
+                                     std::to_string(names.size()) + " fields of " +
+                                     std::to_string(pointCount(cloud)) + " vertices");
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const auto field =
+        std::find_if(cloud.fields.begin(), cloud.fields.end(),
+                     [&](const pcl::PCLPointField& f) { return f.name == names[k]; });
+    if (field == cloud.fields.end() || (field->datatype != pcl::PCLPointField::FLOAT32 &&
+                                        field->datatype != pcl::PCLPointField::FLOAT64))
+      throw pcl::BadArgumentException("no float or double field " + names[k] + " to write");
+    const bool as_double = field->datatype == pcl::PCLPointField::FLOAT64;
+    std::uint8_t* dst = cloud.data.data() + first * cloud.point_step + field->offset;
+    for (std::size_t j = 0; j < count; ++j, dst += cloud.point_step) {
+      const float v = values(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(j));
+      if (as_double) {
+        const double d = v;
+        std::memcpy(dst, &d, 8);
+      } else {
+        std::memcpy(dst, &v, 4);
+      }
+    }
+  }
+}
 
 void setVertexField(pcl::PCLPointCloud2& cloud, const std::string& name,
                     const Eigen::VectorXd& values, FieldPrecision precision) {

@@ -36,7 +36,12 @@ Eigen::Vector3d localOrigin(const Eigen::AlignedBox3d& bounds) {
 
 LocalCloud makeLocalCloud(const PositionsRef& positions, const Eigen::Vector3d& origin,
                           std::uint32_t width) {
-  auto relative = std::make_shared<Eigen::Matrix3Xd>(positions.colwise() - origin);
+  return localCloudOf(std::make_shared<Eigen::Matrix3Xd>(positions.colwise() - origin), origin,
+                      width);
+}
+
+LocalCloud localCloudOf(std::shared_ptr<Eigen::Matrix3Xd> relative, const Eigen::Vector3d& origin,
+                        std::uint32_t width) {
   auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
   points->resize(relative->cols());
   for (Eigen::Index i = 0; i < relative->cols(); ++i) {

@@ -292,6 +292,81 @@ TEST(LocalFit, TilesOfASurveyCloudGiveTheWholeCloudsBits) {
   }
 }
 
+// Sliced, a fit hands every point over once, in order, with the bits of the whole cloud's fit:
+// PCA, quadric and robust (its scales and confidences too), with points left out (NaN) counted.
+TEST(LocalFit, SlicesGiveTheWholeCloudsBitsAndCounts) {
+  const Scene scene = makeScene(3000);
+  Eigen::Matrix3Xd world = scene.points.colwise() + kSurveyOffset;
+  std::int64_t left_out = 0;
+  for (Eigen::Index i = 5; i < world.cols(); i += 401, ++left_out) world.col(i).setConstant(NAN);
+  for (const bool dense : {true, false}) {
+    const LocalCloud local = makeLocalCloud(dense ? Eigen::Matrix3Xd(scene.points.colwise() +
+                                                                     kSurveyOffset)
+                                                  : world);
+    for (const LocalFitMethod method :
+         {LocalFitMethod::PCA, LocalFitMethod::Quadric, LocalFitMethod::Robust}) {
+      const LocalFitOptions options = kdTree(method, method == LocalFitMethod::Robust ? 24 : 16);
+      const LocalFitResult whole = fitLocalSurfaces(local, nullptr, options);
+      std::size_t next = 0, slices = 0;
+      const LocalFitResult counts = fitLocalSurfacesInSlices(
+          local, nullptr, options, 700, [&](std::size_t first, LocalFitResult& slice) {
+            ASSERT_EQ(first, next);
+            ++slices;
+            for (std::size_t j = 0; j < slice.normals.size(); ++j) {
+              const pcl::Normal &a = slice.normals[j], &b = whole.normals[first + j];
+              const float x[4] = {a.normal_x, a.normal_y, a.normal_z, a.curvature};
+              const float y[4] = {b.normal_x, b.normal_y, b.normal_z, b.curvature};
+              ASSERT_EQ(std::memcmp(x, y, sizeof x), 0) << first + j;
+              if (method == LocalFitMethod::Quadric)
+                ASSERT_EQ(std::memcmp(&slice.curvatures[j], &whole.curvatures[first + j],
+                                      sizeof(pcl::PrincipalCurvatures)),
+                          0);
+              if (method == LocalFitMethod::Robust) {
+                ASSERT_EQ(std::memcmp(&slice.scales[j], &whole.scales[first + j], 4), 0);
+                ASSERT_EQ(std::memcmp(&slice.confidences[j], &whole.confidences[first + j], 4), 0);
+              }
+            }
+            next += slice.normals.size();
+          });
+      EXPECT_EQ(next, whole.normals.size());
+      EXPECT_EQ(slices, (whole.normals.size() + 699) / 700);
+      EXPECT_EQ(counts.failed_points, whole.failed_points);
+      EXPECT_EQ(counts.fallback_points, whole.fallback_points);
+      EXPECT_EQ(whole.failed_points, dense ? 0 : left_out);
+      EXPECT_TRUE(counts.normals.empty());
+    }
+  }
+  // A spanning tree orients the normals together: one slice.
+  LocalFitOptions tree = kdTree(LocalFitMethod::PCA, 16);
+  tree.orientation = NormalOrientation::SpanningTree;
+  int slices = 0;
+  fitLocalSurfacesInSlices(makeLocalCloud(world), nullptr, tree, 700,
+                           [&](std::size_t first, LocalFitResult& slice) {
+                             EXPECT_EQ(first, 0u);
+                             EXPECT_EQ(slice.normals.size(),
+                                       static_cast<std::size_t>(world.cols()));
+                             ++slices;
+                           });
+  EXPECT_EQ(slices, 1);
+}
+
+// A caller's own positions shifted in place (what the tools do, instead of a second copy) make
+// the cloud makeLocalCloud makes, and shift back to the coordinates they were, bit for bit.
+TEST(LocalCloud, PositionsShiftedInPlaceAreMakeLocalCloudsAndShiftBackExactly) {
+  const Scene scene = makeScene(2000);
+  const Eigen::Matrix3Xd world = (0.37 * scene.points).colwise() + kSurveyOffset;
+  const Eigen::Vector3d origin = localOrigin(world);
+  const LocalCloud copied = makeLocalCloud(world, origin);
+  auto shifted = std::make_shared<Eigen::Matrix3Xd>(world.colwise() - origin);
+  const LocalCloud in_place = localCloudOf(shifted, origin);
+  ASSERT_TRUE(copied.positions && in_place.positions);
+  EXPECT_EQ(in_place.positions.get(), shifted.get());  // the caller's, not a copy
+  EXPECT_TRUE(*in_place.positions == *copied.positions);
+  for (std::size_t i = 0; i < copied.points->size(); ++i)
+    ASSERT_TRUE((*in_place.points)[i].getVector3fMap() == (*copied.points)[i].getVector3fMap());
+  EXPECT_TRUE(Eigen::Matrix3Xd(shifted->colwise() + origin) == world);
+}
+
 // The pixel grid's window sums read the exact coordinates too: an organized height field far
 // away, its sensor 30 above its middle, gives the normals it gives at the origin.
 TEST(LocalFit, GridNormalsDoNotDependOnWhereTheFrameSits) {

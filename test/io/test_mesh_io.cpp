@@ -203,6 +203,34 @@ TEST(VertexFields, FieldsChangeInPlaceWhenTheBlockHasRoomAndAlikeWhenNot) {
   EXPECT_TRUE(rows[0] == rows[1]);
 }
 
+// Fields laid out first and written a slice at a time are the fields setVertexFields writes at
+// once, float and double, and NaN where no slice was written; a missing field or a slice past the
+// last point is refused.
+TEST(VertexFields, FieldsWrittenASliceAtATimeAreTheFieldsWrittenAtOnce) {
+  const int n = 1000;
+  const pcl::PolygonMesh base = makeMesh(Eigen::Matrix3Xd::Random(3, n), {});
+  const Eigen::MatrixXf values = Eigen::MatrixXf::Random(2, n);
+  const auto slice = [&](int first, int count) {
+    return Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>(
+        values.data() + 2 * first, 2, count, Eigen::OuterStride<>(2));
+  };
+  for (const FieldPrecision precision : {FieldPrecision::Float, FieldPrecision::Double}) {
+    pcl::PCLPointCloud2 at_once = base.cloud, sliced = base.cloud;
+    setVertexFields(at_once, {"a", "b"}, slice(0, n), precision);
+    addVertexFields(sliced, {"a", "b"}, precision);
+    for (int first = 0; first < n - 100; first += 300)
+      setVertexFieldSlice(sliced, {"a", "b"}, first, slice(first, std::min(300, n - 100 - first)));
+    EXPECT_TRUE(std::isnan(vertexScalarField(sliced, "b")[n - 1]));
+    setVertexFieldSlice(sliced, {"a", "b"}, n - 100, slice(n - 100, 100));
+    EXPECT_EQ(sliced.fields.size(), at_once.fields.size());
+    EXPECT_TRUE(sliced.data == at_once.data);
+    EXPECT_THROW(setVertexFieldSlice(sliced, {"a", "b"}, n - 99, slice(0, 100)),
+                 pcl::BadArgumentException);
+    EXPECT_THROW(setVertexFieldSlice(sliced, {"a", "c"}, 0, slice(0, 100)),
+                 pcl::BadArgumentException);
+  }
+}
+
 TEST_F(MeshIOFiles, PlyRoundTripKeepsDoublesFieldsAndFaces) {
   Eigen::Matrix3Xd p(3, 4);
   p << 100000.123456789012, 1, 1, 0,  //

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <string>
 
 #include "estimator_support.h"
@@ -153,6 +154,38 @@ TEST(KdTreeSearch, WithIndicesSearchesOnlyThosePointsAndIndexQueriesFollowPCL) {
     expectSameNeighbours(a, da, b, db, "index query " + std::to_string(i));
     ASSERT_EQ(a.front(), (*even)[i]) << "an index query means the i-th searched point";
   }
+}
+
+// A dense cloud searched whole is indexed where its points lie (no copy, ids its own); with every
+// point given as indices it is copied first: the same answers, ties (a grid's) included, k
+// nearest and radius, and for a cloud whose points moved after, the moved points once
+// setInputCloud is called again.
+TEST(KdTreeSearch, ACloudIndexedWhereItLiesAnswersAsItsCopy) {
+  Eigen::Matrix3Xd grid(3, 900);
+  for (int i = 0; i < 900; ++i) grid.col(i) << i % 30, (i / 30) % 30, 0.25 * (i % 7);
+  const Cloud::Ptr cloud = toCloud(grid);
+  auto all = std::make_shared<pcl::Indices>(900);
+  std::iota(all->begin(), all->end(), 0);
+  KdTreeSearch<pcl::PointXYZ> in_place, copied;
+  in_place.setInputCloud(cloud);
+  copied.setInputCloud(cloud, all);
+  pcl::Indices a, b;
+  std::vector<float> da, db;
+  for (int i = 0; i < 900; ++i) {
+    in_place.nearestKSearch((*cloud)[i], 13, a, da);
+    copied.nearestKSearch((*cloud)[i], 13, b, db);
+    ASSERT_EQ(a, b) << i;
+    ASSERT_EQ(da, db) << i;
+    in_place.radiusSearch((*cloud)[i], 1.5, a, da);
+    copied.radiusSearch((*cloud)[i], 1.5, b, db);
+    ASSERT_EQ(a, b) << i;
+    ASSERT_EQ(da, db) << i;
+  }
+  for (auto& p : *cloud) p.x += 100.0f;
+  in_place.setInputCloud(cloud);
+  in_place.nearestKSearch(pcl::PointXYZ(100.0f, 0.0f, 0.0f), 1, a, da);
+  EXPECT_EQ(a, pcl::Indices{0});
+  EXPECT_EQ(da, std::vector<float>{0.0f});
 }
 
 TEST(KdTreeSearch, RadiusSearchCapsAtMaxNNWithTheNearestAndCountsMoreThanTheTree) {

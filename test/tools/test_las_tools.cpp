@@ -106,6 +106,7 @@ TEST(LasTools, ClassesFitsOnlyThoseClassesAndWritesEveryPoint) {
             0);
   const MeshFile out = readMeshFile(folder + "/g.las");
   ASSERT_EQ(out.positions.cols(), 110000);
+  EXPECT_TRUE(out.positions == las.positions);  // the points left out keep their coordinates
   const Eigen::Matrix3Xd n = normalsOf(out);
   const Eigen::Matrix3Xd ground = normalsOf(readMeshFile(folder + "/ground_n.pcd"));
   const Eigen::VectorXd classes = vertexScalarField(out.mesh.cloud, "classification");

@@ -133,6 +133,27 @@ TEST_F(SurveyCoordinates, FarDoublePlyAndLasGiveTheNormalsOfTheShapeAtTheOrigin)
   }
 }
 
+// The fit shifts a tool's own positions about the local origin and back: the output's coordinates
+// are the input's to the last bit (a double PLY far away, and one around the origin with -0 in
+// it, which a shift by 0 and back would turn into +0), every fitting tool.
+TEST_F(SurveyCoordinates, TheOutputsCoordinatesAreTheInputsBitForBit) {
+  Eigen::Matrix3Xd signed_zeros = scene();
+  for (Eigen::Index i = 0; i < signed_zeros.cols(); i += 7) signed_zeros(2, i) = -0.0;
+  save(path("zeros.ply"), signed_zeros, FieldPrecision::Double);
+  for (const char* name : {"far.ply", "zeros.ply"}) {
+    const Eigen::Matrix3Xd in = readMeshFile(path(name)).positions;
+    for (const char* tool : {PCL_DDG_NORMALS_TOOL, PCL_DDG_CURVATURE_TOOL}) {
+      const std::string out = path("same_" + std::string(name));
+      const ToolRun run = runTool(tool, path(name) + " " + out + " -method quadric -k 16");
+      ASSERT_EQ(run.exit_code, 0) << run.err;
+      const Eigen::Matrix3Xd got = readMeshFile(out).positions;
+      ASSERT_EQ(got.cols(), in.cols());
+      EXPECT_EQ(std::memcmp(got.data(), in.data(), sizeof(double) * in.size()), 0)
+          << tool << " " << name;
+    }
+  }
+}
+
 // Independent of the library: each sampled point's 16 nearest by brute force on the coordinates
 // read back from the LAS file (long double distances), their covariance about their mean, and
 // Eigen's eigenvector of its smallest eigenvalue.

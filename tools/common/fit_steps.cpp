@@ -161,7 +161,7 @@ LocalFitOptions localFitArguments(const ToolArguments& args, ToolInput& input,
     }
     request.radius = radius.value * spacing;
   }
-  applyNeighbourCounts(request, input.positions.cols(), kToolStyle, options);
+  applyNeighbourCounts(request, input.pointCount(), kToolStyle, options);
   return options;
 }
 
@@ -188,7 +188,7 @@ SamplingCheck checkSampling(const char* tool_name, ToolInput& input,
   if (input.topology) return check;  // a mesh's faces orient it; its edges are its spacing
   const pcl::PointCloud<pcl::PointXYZ>& points = *input.points();
   warnAboutQuantisation(tool_name, points);
-  const BoundingBox box = boundingBox(input.positions);
+  const BoundingBox box = input.bounds();
   if (const auto message = farViewpointWarning(box.min, box.max, options, kToolSpelling))
     warn(tool_name, *message);
   if (options.radius > 0.0) {
@@ -270,6 +270,7 @@ std::int64_t keepOnlyClasses(const char* tool_name, const ToolArguments& args, T
         "-classes needs a classification field (a LAS file); the input has "
         "none");
   const Eigen::VectorXd classification = vertexScalarField(input.mesh.cloud, "classification");
+  input.separateLocal();  // the points left out become NaN in the fits only, not in the output
   std::int64_t left_out = 0;
   for (Eigen::Index i = 0; i < classification.size(); ++i) {
     if (std::find(classes.begin(), classes.end(), static_cast<int>(classification[i])) !=

@@ -20,6 +20,18 @@ namespace {
 // curvature in double, robust's scale and confidence (reserved, not touched until written).
 constexpr std::size_t kSparePointBytes = 24 + 4 * 8 + 2 * 8;
 
+// Moves the finite points by `by`: exact both ways about a local origin (local_cloud.h), which
+// holds for the points its box was made of; a point with a NaN coordinate is left as read (it is
+// no one's neighbour, its other coordinates may lie anywhere). Axes not moved are not touched:
+// -0 + 0 would come back as +0.
+void moveFinitePoints(Eigen::Matrix3Xd& positions, const Eigen::Vector3d& by) {
+  for (int d = 0; d < 3; ++d) {
+    if (by[d] == 0.0) continue;
+    for (Eigen::Index i = 0; i < positions.cols(); ++i)
+      if (positions.col(i).allFinite()) positions(d, i) += by[d];
+  }
+}
+
 }  // namespace
 
 ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind kind) {
@@ -34,7 +46,8 @@ ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind k
     throw std::runtime_error(path + " has no faces (a point cloud?)");
   mesh = std::move(file.mesh);
   faces = std::move(file.faces);
-  positions = std::move(file.positions);
+  positions_ = std::make_shared<Eigen::Matrix3Xd>(std::move(file.positions));
+  const Eigen::Matrix3Xd& positions = *positions_;
   sensor_pose = file.sensor_pose;
   las = std::move(file.las);
   coordinate_precision = file.coordinate_precision;
@@ -75,10 +88,35 @@ ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind k
   }
 }
 
+const Eigen::Matrix3Xd& ToolInput::positions() const {
+  if (shifted_)
+    throw std::logic_error("ToolInput::positions() while local() holds them (releaseLocal() first)");
+  return *positions_;
+}
+
+BoundingBox ToolInput::bounds() const {
+  BoundingBox box = boundingBox(*positions_);
+  if (shifted_) {  // exact: each finite point about the origin plus the origin is the one read
+    box.min += local_->origin;
+    box.max += local_->origin;
+  }
+  return box;
+}
+
 const LocalCloud& ToolInput::local() {
   if (local_) return *local_;
-  // An organized cloud (a frame, a range image) keeps its pixel grid and its sensor.
-  local_ = makeLocalCloud(positions, !topology && mesh.cloud.height > 1 ? mesh.cloud.width : 0);
+  const Eigen::Vector3d origin = localOrigin(*positions_);
+  moveFinitePoints(*positions_, -origin);
+  try {
+    // An organized cloud (a frame, a range image) keeps its pixel grid and its sensor.
+    local_ =
+        localCloudOf(positions_, origin, !topology && mesh.cloud.height > 1 ? mesh.cloud.width : 0);
+  } catch (...) {
+    moveFinitePoints(*positions_, origin);
+    throw;
+  }
+  shifted_ = local_->positions != nullptr;
+  if (!shifted_) moveFinitePoints(*positions_, origin);  // the floats hold them: no doubles shared
   points_ = std::const_pointer_cast<pcl::PointCloud<pcl::PointXYZ>>(local_->points);
   points_->sensor_origin_.head<3>() = (sensor_pose.origin - local_->origin).cast<float>();
   points_->sensor_orientation_ = sensor_pose.orientation.cast<float>();
@@ -98,13 +136,23 @@ std::shared_ptr<const FaceRows> ToolInput::outputFaces() const {
   return rows;
 }
 
+void ToolInput::separateLocal() {
+  local();
+  if (!shifted_) return;
+  local_->positions = std::make_shared<Eigen::Matrix3Xd>(*positions_);
+  moveFinitePoints(*positions_, local_->origin);
+  shifted_ = false;
+}
+
 void ToolInput::releaseLocal() {
+  if (shifted_) moveFinitePoints(*positions_, local_->origin);
+  shifted_ = false;
   points_.reset();
   local_.reset();
 }
 
 double ToolInput::spacing() {
-  if (!spacing_) spacing_ = topology ? meanEdgeLength(*topology, positions) : meanSpacing(points());
+  if (!spacing_) spacing_ = topology ? meanEdgeLength(*topology, *positions_) : meanSpacing(points());
   return *spacing_;
 }
 

@@ -54,6 +54,29 @@ void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
   setVertexFields(cloud, {"curvature"}, normalRows(normals, 4, 1), precision);
 }
 
+FitFieldWriter::FitFieldWriter(pcl::PCLPointCloud2& cloud, const std::string& output_path,
+                               FieldPrecision precision, bool robust_scores)
+    : cloud_(cloud), normal_names_(normalNames(cloud, output_path)), robust_scores_(robust_scores) {
+  addVertexFields(cloud, normal_names_, precision);
+  addVertexFields(cloud, {"curvature"}, precision);
+  if (robust_scores) {
+    addVertexFields(cloud, {"scale"}, precision);
+    addVertexFields(cloud, {"confidence"}, precision);
+  }
+}
+
+void FitFieldWriter::write(std::size_t first, const LocalFitResult& slice) {
+  setVertexFieldSlice(cloud_, normal_names_, first, normalRows(slice.normals, 0, 3));
+  setVertexFieldSlice(cloud_, {"curvature"}, first, normalRows(slice.normals, 4, 1));
+  if (!robust_scores_) return;
+  const auto row = [](const std::vector<float>& values) {
+    return Eigen::Map<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>(
+        values.data(), 1, static_cast<Eigen::Index>(values.size()), Eigen::OuterStride<>(1));
+  };
+  setVertexFieldSlice(cloud_, {"scale"}, first, row(slice.scales));
+  setVertexFieldSlice(cloud_, {"confidence"}, first, row(slice.confidences));
+}
+
 Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals) {
   Eigen::Matrix3Xd n(3, normals.size());
   for (std::size_t i = 0; i < normals.size(); ++i)

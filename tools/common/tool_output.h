@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/tool_common.h"
+#include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 
@@ -32,6 +33,22 @@ void setNormalTriple(pcl::PCLPointCloud2& cloud, const std::string& output_path,
  *  (surface variation) as "curvature". */
 void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
                      const pcl::PointCloud<pcl::Normal>& normals, FieldPrecision precision);
+
+/** setNormalFields, and robust's scale and confidence (the neighbours it used, its confidence),
+ *  written a slice of points at a time as fitLocalSurfacesInSlices hands them over: the fields
+ *  are laid out (NaN) when it is made, in the order and precision setNormalFields and
+ *  setVertexField give them. */
+class FitFieldWriter {
+ public:
+  FitFieldWriter(pcl::PCLPointCloud2& cloud, const std::string& output_path,
+                 FieldPrecision precision, bool robust_scores);
+  void write(std::size_t first, const LocalFitResult& slice);
+
+ private:
+  pcl::PCLPointCloud2& cloud_;
+  std::vector<std::string> normal_names_;
+  bool robust_scores_;
+};
 
 /** The normals of a PCL estimator as a 3 x N matrix (NaN kept). */
 Eigen::Matrix3Xd normalsOf(const pcl::PointCloud<pcl::Normal>& normals);

@@ -61,18 +61,19 @@ std::string count(std::int64_t n, const std::string& what) {
 ViewerModel::ViewerModel(tools::ToolInput input, std::string path)
     : input_(std::move(input)), path_(std::move(path)) {
   capabilities_.is_mesh = static_cast<bool>(input_.topology);
-  capabilities_.points = static_cast<int>(input_.positions.cols());
+  capabilities_.points = static_cast<int>(input_.pointCount());
   capabilities_.properties = colourableProperties(input_.mesh.cloud);
   if (vertexColorLayout(input_.mesh.cloud)) {
     capabilities_.has_colors = true;
     file_colors_ = vertexColors(input_.mesh.cloud);
   }
-  spacing_ = input_.spacing();
-  const Eigen::AlignedBox3d box = finiteBounds(input_.positions);
+  const Eigen::AlignedBox3d box = finiteBounds(input_.positions());
   diagonal_ = box.isEmpty() ? 0.0 : box.diagonal().norm();
-  if (!(spacing_ > 0.0)) spacing_ = 1.0;
-  positions_["input;"] = std::make_shared<const Eigen::Matrix3Xd>(input_.positions);
+  positions_["input;"] = std::make_shared<const Eigen::Matrix3Xd>(input_.positions());
+  // The input's own positions from here on are positions_'s: local() holds the ToolInput's.
   clouds_["input;"] = input_.local();
+  spacing_ = input_.spacing();
+  if (!(spacing_ > 0.0)) spacing_ = 1.0;
 }
 
 ViewerModel::Positions ViewerModel::positionsAfter(const std::vector<SmoothingStep>& steps,

@@ -47,13 +47,13 @@ class ViewerModel {
   const std::string& path() const { return path_; }
   bool isMesh() const { return static_cast<bool>(input_.topology); }
   const MeshTopology* topology() const { return input_.topology.get(); }
-  const Eigen::Matrix3Xd& inputPositions() const { return input_.positions; }
+  const Eigen::Matrix3Xd& inputPositions() const { return *positions_.at("input;"); }
   /** Where the sensor was (a PCD's VIEWPOINT): clouds are first seen from there. */
   const SensorPose& sensorPose() const { return input_.sensor_pose; }
   /** An organized cloud (width x height grid): seen from its sensor. */
   bool organized() const { return input_.mesh.cloud.height > 1; }
   /** A LAS survey, or coordinates far from the origin (UTM): +z is up. */
-  bool geographic() const { return input_.las || farFromOrigin(input_.positions); }
+  bool geographic() const { return input_.las || farFromOrigin(inputPositions()); }
   /** Mean edge length (meshes) or mean point spacing (clouds). */
   double spacing() const { return spacing_; }
 

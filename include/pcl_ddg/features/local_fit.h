@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -93,5 +94,22 @@ int gridWindowRadius(int k);
 LocalFitResult fitLocalSurfaces(const LocalCloud& cloud,
                                 const std::shared_ptr<const MeshTopology>& topology,
                                 const LocalFitOptions& options, const pcl::IndicesPtr& indices);
+
+/** Receives the fits of points first .. first + slice.normals.size() - 1 (to move from). */
+using LocalFitSlice = std::function<void(std::size_t first, LocalFitResult& slice)>;
+
+/**
+ * fitLocalSurfaces a slice of at most slice_points points at a time (their neighbours from the
+ * whole cloud), each slice's result handed to take and then freed: every point's fit the same, to
+ * the last bit (a point's fit depends on its neighbourhood only, and every slice searches the same
+ * kd-tree), while the output (32 bytes a point as pcl::Normal) and the order the fits visit are
+ * held for one slice, not for the whole cloud. One slice for all where the fits need each other
+ * or another search than the kd-tree: orientation along a spanning tree, mesh rings, the grid.
+ * Returns the counts (failed, fell back) summed over the slices, without normals.
+ */
+LocalFitResult fitLocalSurfacesInSlices(const LocalCloud& cloud,
+                                        const std::shared_ptr<const MeshTopology>& topology,
+                                        const LocalFitOptions& options, std::size_t slice_points,
+                                        const LocalFitSlice& take);
 
 }  // namespace pcl_ddg

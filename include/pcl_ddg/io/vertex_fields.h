@@ -34,6 +34,18 @@ void setVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>&
                      const Eigen::Ref<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>& values,
                      FieldPrecision precision = FieldPrecision::Float);
 
+/** Lays out the fields `names` (replacing any of the same names), NaN until setVertexFieldSlice
+ *  writes them: a result that comes a slice of points at a time is written where it belongs and
+ *  never held whole beside the cloud. In place within cloud.data's capacity, as setVertexFields. */
+void addVertexFields(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                     FieldPrecision precision = FieldPrecision::Float);
+/** Writes row r of `values` into field names[r] (FLOAT32 or FLOAT64, one value a point) of points
+ *  first .. first + values.cols() - 1; throws pcl::BadArgumentException for a missing field or
+ *  points beyond the cloud's. */
+void setVertexFieldSlice(pcl::PCLPointCloud2& cloud, const std::vector<std::string>& names,
+                         std::size_t first,
+                         const Eigen::Ref<const Eigen::MatrixXf, 0, Eigen::OuterStride<>>& values);
+
 /**
  * Writes positions as the x, y, z fields in the given precision: in place when they already have
  * that type, else as the first three fields of a new layout (every other field kept, in order).

@@ -65,6 +65,14 @@ struct LocalCloud {
 LocalCloud makeLocalCloud(const PositionsRef& positions, const Eigen::Vector3d& origin,
                           std::uint32_t width = 0);
 
+/** The same from positions already relative to origin (world coordinates minus origin), taken
+ *  as they are and not copied: they become the LocalCloud's positions, or none when the floats
+ *  hold them exactly (then the caller's matrix is left to the caller alone). What lets a caller
+ *  shift its own coordinates in place and back (x - origin is exact, by the rule above, and so
+ *  is adding origin back) instead of keeping a second copy. */
+LocalCloud localCloudOf(std::shared_ptr<Eigen::Matrix3Xd> relative, const Eigen::Vector3d& origin,
+                        std::uint32_t width = 0);
+
 /** The same about positions' own local origin. */
 inline LocalCloud makeLocalCloud(const PositionsRef& positions, std::uint32_t width = 0) {
   return makeLocalCloud(positions, localOrigin(positions), width);

@@ -21,11 +21,16 @@ class PointKdTree {
   /** Indexes the points xyz[3 * i .. 3 * i + 2] for i in [0, count); their ids in the answers are
    *  ids[i] (the caller's numbering). */
   PointKdTree(std::vector<float> xyz, std::vector<pcl::index_t> ids);
+  /** Indexes points where they lie, point i at xyz[stride * i .. stride * i + 2] with id i (a PCL
+   *  cloud's floats: neither they nor their ids are copied); owner keeps them alive and unchanged
+   *  as long as the tree. */
+  PointKdTree(std::shared_ptr<const void> owner, const float* xyz, std::size_t stride,
+              std::size_t count);
   ~PointKdTree();
   PointKdTree(const PointKdTree&) = delete;
   PointKdTree& operator=(const PointKdTree&) = delete;
 
-  std::size_t size() const { return ids_.size(); }
+  std::size_t size() const { return size_; }
 
   /** The k nearest points, sorted by squared distance, ties by id: one answer whatever the tree's
    *  shape (what makes tiled processing equal to whole-cloud processing); returns how many (fewer
@@ -41,7 +46,12 @@ class PointKdTree {
 
  private:
   struct Index;
-  std::vector<pcl::index_t> ids_;
+  void build(const float* xyz, std::size_t stride);
+
+  std::vector<float> storage_;          ///< the points, when the tree keeps them
+  std::shared_ptr<const void> owner_;   ///< the points, when they lie elsewhere
+  std::vector<pcl::index_t> ids_;       ///< the caller's ids, by FLANN's index; empty: the same
+  std::size_t size_ = 0;
   std::unique_ptr<Index> index_;
 };
 

@@ -1,6 +1,8 @@
 #pragma once
 #include <pcl/common/point_tests.h>
 
+#include <algorithm>
+
 #include "pcl_ddg/search/kd_tree_search.h"
 
 namespace pcl_ddg {
@@ -10,6 +12,17 @@ void KdTreeSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud,
                                          const IndicesConstPtr& indices) {
   this->input_ = cloud;
   this->indices_ = indices;
+  static_assert(sizeof(PointT) % sizeof(float) == 0, "PCL points are floats");
+  if (!indices && cloud && !cloud->empty() &&
+      std::all_of(cloud->begin(), cloud->end(),
+                  [](const PointT& p) { return pcl::isXYZFinite(p); })) {
+    // Every point, in order: indexed where it lies (x, y, z are consecutive floats in PCL's
+    // point types), not copied.
+    tree_ = std::make_shared<const detail::PointKdTree>(cloud, &(*cloud)[0].x,
+                                                        sizeof(PointT) / sizeof(float),
+                                                        cloud->size());
+    return;
+  }
   std::vector<float> xyz;
   std::vector<pcl::index_t> ids;
   const std::size_t candidates = indices ? indices->size() : (cloud ? cloud->size() : 0);
