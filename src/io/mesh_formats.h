@@ -64,8 +64,9 @@ BinaryCloudLayout plyBinaryLayout(std::string_view head);
 /** The faces are rows when given (mesh.polygons is then empty), else mesh.polygons. */
 void writePLY(std::ostream& out, const pcl::PolygonMesh& mesh, PlyEncoding encoding,
               const FaceRows* rows = nullptr);
-/** A cloud as a binary_compressed PCD file (padding fields left out). */
-std::string encodePCD(const pcl::PCLPointCloud2& cloud, const SensorPose& sensor_pose);
+/** A cloud as a binary_compressed PCD file (padding fields left out); `out` must be seekable (the
+ *  sizes before the data are written last). */
+void writePCD(std::ostream& out, const pcl::PCLPointCloud2& cloud, const SensorPose& sensor_pose);
 /** The header of a binary (uncompressed) PCD file of `points` points with the cloud's fields
  *  (every field, padding included, so that the records are cloud.data's rows as they are). */
 std::string binaryPCDHeader(const pcl::PCLPointCloud2& cloud, std::int64_t width,

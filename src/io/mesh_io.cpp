@@ -34,9 +34,11 @@ const pcl::PolygonMesh& withColorLayout(const pcl::PolygonMesh& mesh, ColorLayou
 }
 
 void savePCD(const std::string& path, const pcl::PolygonMesh& mesh, const SensorPose& pose) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
   pcl::PolygonMesh converted;
-  writeBytes(path, detail::encodePCD(withColorLayout(mesh, ColorLayout::PackedRGB, converted).cloud,
-                                     pose));
+  detail::writePCD(out, withColorLayout(mesh, ColorLayout::PackedRGB, converted).cloud, pose);
+  out.close();
+  if (!out) throw FileFormatException(std::string("write failed: ") + std::strerror(errno));
 }
 
 void savePLY(const std::string& path, const pcl::PolygonMesh& mesh, PlyEncoding encoding,

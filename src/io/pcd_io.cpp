@@ -347,44 +347,59 @@ std::string binaryPCDHeader(const pcl::PCLPointCloud2& cloud, std::int64_t width
 }
 
 // binary_compressed, as PCL's tools write it: the fields one after the other (each as an array
-// over all points), LZF-compressed. Padding fields ("_") carry nothing and are left out.
-std::string encodePCD(const pcl::PCLPointCloud2& cloud, const SensorPose& sensor_pose) {
+// over all points), LZF-compressed. Padding fields ("_") carry nothing and are left out. The
+// planar bytes are compressed a block at a time and written as they come: blocks compressed
+// apart make one LZF stream (each starts with a literal run and refers back only into itself),
+// which PCL's reader decompresses in one call; so only two blocks are held, not the planar copy
+// and its compression beside the cloud (2.5 bytes of memory for each byte of the file).
+void writePCD(std::ostream& out, const pcl::PCLPointCloud2& cloud, const SensorPose& sensor_pose) {
   std::vector<const pcl::PCLPointField*> fields;
   for (const auto& f : cloud.fields) {
     if (f.name != "_" && pcl::getFieldSize(f.datatype) > 0) fields.push_back(&f);
   }
   if (fields.empty()) throw FileFormatException("the cloud has no fields to write");
   const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
-  const std::string header =
-      pcdHeader(fields, cloud.width, cloud.height, sensor_pose, "binary_compressed");
+  std::uint64_t planar_size = 0;
+  for (const auto* f : fields)
+    planar_size += std::uint64_t{pcl::getFieldSize(f->datatype)} *
+                   std::max<std::uint32_t>(f->count, 1) * n;
+  if (planar_size > std::numeric_limits<std::uint32_t>::max() / 2) {
+    throw FileFormatException("cloud too large for a compressed PCD file");
+  }
+  out << pcdHeader(fields, cloud.width, cloud.height, sensor_pose, "binary_compressed");
+  const std::streampos sizes_at = out.tellp();
+  out.write("\0\0\0\0\0\0\0\0", 8);  // the sizes, once known
 
-  std::string planar;
+  constexpr std::size_t kBlock = std::size_t{1} << 20;
+  std::vector<char> planar(kBlock);
+  // LZF may expand incompressible data slightly; PCL allows 1.5x as well.
+  std::vector<char> packed(kBlock + kBlock / 2 + 64);
+  std::size_t filled = 0;
+  std::uint64_t packed_total = 0;
+  const auto flush = [&] {
+    if (filled == 0) return;
+    const unsigned int size = lzf_compress(planar.data(), static_cast<unsigned int>(filled),
+                                           packed.data(), static_cast<unsigned int>(packed.size()));
+    if (size == 0) throw FileFormatException("LZF compression failed");
+    out.write(packed.data(), size);
+    packed_total += size;
+    filled = 0;
+  };
   for (const auto* f : fields) {
     const std::size_t size = pcl::getFieldSize(f->datatype) * std::max<std::uint32_t>(f->count, 1);
     for (std::size_t i = 0; i < n; ++i) {
-      planar.append(
-          reinterpret_cast<const char*>(cloud.data.data() + i * cloud.point_step + f->offset),
-          size);
+      if (filled + size > kBlock) flush();
+      std::memcpy(planar.data() + filled, cloud.data.data() + i * cloud.point_step + f->offset,
+                  size);
+      filled += size;
     }
   }
-  if (planar.size() > std::numeric_limits<std::uint32_t>::max() / 2) {
-    throw FileFormatException("cloud too large for a compressed PCD file");
-  }
-  // LZF may expand incompressible data slightly; PCL allows 1.5x as well.
-  std::string packed(planar.size() + planar.size() / 2 + 64, '\0');
-  const unsigned int packed_size =
-      planar.empty() ? 0
-                     : lzf_compress(planar.data(), static_cast<unsigned int>(planar.size()),
-                                    packed.data(), static_cast<unsigned int>(packed.size()));
-  if (packed_size == 0 && !planar.empty()) throw FileFormatException("LZF compression failed");
-  const auto sizes = [](std::uint32_t compressed, std::uint32_t uncompressed) {
-    std::string bytes(8, '\0');
-    std::memcpy(bytes.data(), &compressed, 4);
-    std::memcpy(bytes.data() + 4, &uncompressed, 4);
-    return bytes;
-  };
-  return header + sizes(packed_size, static_cast<std::uint32_t>(planar.size())) +
-         packed.substr(0, packed_size);
+  flush();
+  const std::uint32_t sizes[2] = {static_cast<std::uint32_t>(packed_total),
+                                  static_cast<std::uint32_t>(planar_size)};
+  out.seekp(sizes_at);
+  out.write(reinterpret_cast<const char*>(sizes), 8);
+  out.seekp(0, std::ios::end);
 }
 
 }  // namespace detail
