@@ -79,8 +79,8 @@ void reportSpanningTree(const pcl_ddg::ConsistentOrientationReport& report) {
   std::cerr << "\n";
 }
 
-// Points fitted at a time (fitLocalSurfacesInSlices): 32 MB of pcl::Normal.
-constexpr std::size_t kSlicePoints = std::size_t{1} << 20;
+// Points fitted at a time (fitLocalSurfacesInSlices): 8 MB of pcl::Normal.
+constexpr std::size_t kSlicePoints = std::size_t{1} << 18;
 
 /** An organized cloud's normals as an image: (n + 1) / 2 as red, green, blue; black where none. */
 void saveNormalMap(const std::string& path, const pcl::PointCloud<pcl::Normal>& normals) {

@@ -56,16 +56,23 @@ void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
 
 FitFieldWriter::FitFieldWriter(pcl::PCLPointCloud2& cloud, const std::string& output_path,
                                FieldPrecision precision, bool robust_scores)
-    : cloud_(cloud), normal_names_(normalNames(cloud, output_path)), robust_scores_(robust_scores) {
-  addVertexFields(cloud, normal_names_, precision);
-  addVertexFields(cloud, {"curvature"}, precision);
-  if (robust_scores) {
-    addVertexFields(cloud, {"scale"}, precision);
-    addVertexFields(cloud, {"confidence"}, precision);
-  }
-}
+    : cloud_(cloud),
+      normal_names_(normalNames(cloud, output_path)),
+      precision_(precision),
+      robust_scores_(robust_scores) {}
 
 void FitFieldWriter::write(std::size_t first, const LocalFitResult& slice) {
+  if (!laid_out_) {
+    // With the first slice, when the fit's search is built: its peak and the fields' memory do
+    // not meet.
+    addVertexFields(cloud_, normal_names_, precision_);
+    addVertexFields(cloud_, {"curvature"}, precision_);
+    if (robust_scores_) {
+      addVertexFields(cloud_, {"scale"}, precision_);
+      addVertexFields(cloud_, {"confidence"}, precision_);
+    }
+    laid_out_ = true;
+  }
   setVertexFieldSlice(cloud_, normal_names_, first, normalRows(slice.normals, 0, 3));
   setVertexFieldSlice(cloud_, {"curvature"}, first, normalRows(slice.normals, 4, 1));
   if (!robust_scores_) return;

@@ -36,7 +36,7 @@ void setNormalFields(pcl::PCLPointCloud2& cloud, const std::string& output_path,
 
 /** setNormalFields, and robust's scale and confidence (the neighbours it used, its confidence),
  *  written a slice of points at a time as fitLocalSurfacesInSlices hands them over: the fields
- *  are laid out (NaN) when it is made, in the order and precision setNormalFields and
+ *  are laid out (NaN) with the first slice, in the order and precision setNormalFields and
  *  setVertexField give them. */
 class FitFieldWriter {
  public:
@@ -47,7 +47,9 @@ class FitFieldWriter {
  private:
   pcl::PCLPointCloud2& cloud_;
   std::vector<std::string> normal_names_;
+  FieldPrecision precision_;
   bool robust_scores_;
+  bool laid_out_ = false;
 };
 
 /** The normals of a PCL estimator as a 3 x N matrix (NaN kept). */

@@ -7,9 +7,8 @@
  * Non-finite points are never indexed nor returned. With indices in setInputCloud only those
  * points are searched, and an index query (nearestKSearch(i, ...)) means the i-th of them, as in
  * PCL. k nearest are sorted by distance; radius results when setSortedResults(true) (the default).
- * A cloud of finite points searched whole is indexed where its points lie, not copied as
- * pcl::search::KdTree does: after changing them, call setInputCloud again (every estimator's
- * compute does).
+ * A cloud of finite points searched whole is indexed straight from its points, without the
+ * packed copy pcl::search::KdTree makes first.
  */
 #include <pcl/search/search.h>
 

@@ -22,10 +22,8 @@ class PointKdTree {
    *  ids[i] (the caller's numbering). */
   PointKdTree(std::vector<float> xyz, std::vector<pcl::index_t> ids);
   /** Indexes points where they lie, point i at xyz[stride * i .. stride * i + 2] with id i (a PCL
-   *  cloud's floats: neither they nor their ids are copied); owner keeps them alive and unchanged
-   *  as long as the tree. */
-  PointKdTree(std::shared_ptr<const void> owner, const float* xyz, std::size_t stride,
-              std::size_t count);
+   *  cloud's floats: not first copied, and no ids), read while the tree is built. */
+  PointKdTree(const float* xyz, std::size_t stride, std::size_t count);
   ~PointKdTree();
   PointKdTree(const PointKdTree&) = delete;
   PointKdTree& operator=(const PointKdTree&) = delete;
@@ -48,9 +46,7 @@ class PointKdTree {
   struct Index;
   void build(const float* xyz, std::size_t stride);
 
-  std::vector<float> storage_;          ///< the points, when the tree keeps them
-  std::shared_ptr<const void> owner_;   ///< the points, when they lie elsewhere
-  std::vector<pcl::index_t> ids_;       ///< the caller's ids, by FLANN's index; empty: the same
+  std::vector<pcl::index_t> ids_;  ///< the caller's ids, by FLANN's index; empty: the same
   std::size_t size_ = 0;
   std::unique_ptr<Index> index_;
 };

@@ -16,11 +16,10 @@ void KdTreeSearch<PointT>::setInputCloud(const PointCloudConstPtr& cloud,
   if (!indices && cloud && !cloud->empty() &&
       std::all_of(cloud->begin(), cloud->end(),
                   [](const PointT& p) { return pcl::isXYZFinite(p); })) {
-    // Every point, in order: indexed where it lies (x, y, z are consecutive floats in PCL's
-    // point types), not copied.
-    tree_ = std::make_shared<const detail::PointKdTree>(cloud, &(*cloud)[0].x,
-                                                        sizeof(PointT) / sizeof(float),
-                                                        cloud->size());
+    // Every point, in order: indexed from where it lies (x, y, z are consecutive floats in PCL's
+    // point types), not first copied.
+    tree_ = std::make_shared<const detail::PointKdTree>(
+        &(*cloud)[0].x, sizeof(PointT) / sizeof(float), cloud->size());
     return;
   }
   std::vector<float> xyz;
