@@ -162,7 +162,8 @@ LocalFitResult fitLocalSurfacesInSlices(const LocalCloud& cloud,
     total.orientation = slice.orientation;
     take(first, slice);
   };
-  if (options.neighbourhood != NeighbourhoodKind::KdTree ||
+  // Robust's wider planes are formed over the whole surface at every compute.
+  if (options.neighbourhood != NeighbourhoodKind::KdTree || options.method == LocalFitMethod::Robust ||
       options.orientation == NormalOrientation::SpanningTree || slice_points == 0 ||
       n <= slice_points) {
     LocalFitResult whole = fitLocalSurfaces(cloud, topology, options);

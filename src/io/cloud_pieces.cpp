@@ -196,7 +196,6 @@ CloudPiece CloudPieceReader::read(std::int64_t first, std::int64_t count) {
                                     std::to_string(first + count) + " are not in the file");
   }
   std::string file = format_->headerFor(count);
-  const std::size_t header = file.size();
   const auto bytes = static_cast<std::size_t>(count * layout_.point_bytes);
   if (format_->laz) {
     file += lazRecords(first, count);

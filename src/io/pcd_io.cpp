@@ -361,7 +361,7 @@ void writePCD(std::ostream& out, const pcl::PCLPointCloud2& cloud, const SensorP
   const std::size_t n = static_cast<std::size_t>(cloud.width) * cloud.height;
   std::uint64_t planar_size = 0;
   for (const auto* f : fields)
-    planar_size += std::uint64_t{pcl::getFieldSize(f->datatype)} *
+    planar_size += static_cast<std::uint64_t>(pcl::getFieldSize(f->datatype)) *
                    std::max<std::uint32_t>(f->count, 1) * n;
   if (planar_size > std::numeric_limits<std::uint32_t>::max() / 2) {
     throw FileFormatException("cloud too large for a compressed PCD file");

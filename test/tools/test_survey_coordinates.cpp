@@ -133,14 +133,20 @@ TEST_F(SurveyCoordinates, FarDoublePlyAndLasGiveTheNormalsOfTheShapeAtTheOrigin)
   }
 }
 
-// The fit shifts a tool's own positions about the local origin and back: the output's coordinates
-// are the input's to the last bit (a double PLY far away, and one around the origin with -0 in
-// it, which a shift by 0 and back would turn into +0), every fitting tool.
+// The fit shifts a tool's own positions about the local origin and back, or keeps a float
+// cloud's only in its floats: the output's coordinates are the input's to the last bit (a double
+// PLY far away, and double and float ones around the origin with -0 in them, which a shift by 0
+// and back would turn into +0), every fitting tool.
 TEST_F(SurveyCoordinates, TheOutputsCoordinatesAreTheInputsBitForBit) {
   Eigen::Matrix3Xd signed_zeros = scene();
   for (Eigen::Index i = 0; i < signed_zeros.cols(); i += 7) signed_zeros(2, i) = -0.0;
   save(path("zeros.ply"), signed_zeros, FieldPrecision::Double);
-  for (const char* name : {"far.ply", "zeros.ply"}) {
+  save(path("zeros_float.ply"), signed_zeros.cast<float>().cast<double>(), FieldPrecision::Float);
+  save(path("far_float.ply"), (signed_zeros.colwise() + Eigen::Vector3d(4096.0, -8192.0, 512.0))
+                                  .cast<float>()
+                                  .cast<double>(),
+       FieldPrecision::Float);
+  for (const char* name : {"far.ply", "zeros.ply", "zeros_float.ply", "far_float.ply"}) {
     const Eigen::Matrix3Xd in = readMeshFile(path(name)).positions;
     for (const char* tool : {PCL_DDG_NORMALS_TOOL, PCL_DDG_CURVATURE_TOOL}) {
       const std::string out = path("same_" + std::string(name));

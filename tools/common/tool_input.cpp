@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "common/tool_common.h"
@@ -47,6 +48,7 @@ ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind k
   mesh = std::move(file.mesh);
   faces = std::move(file.faces);
   positions_ = std::make_shared<Eigen::Matrix3Xd>(std::move(file.positions));
+  point_count_ = positions_->cols();
   const Eigen::Matrix3Xd& positions = *positions_;
   sensor_pose = file.sensor_pose;
   las = std::move(file.las);
@@ -89,18 +91,39 @@ ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind k
 }
 
 const Eigen::Matrix3Xd& ToolInput::positions() const {
-  if (shifted_)
+  if (held_ != Held::AsRead)
     throw std::logic_error("ToolInput::positions() while local() holds them (releaseLocal() first)");
   return *positions_;
 }
 
 BoundingBox ToolInput::bounds() const {
-  BoundingBox box = boundingBox(*positions_);
-  if (shifted_) {  // exact: each finite point about the origin plus the origin is the one read
-    box.min += local_->origin;
-    box.max += local_->origin;
+  if (held_ == Held::AsRead) return boundingBox(*positions_);
+  BoundingBox box;
+  if (held_ == Held::Shifted) {
+    box = boundingBox(*positions_);
+  } else {
+    box.min.setConstant(std::numeric_limits<double>::infinity());
+    box.max.setConstant(-std::numeric_limits<double>::infinity());
+    for (const pcl::PointXYZ& p : *points_) {
+      box.min = box.min.cwiseMin(p.getVector3fMap().cast<double>());
+      box.max = box.max.cwiseMax(p.getVector3fMap().cast<double>());
+    }
   }
+  // Exact: each point about the origin plus the origin is the one read.
+  box.min += local_->origin;
+  box.max += local_->origin;
   return box;
+}
+
+void ToolInput::restoreFromFloats() {
+  positions_->resize(3, point_count_);
+  const Eigen::Vector3d& origin = local_->origin;
+  for (Eigen::Index i = 0; i < point_count_; ++i) {
+    const Eigen::Vector3f& p = (*points_)[static_cast<std::size_t>(i)].getVector3fMap();
+    for (int d = 0; d < 3; ++d)  // an axis about 0 was not moved: its -0 stays -0
+      (*positions_)(d, i) = origin[d] == 0.0 ? double{p[d]} : double{p[d]} + origin[d];
+  }
+  held_ = Held::AsRead;
 }
 
 const LocalCloud& ToolInput::local() {
@@ -115,9 +138,18 @@ const LocalCloud& ToolInput::local() {
     moveFinitePoints(*positions_, origin);
     throw;
   }
-  shifted_ = local_->positions != nullptr;
-  if (!shifted_) moveFinitePoints(*positions_, origin);  // the floats hold them: no doubles shared
   points_ = std::const_pointer_cast<pcl::PointCloud<pcl::PointXYZ>>(local_->points);
+  held_ = Held::Shifted;
+  if (!local_->positions) {  // the floats hold them exactly: no doubles shared
+    moveFinitePoints(*positions_, origin);
+    held_ = Held::AsRead;
+    if (!topology && points_->is_dense) {
+      // A cloud's floats about the origin are its coordinates, to the last bit: until
+      // releaseLocal() they are the only copy (a float cloud's fit needs 24 bytes a point less).
+      Eigen::Matrix3Xd().swap(*positions_);
+      held_ = Held::InFloats;
+    }
+  }
   points_->sensor_origin_.head<3>() = (sensor_pose.origin - local_->origin).cast<float>();
   points_->sensor_orientation_ = sensor_pose.orientation.cast<float>();
   return *local_;
@@ -138,15 +170,17 @@ std::shared_ptr<const FaceRows> ToolInput::outputFaces() const {
 
 void ToolInput::separateLocal() {
   local();
-  if (!shifted_) return;
+  if (held_ == Held::InFloats) restoreFromFloats();
+  if (held_ != Held::Shifted) return;
   local_->positions = std::make_shared<Eigen::Matrix3Xd>(*positions_);
   moveFinitePoints(*positions_, local_->origin);
-  shifted_ = false;
+  held_ = Held::AsRead;
 }
 
 void ToolInput::releaseLocal() {
-  if (shifted_) moveFinitePoints(*positions_, local_->origin);
-  shifted_ = false;
+  if (held_ == Held::InFloats) restoreFromFloats();
+  if (held_ == Held::Shifted) moveFinitePoints(*positions_, local_->origin);
+  held_ = Held::AsRead;
   points_.reset();
   local_.reset();
 }

@@ -46,7 +46,7 @@ class ToolInput {
   /** The coordinates in double, as read (LAS: X * scale + offset). Throws std::logic_error
    *  while local() holds them about its origin (until releaseLocal()). */
   const Eigen::Matrix3Xd& positions() const;
-  Eigen::Index pointCount() const { return positions_->cols(); }
+  Eigen::Index pointCount() const { return point_count_; }
   /** The bounding box of the finite positions, in world coordinates, whenever asked. */
   BoundingBox bounds() const;
 
@@ -54,7 +54,8 @@ class ToolInput {
    *  keep an organized cloud's grid, and the sensor pose is their sensor_origin_ (relative to
    *  the origin) and sensor_orientation_. Made on the first call, from positions shifted in place
    *  (x - origin is exact, and so is the way back), not from a copy: a 10M-point LAS file's fit
-   *  needs 240 MB less. */
+   *  needs 240 MB less; a cloud whose floats hold its coordinates keeps only them until
+   *  releaseLocal(). */
   const LocalCloud& local();
   /** Gives local() positions of its own (a copy), so that they may change (-classes makes points
    *  NaN) while positions() keeps the coordinates read. */
@@ -74,8 +75,15 @@ class ToolInput {
   double spacing();
 
  private:
-  std::shared_ptr<Eigen::Matrix3Xd> positions_;  ///< shared with local_ while shifted
-  bool shifted_ = false;                          ///< positions_ about local_->origin
+  /** Where the coordinates read are while local() lives: positions_ as read, positions_ about
+   *  local_->origin (shared with local_), or only in local_'s floats (positions_ empty). */
+  enum class Held { AsRead, Shifted, InFloats };
+  /** positions_ from local_'s floats, exactly the coordinates read. */
+  void restoreFromFloats();
+
+  std::shared_ptr<Eigen::Matrix3Xd> positions_;
+  Eigen::Index point_count_ = 0;
+  Held held_ = Held::AsRead;
   std::optional<LocalCloud> local_;
   pcl::PointCloud<pcl::PointXYZ>::Ptr points_;  ///< local_'s, not const
   std::optional<double> spacing_;
