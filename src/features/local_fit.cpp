@@ -162,9 +162,10 @@ LocalFitResult fitLocalSurfacesInSlices(const LocalCloud& cloud,
     total.orientation = slice.orientation;
     take(first, slice);
   };
-  // Robust's wider planes are formed over the whole surface at every compute.
+  // Robust's wider planes, and a mesh's reference normals for the orientation, are made for the
+  // whole surface at every compute.
   if (options.neighbourhood != NeighbourhoodKind::KdTree || options.method == LocalFitMethod::Robust ||
-      options.orientation == NormalOrientation::SpanningTree || slice_points == 0 ||
+      topology || options.orientation == NormalOrientation::SpanningTree || slice_points == 0 ||
       n <= slice_points) {
     LocalFitResult whole = fitLocalSurfaces(cloud, topology, options);
     add(0, whole);

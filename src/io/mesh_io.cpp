@@ -35,6 +35,7 @@ const pcl::PolygonMesh& withColorLayout(const pcl::PolygonMesh& mesh, ColorLayou
 
 void savePCD(const std::string& path, const pcl::PolygonMesh& mesh, const SensorPose& pose) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw FileFormatException("cannot write '" + path + "': " + std::strerror(errno));
   pcl::PolygonMesh converted;
   detail::writePCD(out, withColorLayout(mesh, ColorLayout::PackedRGB, converted).cloud, pose);
   out.close();

@@ -385,14 +385,21 @@ void writePCD(std::ostream& out, const pcl::PCLPointCloud2& cloud, const SensorP
     packed_total += size;
     filled = 0;
   };
+  // A value may span blocks (a field of a large COUNT is larger than one).
+  const auto append = [&](const std::uint8_t* from, std::size_t size) {
+    while (size > 0) {
+      const std::size_t take = std::min(size, kBlock - filled);
+      std::memcpy(planar.data() + filled, from, take);
+      filled += take;
+      from += take;
+      size -= take;
+      if (filled == kBlock) flush();
+    }
+  };
   for (const auto* f : fields) {
     const std::size_t size = pcl::getFieldSize(f->datatype) * std::max<std::uint32_t>(f->count, 1);
-    for (std::size_t i = 0; i < n; ++i) {
-      if (filled + size > kBlock) flush();
-      std::memcpy(planar.data() + filled, cloud.data.data() + i * cloud.point_step + f->offset,
-                  size);
-      filled += size;
-    }
+    for (std::size_t i = 0; i < n; ++i)
+      append(cloud.data.data() + i * cloud.point_step + f->offset, size);
   }
   flush();
   const std::uint32_t sizes[2] = {static_cast<std::uint32_t>(packed_total),

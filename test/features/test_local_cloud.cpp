@@ -362,10 +362,14 @@ TEST(LocalCloud, PositionsShiftedInPlaceAreMakeLocalCloudsAndShiftBackExactly) {
   const LocalCloud in_place = localCloudOf(shifted, origin);
   ASSERT_TRUE(copied.positions && in_place.positions);
   EXPECT_EQ(in_place.positions.get(), shifted.get());  // the caller's, not a copy
-  EXPECT_TRUE(*in_place.positions == *copied.positions);
+  // Bit for bit (== would take -0 for +0).
+  EXPECT_EQ(std::memcmp(in_place.positions->data(), copied.positions->data(),
+                        sizeof(double) * world.size()),
+            0);
   for (std::size_t i = 0; i < copied.points->size(); ++i)
-    ASSERT_TRUE((*in_place.points)[i].getVector3fMap() == (*copied.points)[i].getVector3fMap());
-  EXPECT_TRUE(Eigen::Matrix3Xd(shifted->colwise() + origin) == world);
+    ASSERT_EQ(std::memcmp((*in_place.points)[i].data, (*copied.points)[i].data, 12), 0) << i;
+  const Eigen::Matrix3Xd back = shifted->colwise() + origin;
+  EXPECT_EQ(std::memcmp(back.data(), world.data(), sizeof(double) * world.size()), 0);
 }
 
 // The pixel grid's window sums read the exact coordinates too: an organized height field far

@@ -231,6 +231,36 @@ TEST(VertexFields, FieldsWrittenASliceAtATimeAreTheFieldsWrittenAtOnce) {
   }
 }
 
+// A compressed PCD whose one value is larger than the writer's block (a field of COUNT 300,000
+// floats: 1.2 MB a point) is written across blocks and read back byte for byte.
+TEST_F(MeshIOFiles, APcdValueLargerThanACompressionBlockIsWrittenWhole) {
+  pcl::PolygonMesh mesh;
+  mesh.cloud.width = 3;
+  mesh.cloud.height = 1;
+  const std::uint32_t count = 300000;
+  std::uint32_t offset = 0;
+  for (const char* name : {"x", "y", "z", "h"}) {
+    pcl::PCLPointField f;
+    f.name = name;
+    f.offset = offset;
+    f.datatype = pcl::PCLPointField::FLOAT32;
+    f.count = name[0] == 'h' ? count : 1;
+    offset += 4 * f.count;
+    mesh.cloud.fields.push_back(f);
+  }
+  mesh.cloud.point_step = offset;
+  mesh.cloud.row_step = 3 * offset;
+  mesh.cloud.data.resize(3 * std::size_t{offset});
+  for (std::size_t i = 0; i < mesh.cloud.data.size() / 4; ++i) {
+    const float v = static_cast<float>(i % 977) * 0.5f;
+    std::memcpy(mesh.cloud.data.data() + 4 * i, &v, 4);
+  }
+  saveMesh(path("wide.pcd"), mesh);
+  const MeshFile back = readMeshFile(path("wide.pcd"));
+  ASSERT_EQ(back.mesh.cloud.point_step, mesh.cloud.point_step);
+  EXPECT_TRUE(back.mesh.cloud.data == mesh.cloud.data);
+}
+
 TEST_F(MeshIOFiles, PlyRoundTripKeepsDoublesFieldsAndFaces) {
   Eigen::Matrix3Xd p(3, 4);
   p << 100000.123456789012, 1, 1, 0,  //

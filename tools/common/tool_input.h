@@ -31,6 +31,11 @@ class ToolInput {
    *  defects are warned about (degenerate, duplicate, non-manifold, unreferenced). A cloud: the
    *  non-finite points are counted in a warning (kept: NaN output there); none finite throws. */
   ToolInput(const std::string& path, const char* tool_name, InputKind kind = InputKind::Any);
+  // Not copied: a copy would share the positions local() shifts and shift them back twice.
+  ToolInput(const ToolInput&) = delete;
+  ToolInput& operator=(const ToolInput&) = delete;
+  ToolInput(ToolInput&&) = default;
+  ToolInput& operator=(ToolInput&&) = default;
 
   /** x, y, z as float (PCL's point types; positions holds them exactly); its polygons empty when
    *  the faces are rows. */
@@ -60,7 +65,9 @@ class ToolInput {
   /** Gives local() positions of its own (a copy), so that they may change (-classes makes points
    *  NaN) while positions() keeps the coordinates read. */
   void separateLocal();
-  /** local()'s float points, to change (a point made NaN is left out of the fits). */
+  /** local()'s float points, to change after separateLocal() (a point made NaN is left out of
+   *  the fits; without separateLocal() a float cloud's change would reach the output, whose
+   *  coordinates they are until releaseLocal()). */
   const pcl::PointCloud<pcl::PointXYZ>::Ptr& points();
   /** The faces to write with the output (saveResult): faces, or the topology's triangles when
    *  faces was let go for them; null for a cloud or polygons. */

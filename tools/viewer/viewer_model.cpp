@@ -69,7 +69,8 @@ ViewerModel::ViewerModel(tools::ToolInput input, std::string path)
   }
   const Eigen::AlignedBox3d box = finiteBounds(input_.positions());
   diagonal_ = box.isEmpty() ? 0.0 : box.diagonal().norm();
-  positions_["input;"] = std::make_shared<const Eigen::Matrix3Xd>(input_.positions());
+  input_positions_ = std::make_shared<const Eigen::Matrix3Xd>(input_.positions());
+  positions_["input;"] = input_positions_;
   // The input's own positions from here on are positions_'s: local() holds the ToolInput's.
   clouds_["input;"] = input_.local();
   spacing_ = input_.spacing();

@@ -47,7 +47,7 @@ class ViewerModel {
   const std::string& path() const { return path_; }
   bool isMesh() const { return static_cast<bool>(input_.topology); }
   const MeshTopology* topology() const { return input_.topology.get(); }
-  const Eigen::Matrix3Xd& inputPositions() const { return *positions_.at("input;"); }
+  const Eigen::Matrix3Xd& inputPositions() const { return *input_positions_; }
   /** Where the sensor was (a PCD's VIEWPOINT): clouds are first seen from there. */
   const SensorPose& sensorPose() const { return input_.sensor_pose; }
   /** An organized cloud (width x height grid): seen from its sensor. */
@@ -86,6 +86,9 @@ class ViewerModel {
   double diagonal_ = 0.0;  ///< of the input's bounding box
   /** Positions after each prefix of smoothing steps, keyed by the steps' description. */
   std::map<std::string, Positions> positions_;
+  /** positions_'s "input;", held apart: the drawing thread reads it while a computation adds to
+   *  the map. */
+  Positions input_positions_;
   std::map<std::string, std::shared_ptr<const Eigen::Matrix3Xd>> normals_;
   std::map<std::string, Eigen::VectorXd> fields_;
   std::map<std::string, LocalCloud> clouds_;

@@ -105,7 +105,8 @@ using LocalFitSlice = std::function<void(std::size_t first, LocalFitResult& slic
  * kd-tree), while the output (32 bytes a point as pcl::Normal) and the order the fits visit are
  * held for one slice, not for the whole cloud. One slice for all where the fits need each other
  * or another search than the kd-tree: orientation along a spanning tree, robust normals (whose
- * wider planes are summed over the whole cloud at every compute), mesh rings, the grid.
+ * wider planes are summed over the whole cloud at every compute), a mesh (whose faces' normals
+ * orient the fits, made for the whole mesh at every compute), mesh rings, the grid.
  * Returns the counts (failed, fell back) summed over the slices, without normals.
  */
 LocalFitResult fitLocalSurfacesInSlices(const LocalCloud& cloud,
