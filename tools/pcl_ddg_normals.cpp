@@ -195,17 +195,18 @@ int run(int argc, char** argv) {
           tools::Timer timer("Computing " + method + " normals (" +
                              tools::describeNeighbourhood(options) +
                              (spanning_tree ? ", oriented along a spanning tree)" : ")"));
-          // Written into the output a slice at a time: never the whole cloud's pcl::Normal beside it.
+          // Written into the output a slice at a time, never the whole pcl::Normal cloud beside it.
           tools::FitFieldWriter fields(in.mesh.cloud, output, precision, method == "robust");
           pcl::PointCloud<pcl::Normal> map_normals;  // -normal_map: all of them (one slice)
           LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;
-            return fitLocalSurfacesInSlices(
-                in.local(), in.topology, options, args.has("normal_map") ? 0 : kSlicePoints,
-                [&](std::size_t first, LocalFitResult& slice) {
-                  fields.write(first, slice);
-                  if (args.has("normal_map")) map_normals = std::move(slice.normals);
-                });
+            return fitLocalSurfacesInSlices(in.local(), in.topology, options,
+                                            args.has("normal_map") ? 0 : kSlicePoints,
+                                            [&](std::size_t first, LocalFitResult& slice) {
+                                              fields.write(first, slice);
+                                              if (args.has("normal_map"))
+                                                map_normals = std::move(slice.normals);
+                                            });
           }();
           timer.done(in.points()->size());
           in.releaseLocal();

@@ -164,15 +164,17 @@ LocalFitResult fitLocalSurfacesInSlices(const LocalCloud& cloud,
   };
   // Robust's wider planes, and a mesh's reference normals for the orientation, are made for the
   // whole surface at every compute.
-  if (options.neighbourhood != NeighbourhoodKind::KdTree || options.method == LocalFitMethod::Robust ||
-      topology || options.orientation == NormalOrientation::SpanningTree || slice_points == 0 ||
+  if (options.neighbourhood != NeighbourhoodKind::KdTree ||
+      options.method == LocalFitMethod::Robust || topology ||
+      options.orientation == NormalOrientation::SpanningTree || slice_points == 0 ||
       n <= slice_points) {
     LocalFitResult whole = fitLocalSurfaces(cloud, topology, options);
     add(0, whole);
     return total;
   }
   LocalFitOptions shared = options;  // one tree, built by the first slice
-  if (!shared.kd_tree_search) shared.kd_tree_search = std::make_shared<KdTreeSearch<pcl::PointXYZ>>();
+  if (!shared.kd_tree_search)
+    shared.kd_tree_search = std::make_shared<KdTreeSearch<pcl::PointXYZ>>();
   for (std::size_t first = 0; first < n; first += slice_points) {
     auto indices = std::make_shared<pcl::Indices>(std::min(slice_points, n - first));
     std::iota(indices->begin(), indices->end(), static_cast<pcl::index_t>(first));

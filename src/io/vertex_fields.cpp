@@ -165,11 +165,10 @@ void setVertexFieldSlice(pcl::PCLPointCloud2& cloud, const std::vector<std::stri
   const std::size_t count = static_cast<std::size_t>(values.cols());
   if (static_cast<std::size_t>(values.rows()) != names.size() || first > pointCount(cloud) ||
       count > pointCount(cloud) - first)
-    throw pcl::BadArgumentException("a slice of " + std::to_string(values.rows()) + " x " +
-                                     std::to_string(count) + " values from point " +
-                                     std::to_string(first) + " for " +
-                                     std::to_string(names.size()) + " fields of " +
-                                     std::to_string(pointCount(cloud)) + " vertices");
+    throw pcl::BadArgumentException(
+        "a slice of " + std::to_string(values.rows()) + " x " + std::to_string(count) +
+        " values from point " + std::to_string(first) + " for " + std::to_string(names.size()) +
+        " fields of " + std::to_string(pointCount(cloud)) + " vertices");
   for (std::size_t k = 0; k < names.size(); ++k) {
     const auto field =
         std::find_if(cloud.fields.begin(), cloud.fields.end(),

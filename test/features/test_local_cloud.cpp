@@ -300,9 +300,8 @@ TEST(LocalFit, SlicesGiveTheWholeCloudsBitsAndCounts) {
   std::int64_t left_out = 0;
   for (Eigen::Index i = 5; i < world.cols(); i += 401, ++left_out) world.col(i).setConstant(NAN);
   for (const bool dense : {true, false}) {
-    const LocalCloud local = makeLocalCloud(dense ? Eigen::Matrix3Xd(scene.points.colwise() +
-                                                                     kSurveyOffset)
-                                                  : world);
+    const LocalCloud local =
+        makeLocalCloud(dense ? Eigen::Matrix3Xd(scene.points.colwise() + kSurveyOffset) : world);
     for (const LocalFitMethod method :
          {LocalFitMethod::PCA, LocalFitMethod::Quadric, LocalFitMethod::Robust}) {
       const LocalFitOptions options = kdTree(method, method == LocalFitMethod::Robust ? 48 : 16);
@@ -341,13 +340,12 @@ TEST(LocalFit, SlicesGiveTheWholeCloudsBitsAndCounts) {
   LocalFitOptions tree = kdTree(LocalFitMethod::PCA, 16);
   tree.orientation = NormalOrientation::SpanningTree;
   int slices = 0;
-  fitLocalSurfacesInSlices(makeLocalCloud(world), nullptr, tree, 700,
-                           [&](std::size_t first, LocalFitResult& slice) {
-                             EXPECT_EQ(first, 0u);
-                             EXPECT_EQ(slice.normals.size(),
-                                       static_cast<std::size_t>(world.cols()));
-                             ++slices;
-                           });
+  fitLocalSurfacesInSlices(
+      makeLocalCloud(world), nullptr, tree, 700, [&](std::size_t first, LocalFitResult& slice) {
+        EXPECT_EQ(first, 0u);
+        EXPECT_EQ(slice.normals.size(), static_cast<std::size_t>(world.cols()));
+        ++slices;
+      });
   EXPECT_EQ(slices, 1);
 }
 

@@ -16,11 +16,11 @@
 #include <string>
 #include <vector>
 
+#include "estimator_support.h"
 #include "pcl_ddg/io/las_layout.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
-#include "estimator_support.h"
 #include "test_data.h"
 #include "tool_runner.h"
 
@@ -143,9 +143,10 @@ TEST_F(SurveyCoordinates, TheOutputsCoordinatesAreTheInputsBitForBit) {
   for (Eigen::Index i = 0; i < signed_zeros.cols(); i += 7) signed_zeros(2, i) = -0.0;
   save(path("zeros.ply"), signed_zeros, FieldPrecision::Double);
   save(path("zeros_float.ply"), signed_zeros.cast<float>().cast<double>(), FieldPrecision::Float);
-  save(path("far_float.ply"), (signed_zeros.colwise() + Eigen::Vector3d(4096.0, -8192.0, 512.0))
-                                  .cast<float>()
-                                  .cast<double>(),
+  save(path("far_float.ply"),
+       (signed_zeros.colwise() + Eigen::Vector3d(4096.0, -8192.0, 512.0))
+           .cast<float>()
+           .cast<double>(),
        FieldPrecision::Float);
   // A point with one NaN coordinate, its others anywhere: left as read (not shifted).
   Eigen::Matrix3Xd partly = scene().colwise() + kOffset;

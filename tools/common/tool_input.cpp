@@ -92,7 +92,8 @@ ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind k
 
 const Eigen::Matrix3Xd& ToolInput::positions() const {
   if (held_ != Held::AsRead)
-    throw std::logic_error("ToolInput::positions() while local() holds them (releaseLocal() first)");
+    throw std::logic_error(
+        "ToolInput::positions() while local() holds them (releaseLocal() first)");
   return *positions_;
 }
 
@@ -186,7 +187,8 @@ void ToolInput::releaseLocal() {
 }
 
 double ToolInput::spacing() {
-  if (!spacing_) spacing_ = topology ? meanEdgeLength(*topology, *positions_) : meanSpacing(points());
+  if (!spacing_)
+    spacing_ = topology ? meanEdgeLength(*topology, *positions_) : meanSpacing(points());
   return *spacing_;
 }
 
