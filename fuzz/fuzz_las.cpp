@@ -9,18 +9,27 @@
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "las_format.h"
+#include "las_plan.h"
 #include "pcl_ddg/exceptions.h"
 
 namespace {
 
-bool sameRecords(const std::vector<pcl_ddg::LasVariableLengthRecord>& a,
-                 const std::vector<pcl_ddg::LasVariableLengthRecord>& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t k = 0; k < a.size(); ++k) {
-    if (a[k].user_id != b[k].user_id || a[k].record_id != b[k].record_id ||
-        a[k].description != b[k].description || a[k].data != b[k].data)
+// The written records against the read ones, less the source's encoding records, which the
+// writer leaves out (isEncodingRecord).
+bool sameRecords(const std::vector<pcl_ddg::LasVariableLengthRecord>& written,
+                 const std::vector<pcl_ddg::LasVariableLengthRecord>& read) {
+  std::vector<const pcl_ddg::LasVariableLengthRecord*> kept;
+  for (const auto& r : read)
+    if (!pcl_ddg::detail::isEncodingRecord(r)) kept.push_back(&r);
+  if (written.size() != kept.size()) return false;
+  for (std::size_t k = 0; k < written.size(); ++k) {
+    const auto& a = written[k];
+    const auto& b = *kept[k];
+    if (a.user_id != b.user_id || a.record_id != b.record_id || a.description != b.description ||
+        a.data != b.data)
       return false;
   }
   return true;

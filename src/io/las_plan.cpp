@@ -88,20 +88,14 @@ struct Slot {
   std::uint32_t size;
 };
 
-// Records of the source's encoding, which the file written here does not have: a COPC file's
-// info VLR and hierarchy EVLR (user id "copc": the records no longer follow its octree) and a
-// LASzip VLR (22204; an uncompressed file carrying one would be read as LAZ by some readers, and
-// a LAZ output gets its own).
+// The source's encoding records (isEncodingRecord) left out.
 void dropEncodingRecords(LasLayout& layout) {
-  const auto copc = [](const LasVariableLengthRecord& r) {
-    return r.userId() == "copc" || (r.userId() == "laszip encoded" && r.record_id == 22204);
-  };
-  layout.vlrs.erase(std::remove_if(layout.vlrs.begin(), layout.vlrs.end(), copc),
+  layout.vlrs.erase(std::remove_if(layout.vlrs.begin(), layout.vlrs.end(), isEncodingRecord),
                     layout.vlrs.end());
   std::vector<LasVariableLengthRecord> kept;
   int waveform = -1;
   for (std::size_t i = 0; i < layout.evlrs.size(); ++i) {
-    if (copc(layout.evlrs[i])) continue;
+    if (isEncodingRecord(layout.evlrs[i])) continue;
     if (static_cast<int>(i) == layout.waveform_evlr) waveform = static_cast<int>(kept.size());
     kept.push_back(std::move(layout.evlrs[i]));
   }
@@ -110,6 +104,10 @@ void dropEncodingRecords(LasLayout& layout) {
 }
 
 }  // namespace
+
+bool isEncodingRecord(const LasVariableLengthRecord& r) {
+  return r.userId() == "copc" || (r.userId() == "laszip encoded" && r.record_id == 22204);
+}
 
 LasPlan planLAS(const pcl::PCLPointCloud2& cloud, const LasLayout* source,
                 const std::function<Eigen::AlignedBox3d()>& finite_bounds) {

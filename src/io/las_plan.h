@@ -52,6 +52,12 @@ struct LasPlan {
   std::uint64_t header_size = 0, point_offset = 0;
 };
 
+/** A record of the source's encoding, which a file written from it does not carry: a COPC file's
+ *  info VLR and hierarchy EVLR (user id "copc": the records no longer follow its octree) and a
+ *  LASzip VLR (22204; an uncompressed file carrying one would be read as LAZ by some readers, and
+ *  a LAZ output gets its own). */
+bool isEncodingRecord(const LasVariableLengthRecord& record);
+
 /** The plan for writing cloud: source's layout, or LAS 1.4 format 6/7 whose scale and offset are
  *  chosen from finite_bounds() (called only then). */
 LasPlan planLAS(const pcl::PCLPointCloud2& cloud, const LasLayout* source,
