@@ -132,20 +132,22 @@ int run(int argc, char** argv) {
   const bool spanning_tree = orientation == NormalOrientation::SpanningTree;
   if (args.has("memory")) {
     // A cloud larger than memory: fitted tile by tile from the file (pcl_ddg/tiling).
-    if ((!requested.empty() && !fitted) || requested == "robust")
-      throw tools::UsageError("-memory applies to pca and quadric on clouds");
+    if (!requested.empty() && !fitted)
+      throw tools::UsageError("-memory applies to pca, quadric and robust on clouds");
     if (orientation && orientation != NormalOrientation::Viewpoint &&
         orientation != NormalOrientation::Up)
       throw tools::UsageError("-orient " + *args.value("orient") +
                               " needs the whole cloud; with -memory normals face the viewpoint "
                               "or up");
-    LocalFitOptions options = tools::outOfCoreFitArguments(
-        args, requested == "quadric" ? LocalFitMethod::Quadric : LocalFitMethod::PCA);
+    LocalFitOptions options =
+        tools::outOfCoreFitArguments(args, requested == "quadric"  ? LocalFitMethod::Quadric
+                                           : requested == "robust" ? LocalFitMethod::Robust
+                                                                   : LocalFitMethod::PCA);
     if (orientation == NormalOrientation::Up) options.orientation = NormalOrientation::Up;
     return tools::fitEachInputOutOfCore(
         kName, args, options, precision,
         [&](pcl::PCLPointCloud2& piece, const std::string& output, const LocalFitResult& fit) {
-          tools::setNormalFields(piece, output, fit.normals, precision);
+          tools::FitFieldWriter(piece, output, precision, requested == "robust").write(0, fit);
         });
   }
   return tools::forEachInput(

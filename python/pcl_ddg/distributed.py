@@ -8,7 +8,7 @@ halo rule, and writes its results atomically with a checksum. The output is one 
 the inputs' order: the bytes ``pcl_ddg_normals`` / ``pcl_ddg_curvature -method quadric`` write for
 the merged cloud.
 
-    python3 -m pcl_ddg.distributed normals INPUT... OUTPUT_DIR -k 16 [-method pca|quadric]
+    python3 -m pcl_ddg.distributed normals INPUT... OUTPUT_DIR -k 16 [-method pca|quadric|robust]
         [-radius R [-max_nn N]] [-viewpoint x,y,z] [-orient viewpoint|up [-up x,y,z]]
         [-precision float|double] [--scheduler tcp://HOST:8786 | --workers N]
         [--memory-per-worker 2G] [--retries 3] [--merge FILE] [--resume | --no-resume]
@@ -372,6 +372,12 @@ def _gather(plan: Plan, paths: List[str], firsts: List[int], lo: np.ndarray, hi:
             np.concatenate(parts_index).astype(np.int64), np.concatenate(parts_own))
 
 
+def _record_floats(method: str) -> int:
+    """Floats per point of a fit's results: normal and curvature, then the quadric's principal
+    curvatures and k1 direction, or robust's scale and confidence."""
+    return {"quadric": 9, "robust": 6}.get(method, 4)
+
+
 def _fit(plan, xyz, exact, own_positions, options, halo_lo, halo_hi, mode):
     o = options
     return _pcl_ddg._fit_tile(
@@ -379,7 +385,7 @@ def _fit(plan, xyz, exact, own_positions, options, halo_lo, halo_hi, mode):
         o["max_nn"], list(o["viewpoint"]),
         o["orient"], None if o["up"] is None else list(o["up"]),
         None if halo_lo is None else list(halo_lo) + list(halo_hi), plan.bounds, mode,
-        o["threads"])
+        o["threads"], plan.finite_points)
 
 
 def _read_json(path: str) -> Any:
@@ -484,7 +490,7 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
     delay = float(os.environ.get("PCL_DDG_DISTRIBUTED_TILE_DELAY", "0") or 0)
     if delay > 0:  # fault tests: a tile long enough to be killed in the middle of
         time.sleep(delay)
-    floats = 9 if options["method"] == "quadric" else 4
+    floats = _record_floats(options["method"])
     bounds = plan.bounds
     core_lo, core_hi = plan.tile_box(tile)
     radius = options["radius"]
@@ -530,27 +536,42 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
         results.append(rec[ok])
         if len(far):
             # Fitted apart with everything around them (their look among the gathered points is
-            # never nearer than their true k-th neighbour).
+            # never nearer than their true k-th neighbour). A robust look also counts the rows
+            # its wider planes read, which only rows found in the whole cloud bound: robust far
+            # points are certified in their box, and those that look past it fitted again in a
+            # box whose looks at least double (the cloud's bounds certify every point).
             far_look = look[~ok]
             fq = xyz[far].astype(np.float64)
-            b = np.array(bounds)
-            finite_look = np.isfinite(far_look)
-            a_lo = np.where(finite_look[:, None], fq - far_look[:, None], b[None, :3]).min(axis=0)
-            a_hi = np.where(finite_look[:, None], fq + far_look[:, None], b[None, 3:]).max(axis=0)
-            a_lo, a_hi = np.maximum(a_lo, b[:3] - 1.0), np.minimum(a_hi, b[3:] + 1.0)
             far_index = index[far]
             del xyz, exact, own
-            boxes.append([float(v) for v in (*a_lo, *a_hi)])
-            xyz2, exact2, index2, _ = _gather(plan, paths, firsts, a_lo, a_hi, -1)
-            largest = max(largest, len(xyz2))
-            positions = np.searchsorted(index2, far_index)
-            rec2, _, _, _, f1, f2 = _fit(plan, xyz2, exact2, positions, options, None, None,
-                                         "all")
-            failed += f1
-            fallback += f2
+            b = np.array(bounds)
+            robust = options["method"] == "robust"
             far_count = len(far)
-            results_index.append(far_index)
-            results.append(rec2)
+            while len(far_index):
+                finite_look = np.isfinite(far_look)
+                grown_lo = np.where(finite_look[:, None], fq - far_look[:, None], b[None, :3])
+                grown_hi = np.where(finite_look[:, None], fq + far_look[:, None], b[None, 3:])
+                a_lo = np.maximum(grown_lo.min(axis=0), b[:3] - 1.0)
+                a_hi = np.minimum(grown_hi.max(axis=0), b[3:] + 1.0)
+                boxes.append([float(v) for v in (*a_lo, *a_hi)])
+                xyz2, exact2, index2, _ = _gather(plan, paths, firsts, a_lo, a_hi, -1)
+                largest = max(largest, len(xyz2))
+                positions = np.searchsorted(index2, far_index)
+                if robust:
+                    rec2, ok2, look2, _, f1, f2 = _fit(plan, xyz2, exact2, positions, options,
+                                                       a_lo, a_hi, "certified")
+                else:
+                    rec2, _, _, _, f1, f2 = _fit(plan, xyz2, exact2, positions, options, None,
+                                                 None, "all")
+                    ok2 = np.ones(len(far_index), bool)
+                failed += f1
+                fallback += f2
+                results_index.append(far_index[ok2])
+                results.append(rec2[ok2])
+                far_look = far_look[~ok2]
+                if robust:
+                    far_look = np.maximum(look2[~ok2], 2.0 * far_look)
+                fq, far_index = fq[~ok2], far_index[~ok2]
     gi = np.concatenate(results_index)
     rr = np.concatenate(results).astype(np.float32)
     order = np.argsort(gi, kind="stable")
@@ -663,8 +684,8 @@ class _Progress:
 def _fit_options(method: str, k: Optional[int], radius: Optional[float], max_nn: Optional[int],
                  viewpoint, orient: Optional[str], up, threads: int) -> Dict[str, Any]:
     # What only the runner refuses; the rest is checked, and defaulted, as the tools do.
-    if method not in ("pca", "quadric"):
-        raise ValueError(f"method must be 'pca' or 'quadric', not '{method}'")
+    if method not in ("pca", "quadric", "robust"):
+        raise ValueError(f"method must be 'pca', 'quadric' or 'robust', not '{method}'")
     if isinstance(radius, str):
         if radius.endswith("h"):
             raise ValueError("-radius is a length here (a multiple of h needs the whole cloud)")
@@ -851,7 +872,7 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
         # The results at their points' places, then the output files, written as the tool writes
         # them: one task per input file on the workers (one for a merged output).
         started = time.perf_counter()
-        floats = 9 if method == "quadric" else 4
+        floats = _record_floats(method)
         results_path = os.path.join(state, "results.bin")
         mm = np.memmap(results_path, dtype="<f4", mode="w+", shape=(max(total, 1), floats))
         mm[:] = np.nan
@@ -925,12 +946,12 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
 
 def estimate_normals(inputs, output_dir, client=None, **options) -> Dict[str, Any]:
     """Normals of the scene formed by `inputs` (files, folders or glob patterns of LAS, binary
-    PCD or binary PLY clouds), as ``pcl_ddg_normals -method pca|quadric`` on the merged cloud, on a Dask
-    cluster: `client` (a distributed.Client), or ``scheduler="tcp://host:8786"``, or a new
-    LocalCluster of ``workers`` processes.
+    PCD or binary PLY clouds), as ``pcl_ddg_normals -method pca|quadric|robust`` on the merged
+    cloud, on a Dask cluster: `client` (a distributed.Client), or
+    ``scheduler="tcp://host:8786"``, or a new LocalCluster of ``workers`` processes.
 
-    options: method ("pca"|"quadric"), k, radius, max_nn, viewpoint, orient ("viewpoint"|"up"),
-    up, precision ("float"|"double"), merge (one output file) or one file per input in
+    options: method ("pca"|"quadric"|"robust"), k, radius, max_nn, viewpoint, orient
+    ("viewpoint"|"up"), up, precision ("float"|"double"), merge (one output file) or one file per input in
     output_dir (``output_format`` "ply"|"pcd"|"las" to change it), memory_per_worker ("2G"), retries
     (3), resume (True: the tiles of an earlier run of the same tool, options, code and inputs whose
     results match their checksum are skipped; docs/distributed.md, "Resume"),
@@ -1124,7 +1145,7 @@ def _parser(tool: str) -> argparse.ArgumentParser:
         f"pcl_ddg_{tool} on the merged cloud.")
     p.add_argument("paths", nargs="+", metavar="INPUT... OUTPUT_DIR")
     if tool == "normals":
-        p.add_argument("-method", choices=["pca", "quadric"], default="pca")
+        p.add_argument("-method", choices=["pca", "quadric", "robust"], default="pca")
     p.add_argument("-k", type=int)
     p.add_argument("-radius", type=str)
     p.add_argument("-max_nn", type=int)

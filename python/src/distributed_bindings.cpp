@@ -149,11 +149,13 @@ Eigen::AlignedBox3d boxOf(const std::vector<double>& b) {
 /**
  * Fits the `own` points of a gathered tile (points in the merged cloud's order, so that the
  * kd-tree's ties break as on the whole cloud). mode "certified": a point's fit counts only when
- * its k-th neighbour among the gathered points (widened by the rounding margin) is nearer than the
- * halo box's edge (haloReach, tile_certificate.h), as the fit's own search finds it; the others
+ * its look (lookingDistance, tile_certificate.h: its k-th neighbour among the gathered points,
+ * and for robust the rows its wider planes read) is nearer than the halo box's edge (haloReach),
+ * as the fit's own search finds it; the others
  * come back uncertified, with how far they looked, for a wider gather. "all": every own point is
  * fitted. Radius searches are certified by a halo of the radius, so the check applies to k only.
- * Returns (records (n_own, 4 or 9) float32: nx ny nz curvature [pc1 pc2 k1 direction],
+ * Returns (records (n_own, 4, 9 or 6) float32: nx ny nz curvature, then the quadric's pc1 pc2
+ * k1 direction or robust's scale confidence,
  * certified, looking distance, reach (how far each point may look inside the halo box; infinity
  * unchecked), failed, fallback).
  */
@@ -165,8 +167,8 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
                   const std::vector<double>& viewpoint, const std::string& orient,
                   const std::optional<std::vector<double>>& up,
                   const std::optional<std::vector<double>>& halo_box,
-                  const std::vector<double>& bounds, const std::string& mode,
-                  unsigned int threads) {
+                  const std::vector<double>& bounds, const std::string& mode, unsigned int threads,
+                  std::int64_t cloud_points) {
   const bool certify = choice("mode", mode, {"certified", "all"}) == "certified";
   if (xyz.ndim() != 2 || xyz.shape(1) != 3) throw py::value_error("points must be (m, 3)");
   if (exact.ndim() != 2 || exact.shape(0) != xyz.shape(0) || exact.shape(1) != 3)
@@ -175,8 +177,11 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
   const auto m = static_cast<std::size_t>(xyz.shape(0));
   const auto n_own = static_cast<std::size_t>(own.size());
   LocalFitOptions options;
-  options.method = choice("method", method, {"pca", "quadric"}) == "pca" ? LocalFitMethod::PCA
-                                                                         : LocalFitMethod::Quadric;
+  const std::string chosen = choice("method", method, {"pca", "quadric", "robust"});
+  options.method = chosen == "pca"       ? LocalFitMethod::PCA
+                   : chosen == "quadric" ? LocalFitMethod::Quadric
+                                         : LocalFitMethod::Robust;
+  options.cloud_points = cloud_points;
   options.neighbourhood = NeighbourhoodKind::KdTree;
   options.k = k;
   options.radius = radius;
@@ -195,7 +200,9 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
     if (!halo_box) throw py::value_error("certify needs the halo box");
     box = boxOf(*halo_box);
   }
-  const int floats = options.method == LocalFitMethod::Quadric ? 9 : 4;
+  const bool robust = options.method == LocalFitMethod::Robust;
+  const int floats = options.method == LocalFitMethod::Quadric ? 9 : robust ? 6 : 4;
+  options.report_reaches = robust && check;
   py::array_t<float> records({static_cast<py::ssize_t>(n_own), static_cast<py::ssize_t>(floats)});
   py::array_t<bool> certified(static_cast<py::ssize_t>(n_own));
   py::array_t<double> looking(static_cast<py::ssize_t>(n_own));
@@ -240,7 +247,8 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
       if (!check) continue;
       const auto at = static_cast<std::size_t>(own_at[j]);
       reach_of[j] = haloReach((*cloud)[at].getVector3fMap().cast<double>(), box, cloud_bounds);
-      look[j] = lookingDistance(search->squaredKth(at));
+      look[j] = robust ? lookingDistance(search->squaredKth(at), fit.reaches[j])
+                       : lookingDistance(search->squaredKth(at));
       ok[j] = look[j] <= reach_of[j];
     }
     // Counted over the certified points only (the others are fitted again after a wider gather):
@@ -261,6 +269,10 @@ py::tuple fitTile(const py::array_t<float, py::array::c_style | py::array::force
       r[1] = n.normal_y;
       r[2] = n.normal_z;
       r[3] = n.curvature;
+      if (robust) {
+        r[4] = fit.scales[j];
+        r[5] = fit.confidences[j];
+      }
       if (floats == 9) {
         const pcl::PrincipalCurvatures& c = fit.curvatures[j];
         r[4] = c.pc1;
@@ -284,13 +296,17 @@ void addFields(CloudPiece& input, const std::string& output, const std::string& 
   setVertexCoordinates(piece, positions, FieldPrecision::Float);
   const auto n = static_cast<Eigen::Index>(positions.cols());
   Eigen::Matrix3Xd normals(3, n);
-  Eigen::VectorXd curvature(n), k1(n), k2(n);
+  Eigen::VectorXd curvature(n), k1(n), k2(n), scale(n), confidence(n);
   Eigen::Matrix3Xd direction(3, n);
   for (Eigen::Index i = 0; i < n; ++i) {
     const float* r = records.data() + i * floats;
     // As normalsOf: the float normal widened to double.
     normals.col(i) = Eigen::Vector3f(r[0], r[1], r[2]).cast<double>();
     curvature[i] = r[3];
+    if (floats == 6) {
+      scale[i] = r[4];
+      confidence[i] = r[5];
+    }
     if (floats == 9) {
       k1[i] = r[4];
       k2[i] = r[5];
@@ -322,6 +338,10 @@ void addFields(CloudPiece& input, const std::string& output, const std::string& 
     setVertexField(piece, "k2", k2, precision);
   } else {
     setNormals();
+    if (floats == 6) {  // robust's, as FitFieldWriter adds them
+      setVertexField(piece, "scale", scale, precision);
+      setVertexField(piece, "confidence", confidence, precision);
+    }
   }
   const FieldPrecision coordinates =
       input.coordinate_precision == FieldPrecision::Double || precision == FieldPrecision::Double
@@ -516,10 +536,11 @@ void bindDistributed(py::module_& m) {
   m.def("_fit_tile", &fitTile, py::arg("points"), py::arg("exact"), py::arg("local_origin"),
         py::arg("own"), py::arg("method"), py::arg("k"), py::arg("radius"), py::arg("max_nn"),
         py::arg("viewpoint"), py::arg("orient"), py::arg("up"), py::arg("halo_box"),
-        py::arg("bounds"), py::arg("mode"), py::arg("threads"),
+        py::arg("bounds"), py::arg("mode"), py::arg("threads"), py::arg("cloud_points") = 0,
         "Fits a tile's own points among its gathered points (merged-cloud order); mode "
-        "'certified': the fits of the points whose k-th neighbour is nearer than the halo's edge "
-        "count, 'all': every own point's.");
+        "'certified': the fits of the points whose look (k-th neighbour; robust: and the rows "
+        "its wider planes read) stays nearer than the halo's edge count, 'all': every own "
+        "point's. cloud_points: the merged cloud's finite points (robust's scale).");
   m.def("_write_output", &writeOutput, py::arg("inputs"), py::arg("output"), py::arg("results"),
         py::arg("first_result"), py::arg("floats"), py::arg("tool"), py::arg("precision"),
         py::arg("piece_points") = std::int64_t{1} << 18, py::arg("stream_pcd") = false,

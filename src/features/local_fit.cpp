@@ -131,11 +131,14 @@ LocalFitResult fitLocalSurfaces(const LocalCloud& local,
   } else if (options.method == LocalFitMethod::Robust) {
     RobustNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
     configure(estimator, local, topology, options, indices);
+    estimator.setCloudPoints(options.cloud_points);
+    estimator.setReportReaches(options.report_reaches);
     estimator.compute(result.normals);
     result.failed_points = estimator.getFailedPoints();
     result.orientation = estimator.getOrientationReport();
     result.scales = estimator.getScales();
     result.confidences = estimator.getConfidences();
+    result.reaches = estimator.getReaches();
   } else {
     QuadricNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
     configure(estimator, local, topology, options, indices);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <limits>
 #include <numeric>
 
 #include "pcl_ddg/features/plane_fit.h"
@@ -28,6 +29,20 @@ PointMoments sumOverRow(const Eigen::Vector3d& at, const int* row, int width,
   return sum;
 }
 
+/** U_l of a row (widening_planes.h): the farthest its members' own reach extends along the row,
+ *  previous holding U_{l-1} (nullptr: level 0). */
+double rowReach(const Eigen::Vector3f& at, const int* row, int width,
+                const std::vector<Eigen::Vector3f>& points, const std::vector<double>* previous) {
+  double reach = 0.0;
+  for (int n = 0; n < width; ++n) {
+    const int j = row[n];
+    if (j < 0) return std::numeric_limits<double>::infinity();
+    const double step = (points[j].cast<double>() - at.cast<double>()).norm();
+    reach = std::max(reach, step + (previous ? (*previous)[j] : 0.0));
+  }
+  return reach;
+}
+
 }  // namespace
 
 std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
@@ -35,7 +50,8 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
                                     const std::vector<Eigen::Vector3d>& queries,
                                     const std::vector<int>& query_nodes,
                                     const NeighbourGraph& query_graph,
-                                    const std::vector<double>& largest_reference, int threads) {
+                                    const std::vector<double>& largest_reference, int threads,
+                                    const std::vector<Eigen::Vector3f>* search_points) {
   // Nodes renumbered in space-filling order: a row's moments then lie near each other in memory.
   std::vector<Eigen::Vector3f> approximate(nodes.size());
   for (std::size_t j = 0; j < nodes.size(); ++j) approximate[j] = nodes[j].cast<float>();
@@ -44,9 +60,11 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
   for (std::size_t r = 0; r < order.size(); ++r) rank[order[r]] = static_cast<int>(r);
   const int width = node_graph.width;
   std::vector<Eigen::Vector3d> at(nodes.size());
+  std::vector<Eigen::Vector3f> searched_at(search_points ? nodes.size() : 0);
   std::vector<int> rows(node_graph.neighbours.size());
   for (std::size_t r = 0; r < order.size(); ++r) {
     at[r] = nodes[order[r]];
+    if (search_points) searched_at[r] = (*search_points)[order[r]];
     for (int n = 0; n < width; ++n) {
       const int j = node_graph.neighbours[static_cast<std::size_t>(order[r]) * width + n];
       rows[r * width + n] = j < 0 ? -1 : rank[j];
@@ -71,13 +89,21 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
   std::vector<double> reference(queries.size());      // lambda0 of level kFirstWideLevel - 1
   std::vector<char> stopped(queries.size(), 0);       // a level's residual was too large
   std::vector<PointMoments> level_moments, previous;  // A_l and A_{l-1} of the nodes
+  std::vector<double> level_reach, previous_reach;    // U_l and U_{l-1} (search_points given)
   for (int level = 0; level < kWideLevels; ++level) {
     std::swap(previous, level_moments);
+    std::swap(previous_reach, level_reach);
     level_moments.resize(at.size());
+    level_reach.resize(searched_at.size());
     const std::vector<PointMoments>* below = level == 0 ? nullptr : &previous;
+    const std::vector<double>* reach_below = level == 0 ? nullptr : &previous_reach;
 #pragma omp parallel for num_threads(threads) schedule(static)
-    for (std::ptrdiff_t r = 0; r < static_cast<std::ptrdiff_t>(at.size()); ++r)
+    for (std::ptrdiff_t r = 0; r < static_cast<std::ptrdiff_t>(at.size()); ++r) {
       level_moments[r] = sumOverRow(at[r], &rows[r * width], width, at, below);
+      if (search_points)
+        level_reach[r] =
+            rowReach(searched_at[r], &rows[r * width], width, searched_at, reach_below);
+    }
     if (level + 1 < kFirstWideLevel) continue;
     std::ptrdiff_t widening = 0;
 #pragma omp parallel for num_threads(threads) schedule(static) reduction(+ : widening)
@@ -85,6 +111,13 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
       if (stopped[v]) continue;
       const int q = visit[v];
       const int node = query_nodes[q];
+      if (!(largest_reference[q] >= 0.0)) {  // no plane to widen from: nothing read
+        stopped[v] = 1;
+        continue;
+      }
+      if (search_points)
+        kept[v].reach =
+            node >= 0 ? level_reach[rank[node]] : std::numeric_limits<double>::infinity();
       const PointMoments m =
           node >= 0
               ? level_moments[rank[node]]
@@ -98,10 +131,12 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
         stopped[v] = 1;
         continue;
       }
-      if (wide)
-        kept[v] = {level, fit.normal};
-      else
+      if (wide) {
+        kept[v].level = level;
+        kept[v].normal = fit.normal;
+      } else {
         reference[v] = lambda0;
+      }
       ++widening;
     }
     if (widening == 0) break;  // clean data: no plane widens, no need for the next level

@@ -81,11 +81,13 @@ class TileFiles {
 };
 
 // The fit of every point at its place: normal x y z, curvature, and for the quadric pc1, pc2 and
-// the k1 direction; NaN until written.
+// the k1 direction, for robust the scale and confidence; NaN until written.
 class ResultFile {
  public:
-  ResultFile(const std::string& path, std::int64_t points, bool curvatures)
-      : floats_(curvatures ? 9 : 4) {
+  ResultFile(const std::string& path, std::int64_t points, LocalFitMethod method)
+      : floats_(method == LocalFitMethod::Quadric  ? 9
+                : method == LocalFitMethod::Robust ? 6
+                                                   : 4) {
     fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_TRUNC, 0600);
     if (fd_ < 0) failSystem("cannot create " + path);
     const std::vector<float> nan(static_cast<std::size_t>(floats_) * 65536,
@@ -114,6 +116,7 @@ class ResultFile {
       if (run.empty()) run_first = point;
       const pcl::Normal& n = fit.normals[j];
       run.insert(run.end(), {n.normal_x, n.normal_y, n.normal_z, n.curvature});
+      if (floats_ == 6) run.insert(run.end(), {fit.scales[j], fit.confidences[j]});
       if (floats_ == 9) {
         const pcl::PrincipalCurvatures& c = fit.curvatures[j];
         run.insert(run.end(), {c.pc1, c.pc2, c.principal_curvature_x, c.principal_curvature_y,
@@ -133,6 +136,10 @@ class ResultFile {
     LocalFitResult fit;
     fit.normals.resize(static_cast<std::size_t>(count));
     if (floats_ == 9) fit.curvatures.resize(static_cast<std::size_t>(count));
+    if (floats_ == 6) {
+      fit.scales.resize(static_cast<std::size_t>(count));
+      fit.confidences.resize(static_cast<std::size_t>(count));
+    }
     for (std::int64_t i = 0; i < count; ++i) {
       const float* r = records.data() + i * floats_;
       pcl::Normal& n = fit.normals[i];
@@ -140,6 +147,10 @@ class ResultFile {
       n.normal_y = r[1];
       n.normal_z = r[2];
       n.curvature = r[3];
+      if (floats_ == 6) {
+        fit.scales[i] = r[4];
+        fit.confidences[i] = r[5];
+      }
       if (floats_ == 9) {
         pcl::PrincipalCurvatures& c = fit.curvatures[i];
         c.pc1 = r[4];
@@ -256,8 +267,7 @@ OutOfCoreReport fitCloudFileOutOfCore(const std::string& input, const std::strin
                                  ? std::filesystem::path(output).parent_path().string()
                                  : limits.scratch_folder;
   const ScratchFolder scratch(folder);
-  ResultFile results(scratch.path() + "/results.bin", layout.points,
-                     options.method == LocalFitMethod::Quadric);
+  ResultFile results(scratch.path() + "/results.bin", layout.points, options.method);
   if (!bounds.isEmpty()) {
     // 2. The plan, from a histogram of a second pass.
     PointHistogram histogram(bounds, 128);

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include "pcl_ddg/features/robust_normal_estimation.h"
+#include "pcl_ddg/features/widening_planes.h"
 #include "pcl_ddg/search/kd_tree_search.h"
 #include "pcl_ddg/tiling/tile_certificate.h"
 
@@ -42,6 +44,54 @@ std::vector<double> lookingDistances(const TilePoints& tile, int k) {
   return distance;
 }
 
+// How far each own point of a robust fit looked (tile_certificate.h): its own k nearest, and the
+// rows its wider planes read (RobustNormalEstimation::getReaches).
+struct LookedFit {
+  LocalFitResult fit;
+  std::vector<double> looked;
+};
+
+LookedFit fitLooking(const TilePoints& points, LocalFitOptions options) {
+  auto search = std::make_shared<LookingKdTree>(points.points->size(), options.k);
+  options.kd_tree_search = search;
+  options.report_reaches = true;
+  LocalCloud cloud(points.points);
+  cloud.positions = points.positions;
+  cloud.origin = points.origin;
+  LookedFit out;
+  out.fit = fitLocalSurfaces(cloud, nullptr, options, points.own);
+  out.looked.resize(points.own->size());
+  for (std::size_t j = 0; j < out.looked.size(); ++j)
+    out.looked[j] = lookingDistance(search->squaredKth((*points.own)[j]), out.fit.reaches[j]);
+  return out;
+}
+
+// The points and fits of the own points j with keep[j] only.
+void keepOnly(TilePoints& points, LocalFitResult& fit, const std::vector<char>& keep) {
+  auto own = std::make_shared<pcl::Indices>();
+  LocalFitResult kept;
+  kept.normals.is_dense = true;
+  for (std::size_t j = 0; j < keep.size(); ++j) {
+    if (!keep[j]) continue;
+    own->push_back((*points.own)[j]);
+    kept.normals.push_back(fit.normals[j]);
+    kept.scales.push_back(fit.scales[j]);
+    kept.confidences.push_back(fit.confidences[j]);
+    if (std::isfinite(fit.normals[j].normal_x)) continue;
+    ++kept.failed_points;
+    kept.normals.is_dense = false;
+  }
+  points.own = own;
+  fit = std::move(kept);
+}
+
+// The 99th percentile of values (not empty): the look that more than 1 % of the points exceed.
+double percentile99(std::vector<double> values) {
+  const std::size_t p99 = values.size() - 1 - values.size() / 100;
+  std::nth_element(values.begin(), values.begin() + p99, values.end());
+  return values[p99];
+}
+
 // The positions in `points` of the given global indices (all present: gathered in order).
 pcl::IndicesPtr positionsOf(const TilePoints& points, const std::vector<std::int64_t>& wanted) {
   auto positions = std::make_shared<pcl::Indices>();
@@ -60,14 +110,69 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
     throw pcl::BadArgumentException("tiles are fitted with kd-tree neighbourhoods only");
   const Eigen::AlignedBox3d& bounds = plan.histogram.bounds();
   TilingReport local;
-  const auto fit = [&](TilePoints& points) {
+  const auto gathered = [&](const TilePoints& points) {
     local.largest_gather = std::max<std::int64_t>(local.largest_gather,
                                                   static_cast<std::int64_t>(points.points->size()));
+  };
+  const auto fit = [&](TilePoints& points) {
+    gathered(points);
     if (points.own->empty()) return;
     LocalCloud cloud(points.points);
     cloud.positions = points.positions;
     cloud.origin = points.origin;
     consume(points, fitLocalSurfaces(cloud, nullptr, options, points.own));
+  };
+  // Robust with k nearest: how far a point looked is known after its fit (fitLooking).
+  const bool robust = options.method == LocalFitMethod::Robust && options.radius == 0.0;
+  LocalFitOptions robust_options = options;
+  for (const std::int64_t count : plan.histogram.counts()) robust_options.cloud_points += count;
+  struct FarPoint {
+    std::int64_t index;  ///< in the cloud
+    Eigen::Vector3d at;
+    double look;
+  };
+  // Fits far points with what lies in a box about them, a group of near ones at a time (one box
+  // for all would gather much of the cloud), again in a wider box for those that look past it
+  // (each round at least doubles a look; the cloud's bounds certify every point).
+  const auto fitRobustApart = [&](std::vector<FarPoint> far) {
+    local.far_points += static_cast<std::int64_t>(far.size());
+    const auto box = [&](const FarPoint& f) {
+      return std::isfinite(f.look) ? grown(Eigen::AlignedBox3d(f.at, f.at), f.look) : bounds;
+    };
+    while (!far.empty()) {
+      // The group: the points within the first one's look of it.
+      const Eigen::AlignedBox3d seed = box(far.front());
+      std::vector<FarPoint> group, rest;
+      Eigen::AlignedBox3d region;
+      for (const FarPoint& f : far) {
+        if (!seed.contains(f.at)) {
+          rest.push_back(f);
+          continue;
+        }
+        group.push_back(f);
+        region.extend(box(f));
+      }
+      region = region.intersection(grown(bounds, 1.0));
+      std::vector<std::int64_t> wanted;
+      for (const FarPoint& f : group) wanted.push_back(f.index);
+      std::sort(wanted.begin(), wanted.end());
+      std::sort(group.begin(), group.end(),
+                [](const FarPoint& a, const FarPoint& b) { return a.index < b.index; });
+      TilePoints points = gather(-1, region);
+      points.own = positionsOf(points, wanted);
+      gathered(points);
+      LookedFit looked = fitLooking(points, robust_options);
+      std::vector<char> keep(group.size());
+      for (std::size_t j = 0; j < group.size(); ++j) {
+        keep[j] = looked.looked[j] <= haloReach(group[j].at, region, bounds);
+        if (!keep[j])
+          rest.push_back(
+              {group[j].index, group[j].at, std::max(looked.looked[j], 2.0 * group[j].look)});
+      }
+      keepOnly(points, looked.fit, keep);
+      if (!points.own->empty()) consume(points, looked.fit);
+      far = std::move(rest);
+    }
   };
   // k nearest: the halo the tile before needed (neighbouring tiles have alike densities).
   double guess = 0.0;
@@ -80,47 +185,72 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
       fit(points);
       continue;
     }
+    if (robust && t == 0) {
+      // A first guess: the widest planes read rows up to kWideLevels steps away.
+      const std::vector<double> rows = lookingDistances(points, kWideGraphWidth);
+      const double widest = percentile99(rows);
+      if (std::isfinite(widest)) {
+        halo = (kWideLevels + 1) * widest;
+        points = gather(t, grown(box, halo));
+      }
+    }
     for (int round = 0;; ++round) {
       const Eigen::AlignedBox3d halo_box = grown(box, halo);
-      const std::vector<double> looking = lookingDistances(points, options.k);
+      LookedFit looked;
+      std::vector<double>& looking = looked.looked;
+      if (robust) {
+        gathered(points);
+        if (points.own->empty()) break;
+        looked = fitLooking(points, robust_options);
+      } else {
+        looking = lookingDistances(points, options.k);
+      }
       // The halo each point needs (its look beyond what the current halo gives it).
       std::vector<double> needed(looking.size());
       for (std::size_t i = 0; i < looking.size(); ++i) {
         const Eigen::Vector3d q = position((*points.points)[(*points.own)[i]]);
         needed[i] = std::max(0.0, halo + looking[i] - haloReach(q, halo_box, bounds));
       }
-      std::vector<double> sorted = needed;
-      const std::size_t p99 = sorted.size() - 1 - sorted.size() / 100;
-      std::nth_element(sorted.begin(), sorted.begin() + p99, sorted.end());
-      guess = std::isfinite(sorted[p99]) ? sorted[p99] : halo;
-      if (sorted[p99] > halo && round < 2) {
+      const double p99 = needed.empty() ? 0.0 : percentile99(needed);
+      guess = std::isfinite(p99) ? p99 : halo;
+      if (p99 > halo && round < 2) {
         // More than 1% look beyond: the halo itself is too narrow.
-        halo = std::isfinite(sorted[p99]) ? 1.05 * sorted[p99] : 2.0 * halo + box.sizes().norm();
+        halo = std::isfinite(p99) ? 1.05 * p99 : 2.0 * halo + box.sizes().norm();
         points = gather(t, grown(box, halo));
         ++local.halo_growths;
         continue;
       }
       local.widest_halo = std::max(local.widest_halo, halo);
       // The points that look beyond the halo are fitted apart, with what lies around them.
-      std::vector<std::int64_t> far;
+      std::vector<FarPoint> far;
       Eigen::AlignedBox3d around;
       auto inside = std::make_shared<pcl::Indices>();
+      std::vector<char> keep(needed.size());
       for (std::size_t i = 0; i < needed.size(); ++i) {
         const pcl::index_t at = (*points.own)[i];
-        if (needed[i] <= halo) {
+        keep[i] = needed[i] <= halo;
+        if (keep[i]) {
           inside->push_back(at);
           continue;
         }
-        far.push_back(points.global_index[at]);
         const Eigen::Vector3d q = position((*points.points)[at]);
+        far.push_back({points.global_index[at], q, looking[i]});
         around.extend(std::isfinite(looking[i]) ? grown(Eigen::AlignedBox3d(q, q), looking[i])
                                                 : bounds);
+      }
+      if (robust) {
+        keepOnly(points, looked.fit, keep);
+        if (!points.own->empty()) consume(points, looked.fit);
+        fitRobustApart(std::move(far));
+        break;
       }
       points.own = inside;
       fit(points);
       if (!far.empty()) {
         TilePoints far_points = gather(-1, around.intersection(grown(bounds, 1.0)));
-        far_points.own = positionsOf(far_points, far);
+        std::vector<std::int64_t> wanted;
+        for (const FarPoint& f : far) wanted.push_back(f.index);
+        far_points.own = positionsOf(far_points, wanted);
         local.far_points += static_cast<std::int64_t>(far.size());
         fit(far_points);
       }
@@ -135,8 +265,6 @@ LocalFitResult fitLocalSurfacesTiled(const LocalCloud& local, const LocalFitOpti
                                      const TilingOptions& tiling, TilingReport* report) {
   const pcl::PointCloud<pcl::PointXYZ>::ConstPtr& cloud = local.points;
   if (!cloud || cloud->empty()) throw pcl::BadArgumentException("the cloud is empty");
-  if (options.method == LocalFitMethod::Robust)  // its scales and confidences have no tile path
-    throw pcl::BadArgumentException("tiled fits are PCA or quadric; robust needs the whole cloud");
   const std::size_t n = cloud->size();
   Eigen::AlignedBox3d bounds;
   for (const auto& p : *cloud)
@@ -154,6 +282,10 @@ LocalFitResult fitLocalSurfacesTiled(const LocalCloud& local, const LocalFitOpti
     none.principal_curvature_x = none.principal_curvature_y = none.principal_curvature_z =
         none.pc1 = none.pc2 = std::numeric_limits<float>::quiet_NaN();
     result.curvatures.assign(n, none);
+  }
+  if (options.method == LocalFitMethod::Robust) {
+    result.scales.assign(n, std::numeric_limits<float>::quiet_NaN());
+    result.confidences.assign(n, std::numeric_limits<float>::quiet_NaN());
   }
   result.normals.is_dense = true;
   for (const auto& p : *cloud) {
@@ -198,6 +330,10 @@ LocalFitResult fitLocalSurfacesTiled(const LocalCloud& local, const LocalFitOpti
       const std::int64_t i = points.global_index[(*points.own)[j]];
       result.normals[i] = fit.normals[j];
       if (!fit.curvatures.empty()) result.curvatures[i] = fit.curvatures[j];
+      if (!fit.scales.empty()) {
+        result.scales[i] = fit.scales[j];
+        result.confidences[i] = fit.confidences[j];
+      }
     }
     result.failed_points += fit.failed_points;
     result.fallback_points += fit.fallback_points;

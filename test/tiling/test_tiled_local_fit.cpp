@@ -1,10 +1,11 @@
 // Tiles give the whole-cloud result bit for bit: on every shared cloud with tiles forced small, for
-// PCA and quadric, k nearest and radius; the halo grows where a tile's points look far (a dense
-// cluster in a sparse cloud); the plan gives every point one tile.
+// PCA, quadric and robust (its wider planes included), k nearest and radius; the halo grows where a
+// tile's points look far (a dense cluster in a sparse cloud); the plan gives every point one tile.
 #include <gtest/gtest.h>
 
 #include <pcl/io/pcd_io.h>
 
+#include <algorithm>
 #include <cstring>
 #include <random>
 
@@ -48,7 +49,12 @@ void expectSameBits(const pcl::PointCloud<Point>& a, const pcl::PointCloud<Point
   EXPECT_EQ(different, 0u) << "first at point " << first;
 }
 
-void expectTiledEqualsWhole(const Cloud::Ptr& cloud, const LocalFitOptions& options,
+void expectSameBits(const std::vector<float>& a, const std::vector<float>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
+}
+
+void expectTiledEqualsWhole(const LocalCloud& cloud, const LocalFitOptions& options,
                             std::int64_t tile_points, TilingReport* report = nullptr) {
   const LocalFitResult whole = fitLocalSurfaces(cloud, nullptr, options);
   TilingOptions tiling;
@@ -60,6 +66,8 @@ void expectTiledEqualsWhole(const Cloud::Ptr& cloud, const LocalFitOptions& opti
   expectSameBits(tiled.curvatures, whole.curvatures);
   EXPECT_EQ(tiled.failed_points, whole.failed_points);
   EXPECT_EQ(tiled.fallback_points, whole.fallback_points);
+  expectSameBits(tiled.scales, whole.scales);
+  expectSameBits(tiled.confidences, whole.confidences);
   if (report) *report = local;
 }
 
@@ -98,6 +106,52 @@ TEST(TiledLocalFit, QuadricAndRadiusSearchesToo) {
   radius.max_neighbours = 0;
   radius.radius = 0.03;
   expectTiledEqualsWhole(loadCloud("clouds/bun0.pcd"), radius, 40);
+}
+
+// Points of which at least one widened (a scale above the k searched).
+std::size_t widened(const LocalFitResult& fit, int k) {
+  return static_cast<std::size_t>(
+      std::count_if(fit.scales.begin(), fit.scales.end(), [&](float s) { return s > k; }));
+}
+
+TEST(TiledLocalFit, RobustWithItsWiderPlanesEqualsTheWholeCloudBitForBit) {
+  // A noisy roof (two planes meeting at a ridge, noise 1 % of the spacing's tenfold) at survey
+  // coordinates: the wider planes widen on the faces and stop at the ridge, and read rows up to
+  // twelve steps away, far past the k nearest.
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const int n = 30000;
+  Eigen::Matrix3Xd world(3, n);
+  for (int i = 0; i < n; ++i) {
+    const double x = 10.0 * unit(random), y = 10.0 * unit(random);
+    world.col(i) = Eigen::Vector3d(512345.25 + x, 4212345.5 + y,
+                                   120.0 + 0.4 * std::abs(x - 5.0) + noise(random));
+  }
+  const LocalCloud roof = makeLocalCloud(world);
+  ASSERT_TRUE(roof.positions);
+  LocalFitOptions robust;
+  robust.method = LocalFitMethod::Robust;
+  robust.k = 96;
+  robust.viewpoint = Eigen::Vector3d(512350.0, 4212350.0, 200.0);
+  TilingReport report;
+  expectTiledEqualsWhole(roof, robust, 3000, &report);
+  const LocalFitResult whole = fitLocalSurfaces(roof, nullptr, robust);
+  EXPECT_GT(widened(whole, robust.k), static_cast<std::size_t>(n) / 2);
+  EXPECT_GT(report.widest_halo, 1.0);  // the rows' reach, several times the 96 nearest's radius
+  std::printf(
+      "robust roof: %zu tiles, %lld halo growths, %lld far points, widest halo %.3f, "
+      "%lld gathered at most\n",
+      report.tiles, static_cast<long long>(report.halo_growths),
+      static_cast<long long>(report.far_points), report.widest_halo,
+      static_cast<long long>(report.largest_gather));
+
+  // A real scan in float, with its duplicates and sparse rim; and a radius, where robust does
+  // not widen.
+  expectTiledEqualsWhole(loadCloud("clouds/milk.pcd"), robust, 1500, &report);
+  robust.radius = 0.01;
+  robust.max_neighbours = 64;
+  expectTiledEqualsWhole(loadCloud("clouds/milk.pcd"), robust, 1500);
 }
 
 TEST(TiledLocalFit, TheHaloGrowsAroundADenseClusterInASparseCloud) {

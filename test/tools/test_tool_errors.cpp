@@ -169,7 +169,7 @@ TEST_F(ToolErrors, BadOptionsFailBeforeAnyFileIsRead) {
       {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method pca -k 16 -radius 0.1"},
       {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method pca -max_nn 8"},
       {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method pca -radius 2.5x"},
-      {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method robust -memory 1G"},
+      {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method robust -memory 1G -orient mst"},
       {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method robust -k 2"},
       {PCL_DDG_NORMALS_TOOL, "missing.ply", "-method pca -radius 1 -max_nn 0"},
       {PCL_DDG_NORMALS_TOOL, "missing.ply", "-neighbours tree"},

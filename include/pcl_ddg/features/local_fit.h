@@ -57,6 +57,11 @@ struct LocalFitOptions {
   /** KdTree: this search method instead of a new KdTreeSearch (one that also records what it
    *  finds, say). */
   std::shared_ptr<pcl::search::Search<pcl::PointXYZ>> kd_tree_search;
+  /** Robust, on a tile of a cloud (tiled_local_fit.h): the whole cloud's finite points
+   *  (RobustNormalEstimation::setCloudPoints; 0: the tile's), and whether to report each
+   *  point's reach (LocalFitResult::reaches). */
+  std::int64_t cloud_points = 0;
+  bool report_reaches = false;
 };
 
 struct LocalFitResult {
@@ -67,6 +72,8 @@ struct LocalFitResult {
   std::int64_t fallback_points = 0;  ///< quadric: PCA normal used
   /** Robust only: per point the neighbours used and the confidence (RobustNormalEstimation). */
   std::vector<float> scales, confidences;
+  /** Robust with options.report_reaches: RobustNormalEstimation::getReaches. */
+  std::vector<double> reaches;
   ConsistentOrientationReport orientation;  ///< SpanningTree: what the propagation turned
 };
 

@@ -23,6 +23,7 @@
  * are formed over the whole search surface (every point of it is a node of the graph), also
  * when only some indices are estimated: their cost is the surface's.
  */
+#include <cstdint>
 #include <vector>
 
 #include "pcl_ddg/features/local_fit_estimation.h"
@@ -61,6 +62,22 @@ class RobustNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
    *  [0, 1]; 1 for a wider plane. */
   const std::vector<float>& getConfidences() const { return confidences_; }
 
+  /** The finite points of the whole cloud the surface is part of (a tile's points with their
+   *  halo: the cloud's), at most a wider plane's scale; 0 (the default): the surface's. */
+  void setCloudPoints(std::int64_t points) { cloud_points_ = points; }
+  /** Also reports each output point's reach (getReaches): for fitting a cloud tile by tile
+   *  (tile_certificate.h). Off by default: it costs a square root per graph edge and level. */
+  void setReportReaches(bool report) { report_reaches_ = report; }
+  /**
+   * Per output point of the last compute() with setReportReaches: how far from the point, in the
+   * surface's float coordinates, its wider planes read (widening_planes.h: every node whose row
+   * was read, with that row's ball, lies within it); 0 where no wider plane was tried; infinity
+   * where a row had fewer than kWideGraphWidth points. The output of a point equals the one on
+   * a larger cloud around the surface where the point's own search and this ball find the same
+   * points in both.
+   */
+  const std::vector<double>& getReaches() const { return reaches_; }
+
  protected:
   /** Neither setKSearch nor setRadiusSearch: k = kRobustNormalNeighbours. */
   int defaultK() const override { return kRobustNormalNeighbours; }
@@ -77,6 +94,9 @@ class RobustNormalEstimation : public LocalFitEstimation<PointInT, PointOutT> {
              NeighbourGraph query_graph);
 
   std::vector<float> scales_, confidences_;
+  std::vector<double> reaches_;
+  std::int64_t cloud_points_ = 0;
+  bool report_reaches_ = false;
 };
 
 }  // namespace pcl_ddg

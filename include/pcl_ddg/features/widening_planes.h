@@ -18,6 +18,13 @@
  * Residual that does not grow with the scale is noise, which a wider plane averages; residual
  * that grows is curvature or another face, where the plane stops. On clean curved data the
  * reference is curvature, far above a small plane's residual, and no level is kept.
+ *
+ * Reach (for fitting tile by tile): level l of node r reads the rows of the nodes within l steps
+ * of r. With the nodes' search coordinates given, a bound on how far that reaches,
+ * \f$ U_l(r) = \max_{m \in N(r)} \left( |m - r| + U_{l-1}(m) \right) \f$, \f$ U_{-1} = 0 \f$,
+ * is carried along: every node c whose row was read, and that row's farthest point, lie within
+ * \f$ U_l(r) \f$ of r along the walk, hence its row's ball \f$ |c - r| + \rho_c \le U_l(r) \f$. A
+ * row short of the graph's width (fewer points than that were searched) reaches without bound.
  */
 #include <Eigen/Core>
 #include <vector>
@@ -42,6 +49,9 @@ constexpr double kWideGrowth = 2.0;
 struct WidePlane {
   int level = -1;  ///< the level kept; -1 for none (the reference or the first wide level failed)
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();  ///< unit, sign arbitrary; level >= 0
+  /** With search_points: U (see the file's comment) of the last level the query tried (0: none
+   *  tried; infinity: a query that is not a node). */
+  double reach = 0.0;
 };
 
 /**
@@ -51,12 +61,15 @@ struct WidePlane {
  * queries in double relative to any common origin near the cloud. Deterministic: the same input
  * gives the same bits on any number of threads. largest_reference[q]: the most residual
  * variance the reference level of query q may have for any level to be kept (-1: none).
+ * search_points (optional): the nodes' coordinates in which their rows were searched (the
+ * cloud's floats); given, each plane carries its reach.
  */
 std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
                                     const NeighbourGraph& node_graph,
                                     const std::vector<Eigen::Vector3d>& queries,
                                     const std::vector<int>& query_nodes,
                                     const NeighbourGraph& query_graph,
-                                    const std::vector<double>& largest_reference, int threads);
+                                    const std::vector<double>& largest_reference, int threads,
+                                    const std::vector<Eigen::Vector3f>* search_points = nullptr);
 
 }  // namespace pcl_ddg

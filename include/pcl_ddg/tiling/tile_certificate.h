@@ -12,12 +12,16 @@
  *   the fit holds when that look stays inside the halo box, haloReach: the distance to the nearest
  *   face of the box that does not lie beyond the cloud's bounds (nothing lies beyond those).
  *
+ * - Robust normals with k nearest: also the rows its wider planes read, each the nearest 32 of a
+ *   node up to twelve steps away along the graph; the reach bounds the ball of every such row.
+ *
  * The margin: float squared distances of points that differ in their last bits can round either
  * way, so a point counts as inside only with a relative margin of 1e-5.
  */
 #include <pcl/point_types.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -29,7 +33,9 @@ namespace pcl_ddg {
 constexpr double kRoundingMargin = 1e-5;
 
 /** The halo that certifies radius searches of radius r. */
-inline double radiusHalo(double radius) { return radius * (1.0 + kRoundingMargin); }
+inline double radiusHalo(double radius) {
+  return radius * (1.0 + kRoundingMargin);
+}
 
 /** How far a point whose k-th gathered neighbour lies at squared float distance squared_kth
  *  looks (infinity: fewer than k were gathered). */
@@ -37,6 +43,13 @@ inline double lookingDistance(float squared_kth) {
   return squared_kth <= std::numeric_limits<float>::max()
              ? std::sqrt(static_cast<double>(squared_kth)) * (1.0 + kRoundingMargin) + 1e-30
              : std::numeric_limits<double>::infinity();
+}
+
+/** How far a robust fit looked: its k nearest (squared_kth, as above) or the rows its wider
+ *  planes read (reach: RobustNormalEstimation::getReaches, in the same float coordinates),
+ *  whichever is farther, widened by the margin. */
+inline double lookingDistance(float squared_kth, double reach) {
+  return std::max(lookingDistance(squared_kth), reach * (1.0 + kRoundingMargin));
 }
 
 /** How far q may look before it could meet a point that was not gathered (see above). */

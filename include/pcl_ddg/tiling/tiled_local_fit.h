@@ -1,7 +1,7 @@
 #pragma once
 /** \file
- * The fitted estimators (PCA, quadric) run tile by tile, with the same result as on the whole
- * cloud, bit for bit: each tile is processed with a halo that holds every point's whole
+ * The fitted estimators (PCA, quadric, robust) run tile by tile, with the same result as on the
+ * whole cloud, bit for bit: each tile is processed with a halo that holds every point's whole
  * neighbourhood, and the kd-tree breaks distance ties by point index, so a tile (indexed in the
  * cloud's order) finds exactly the neighbours, in the order, that the whole cloud does.
  *   k nearest  the halo is set so that (nearly) every own point's k-th neighbour lies inside it,
@@ -9,6 +9,11 @@
  *              more than 1% of the points look farther); the few points that look farther still
  *              (outliers, the rim of a dense cluster) are fitted with the points around them alone
  *   radius     the halo is the radius (with max_neighbours too: those are cut from the ball)
+ *   robust     with k nearest, how far a point looked (its k nearest and the rows its wider planes
+ *              read, RobustNormalEstimation::getReaches) is known after its fit: the tile is
+ *              fitted and refitted with a wider halo while more than 1% look past it; the rest
+ *              are fitted apart, a group of near ones at a time, in boxes that widen until each
+ *              looks inside its own
  */
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>

@@ -18,6 +18,7 @@ void RobustNormalEstimation<PointInT, PointOutT>::computeFeature(PointCloudOut& 
   constexpr float nan = std::numeric_limits<float>::quiet_NaN();
   scales_.assign(output.size(), nan);
   confidences_.assign(output.size(), nan);
+  reaches_.assign(report_reaches_ ? output.size() : 0, 0.0);
   std::vector<double> largest_reference(output.size(), -1.0);  // none: no wider plane
   // Planes widen from a k-nearest search (not a radius) along a graph whose rows are each
   // query's first kWideGraphWidth neighbours found.
@@ -64,27 +65,21 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
   const pcl::Indices& indices = *this->indices_;
   pcl::search::Search<PointInT>& tree = *this->tree_;
   const int threads = this->threadCount();
-  // Coordinates relative to one point of the cloud, in double (the exact ones when given: then
-  // the surface is the input).
+  // Coordinates in double as given (the exact ones when given: then the surface is the input):
+  // the moments are kept about their own nodes, so nothing cancels, and the bits do not depend
+  // on which points the surface holds (a tile's fit gives the whole cloud's).
   const auto absolute = [&](const PointInT& p, pcl::index_t j) -> Eigen::Vector3d {
     const auto& exact = this->getInputPositions();
     return exact ? Eigen::Vector3d(exact->col(j))
                  : Eigen::Vector3d(p.getVector3fMap().template cast<double>());
   };
-  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
-  for (std::size_t j = 0; j < surface.size(); ++j)
-    if (pcl::isXYZFinite(surface[j])) {
-      origin = absolute(surface[j], static_cast<pcl::index_t>(j));
-      break;
-    }
   std::vector<Eigen::Vector3d> nodes(surface.size());
   for (std::size_t j = 0; j < surface.size(); ++j)
-    nodes[j] = pcl::isXYZFinite(surface[j])
-                   ? Eigen::Vector3d(absolute(surface[j], static_cast<pcl::index_t>(j)) - origin)
-                   : Eigen::Vector3d::Zero();
+    nodes[j] = pcl::isXYZFinite(surface[j]) ? absolute(surface[j], static_cast<pcl::index_t>(j))
+                                            : Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> queries(indices.size());
   for (std::size_t i = 0; i < indices.size(); ++i)
-    queries[i] = absolute(input[indices[i]], indices[i]) - origin;
+    queries[i] = absolute(input[indices[i]], indices[i]);
 
   // The nodes' rows: on the input itself a query is its node and brings its row; the other
   // nodes (all of a separate search surface) search for theirs.
@@ -124,14 +119,24 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
     }
   }
   interruption.throwIfStopped();
-  const std::vector<WidePlane> planes = widestPlanes(nodes, node_graph, queries, query_nodes,
-                                                     query_graph, largest_reference, threads);
-  const auto finite = static_cast<int>(std::count_if(
-      surface.begin(), surface.end(), [](const PointInT& p) { return pcl::isXYZFinite(p); }));
+  std::vector<Eigen::Vector3f> searched;  // where the rows were searched: their reach
+  if (report_reaches_) {
+    searched.resize(surface.size());
+    for (std::size_t j = 0; j < surface.size(); ++j) searched[j] = surface[j].getVector3fMap();
+  }
+  const std::vector<WidePlane> planes =
+      widestPlanes(nodes, node_graph, queries, query_nodes, query_graph, largest_reference, threads,
+                   report_reaches_ ? &searched : nullptr);
+  const std::int64_t finite =
+      cloud_points_ > 0 ? cloud_points_
+                        : std::count_if(surface.begin(), surface.end(),
+                                        [](const PointInT& p) { return pcl::isXYZFinite(p); });
   for (std::size_t i = 0; i < planes.size(); ++i) {
+    if (report_reaches_) reaches_[i] = planes[i].reach;
     if (planes[i].level < 0) continue;
     write(output[i], planes[i].normal, indices[i], this->inputPosition(indices[i]));
-    scales_[i] = static_cast<float>(std::min(kWideGraphWidth * (planes[i].level + 1), finite));
+    scales_[i] =
+        static_cast<float>(std::min<std::int64_t>(kWideGraphWidth * (planes[i].level + 1), finite));
     confidences_[i] = 1.0f;
   }
 }
