@@ -10,8 +10,9 @@ namespace pcl_ddg {
 namespace detail {
 
 struct PointMoments {
-  double weight = 0.0, x = 0.0, y = 0.0, z = 0.0, xx = 0.0, xy = 0.0, xz = 0.0, yy = 0.0, yz = 0.0,
-         zz = 0.0;
+  // Laid out so that (x, y), (xx, yy) and (xy, xz) are pairs addMoved forms in one vector each.
+  double weight = 0.0, x = 0.0, y = 0.0, z = 0.0, xx = 0.0, yy = 0.0, zz = 0.0, xy = 0.0, xz = 0.0,
+         yz = 0.0;
 
   /** Adds a point of unit weight. */
   void add(const Eigen::Vector3d& p) {
@@ -26,17 +27,22 @@ struct PointMoments {
     yz += p.y() * p.z();
     zz += p.z() * p.z();
   }
-  /** Adds other, taken about a reference d from this one's: x - ours = (x - theirs) + d. */
+  /** Adds other, taken about a reference d from this one's: x - ours = (x - theirs) + d. Each
+   *  sum is formed as o.xx + 2 o.x d.x + o.weight d.x d.x (and alike), left to right; the pairs are
+   *  the same operations lane by lane (the wider planes add 32 of these per point and level). */
   void addMoved(const PointMoments& o, const Eigen::Vector3d& d) {
+    using Pair = Eigen::Array2d;
+    using PairMap = Eigen::Map<Pair>;
+    using ConstPairMap = Eigen::Map<const Pair>;
+    const Pair dxy(d.x(), d.y()), dyz(d.y(), d.z());
+    const Pair oxy = ConstPairMap(&o.x), oyz(o.y, o.z);
+    const double wdx = o.weight * d.x();
     weight += o.weight;
-    x += o.x + o.weight * d.x();
-    y += o.y + o.weight * d.y();
+    PairMap(&x) += oxy + o.weight * dxy;
     z += o.z + o.weight * d.z();
-    xx += o.xx + 2.0 * o.x * d.x() + o.weight * d.x() * d.x();
-    yy += o.yy + 2.0 * o.y * d.y() + o.weight * d.y() * d.y();
+    PairMap(&xx) += ConstPairMap(&o.xx) + 2.0 * oxy * dxy + o.weight * dxy * dxy;
     zz += o.zz + 2.0 * o.z * d.z() + o.weight * d.z() * d.z();
-    xy += o.xy + o.x * d.y() + o.y * d.x() + o.weight * d.x() * d.y();
-    xz += o.xz + o.x * d.z() + o.z * d.x() + o.weight * d.x() * d.z();
+    PairMap(&xy) += ConstPairMap(&o.xy) + o.x * dyz + oyz * d.x() + wdx * dyz;
     yz += o.yz + o.y * d.z() + o.z * d.y() + o.weight * d.y() * d.z();
   }
   /** The number of points added with unit weights. */

@@ -35,21 +35,31 @@ struct Plane {
 
 /** The median of |n . (x_i - c)| over the first count columns of x (element count / 2 of them
  *  sorted) when it is below `below`, else infinity. Most planes tried are worse than the best so
- *  far: counting the residuals below it tells so (fewer than count / 2 + 1 of them) without the
- *  selection, and the planes kept get the same median as a full selection gives. */
+ *  far: counting the residuals below it tells so (fewer than count / 2 + 1 of them), as soon as
+ *  too few are left to reach that, without the selection. A plane kept has its median among the
+ *  residuals below `below` (they are the smallest), which are selected from alone: the same value
+ *  as a selection from all. (A NaN residual, from coordinates near overflow, selects from all.) */
 double medianResidualBelow(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double below,
-                           std::vector<double>& residuals) {
+                           std::vector<double>& residuals, std::vector<double>& smaller) {
   residuals.resize(static_cast<std::size_t>(count));
+  smaller.resize(static_cast<std::size_t>(count));
   const double offset = plane.normal.dot(plane.centroid);
+  const int needed = count / 2 + 1;  // residuals under `below` for a median under it
   int under = 0;
   bool nan = false;
   for (int i = 0; i < count; ++i) {
     const double r = std::abs(plane.normal.dot(x.col(i)) - offset);
     residuals[i] = r;
+    smaller[under] = r;
     under += r < below;
     nan = nan || std::isnan(r);
+    if (!nan && under + (count - 1 - i) < needed) return std::numeric_limits<double>::infinity();
   }
-  if (!nan && under <= count / 2) return std::numeric_limits<double>::infinity();
+  if (!nan) {
+    const auto middle = smaller.begin() + count / 2;
+    std::nth_element(smaller.begin(), middle, smaller.begin() + under);
+    return *middle;
+  }
   const auto middle = residuals.begin() + count / 2;
   std::nth_element(residuals.begin(), middle, residuals.end());
   return *middle < below ? *middle : std::numeric_limits<double>::infinity();
@@ -80,16 +90,27 @@ class NestedQuadric {
         origin_(frame.centroid),
         scale_(scale) {}
 
-  void add(const Eigen::Vector3d& p) {
-    const Eigen::Vector3d d = (p - origin_) / scale_;
-    const double u = d.dot(t1_), v = d.dot(t2_), w = d.dot(normal_);
-    Row a;
-    a << u * u, u * v, v * v, u, v, 1.0;
-    for (int r = 0; r < 6; ++r)
-      for (int c = 0; c <= r; ++c) normal_matrix_(r, c) += a[r] * a[c];
-    right_ += w * a;
-    squares_ += w * w;
-    ++count_;
+  /** Adds the columns begin .. end - 1 of x. The sums stay in locals over the range (as members
+   *  they went through memory at every point), and the whole outer product is added, whose
+   *  columns vectorize: its lower triangle, all that is read, is the same products added in the
+   *  same order as entry by entry. */
+  void add(const Eigen::Matrix3Xd& x, int begin, int end) {
+    Eigen::Matrix<double, 6, 6> products = normal_matrix_;
+    Row right = right_;
+    double squares = squares_;
+    for (int i = begin; i < end; ++i) {
+      const Eigen::Vector3d d = (x.col(i) - origin_) / scale_;
+      const double u = d.dot(t1_), v = d.dot(t2_), w = d.dot(normal_);
+      Row a;
+      a << u * u, u * v, v * v, u, v, 1.0;
+      products.noalias() += a * a.transpose();
+      right += w * a;
+      squares += w * w;
+    }
+    normal_matrix_ = products;
+    right_ = right;
+    squares_ = squares;
+    count_ += end - begin;
   }
   /** Residual variance SSR / (m - 6) in length^2; NaN when the system is singular. */
   double variance() const {
@@ -121,7 +142,7 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   // Buffers reused by each thread's next neighbourhood: a fit takes microseconds.
   thread_local std::vector<std::pair<double, int>> by_distance;
   thread_local Eigen::Matrix3Xd x;
-  thread_local std::vector<double> residuals;
+  thread_local std::vector<double> residuals, smaller;
   // The neighbours nearest first (k-d tree searches give them so; ties keep their order).
   by_distance.resize(static_cast<std::size_t>(count));
   for (int i = 0; i < count; ++i) by_distance[i] = {points.col(i).squaredNorm(), i};
@@ -165,18 +186,17 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   bool smooth = false;  // the smallest scale is a smooth surface: a quadric explains it
   if (!scales.empty()) {
     NestedQuadric quadric(scales.back().plane, radius);
-    std::size_t j = 0;
-    for (int i = 0; i < count && j < scales.size(); ++i) {
-      quadric.add(x.col(i));
-      if (i + 1 != scales[j].k) continue;
+    int added = 0;
+    for (std::size_t j = 0; j < scales.size(); ++j) {
       const int k = scales[j].k;
+      quadric.add(x, added, k);
+      added = k;
       const double plane = scales[j].l0 * k / std::max(k - 3, 1);
       const double fitted = quadric.variance();
-      ++j;
       if (std::isnan(fitted)) continue;  // no quadric: neither smooth nor explained by the plane
       const double curved = std::max(fitted, floor * floor);
-      if (j == 1) smooth = curved < kSmooth * plane;
-      if (plane <= kScaleVariance * curved) chosen = static_cast<int>(j - 1);
+      if (j == 0) smooth = curved < kSmooth * plane;
+      if (plane <= kScaleVariance * curved) chosen = static_cast<int>(j);
     }
   }
   const int used = chosen < 0 ? count : scales[chosen].k;
@@ -188,7 +208,8 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   double best_median = std::numeric_limits<double>::infinity();
   Plane plane;
   for (int j = 0; j <= chosen; ++j) {
-    const double median = medianResidualBelow(x, scored, scales[j].plane, best_median, residuals);
+    const double median =
+        medianResidualBelow(x, scored, scales[j].plane, best_median, residuals, smaller);
     if (median < best_median) {
       best_median = median;
       plane = scales[j].plane;
@@ -207,7 +228,8 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
       if (!(n.norm() > 1e-9 * size)) continue;  // the query itself, a duplicate, or collinear
       const Plane through{n.normalized(), Eigen::Vector3d::Zero()};
       const double median = medianResidualBelow(
-          x, scored, through, std::min(best_median, kThroughQuery * nested_median), residuals);
+          x, scored, through, std::min(best_median, kThroughQuery * nested_median), residuals,
+          smaller);
       if (median < best_median && median < kThroughQuery * nested_median) {
         best_median = median;
         plane = through;
