@@ -297,6 +297,9 @@ def make_plan(client: Any, clouds: List[CloudInput], points_per_tile: int,
     area = max(extent[0] * max(extent[1], extent[0] * 1e-3), 1e-300)
     k = options["k"]
     guess = 1.5 * math.sqrt(k / (math.pi * finite / area)) if options["radius"] == 0 else 0.0
+    if options["method"] == "robust" and options["radius"] == 0 and k >= 32:
+        # Its wider planes read rows (32 nearest) up to twelve steps away: about 14 of their radii.
+        guess = max(guess, 14 * 1.5 * math.sqrt(32 / (math.pi * finite / area)))
     plan = Plan(tuple(origin), tuple(lo), tuple(hi), dims, chunks, [], finite, points_per_tile,
                 guess)
     tiles = []
@@ -726,6 +729,8 @@ def _run(tool: str, inputs, output_dir: str, client=None, *, method: str = "pca"
     check_output_folder(output_dir, paths, merge)
     clouds = scan_inputs(paths, allow_mixed_crs)
     total = sum(c.points for c in clouds)
+    if method == "robust" and k is None and radius is None:
+        options["k"] = min(options["k"], total)  # as the tool's default: 96 or every point
     if options["radius"] == 0 and options["k"] > total:
         raise ValueError(f"-k {options['k']} is more than the {total} points of the input")
     # Aerial LiDAR has no single viewpoint: LAS inputs are oriented up unless told otherwise, as

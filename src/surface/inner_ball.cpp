@@ -11,7 +11,8 @@
 
 namespace pcl_ddg {
 
-Eigen::VectorXd innerBallRadii(const MeshTopology& topology, const PositionsRef& positions) {
+Eigen::VectorXd innerBallRadii(const MeshTopology& topology, const PositionsRef& positions,
+                               double largest) {
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   const int n = topology.numVertices();
   Eigen::VectorXd radii = Eigen::VectorXd::Constant(n, kInfinity);
@@ -63,7 +64,7 @@ Eigen::VectorXd innerBallRadii(const MeshTopology& topology, const PositionsRef&
       if (!normals.valid[v]) continue;
       const Eigen::Vector3d p = positions.col(v) - centre;
       const Eigen::Vector3d normal = outward[component[v]] * normals.normals.col(v);
-      double r = diagonal;
+      double r = largest < diagonal ? largest : diagonal;
       // Each pass shrinks r strictly; 64 passes are far more than a surface needs (usually under
       // 10). Were they spent, r would be an upper bound.
       for (int pass = 0; pass < 64; ++pass) {
@@ -78,7 +79,7 @@ Eigen::VectorXd innerBallRadii(const MeshTopology& topology, const PositionsRef&
         if (!(shrunk < r)) break;
         r = shrunk;
       }
-      if (r < diagonal) radii[v] = r;
+      if (r < diagonal) radii[v] = r;  // a ball as wide as the surface: nothing constrains it
     }
   }
   return radii;

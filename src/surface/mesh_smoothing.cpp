@@ -93,7 +93,11 @@ Eigen::ArrayXd thinPartSlowdown(const MeshTopology& topology, const Eigen::Matri
                                 const Eigen::SparseMatrix<double>& stiffness,
                                 const Eigen::VectorXd& mass, const MeshSmoothingParameters& p) {
   const double time = p.time_step * p.iterations;
-  const Eigen::ArrayXd radii = innerBallRadii(topology, positions).array();
+  // Only radii below sqrt(time / limit) slow anything down: no ball needs to start wider.
+  const double widest = time > 0.0 && p.thickness_limit > 0.0
+                            ? std::sqrt(time / p.thickness_limit)
+                            : std::numeric_limits<double>::infinity();
+  const Eigen::ArrayXd radii = innerBallRadii(topology, positions, widest).array();
   // Capped where a radius rounds to nothing: such a vertex just stays (r = inf gives 1).
   Eigen::MatrixXd log_slowdown =
       (time / (p.thickness_limit * radii.square())).max(1.0).min(1e12).log().matrix();

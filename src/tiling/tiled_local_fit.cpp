@@ -185,7 +185,7 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
       fit(points);
       continue;
     }
-    if (robust && t == 0) {
+    if (robust && t == 0 && options.k >= kWideGraphWidth) {
       // A first guess: the widest planes read rows up to kWideLevels steps away.
       const std::vector<double> rows = lookingDistances(points, kWideGraphWidth);
       const double widest = percentile99(rows);
@@ -214,9 +214,21 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
       const double p99 = needed.empty() ? 0.0 : percentile99(needed);
       guess = std::isfinite(p99) ? p99 : halo;
       if (p99 > halo && round < 2) {
-        // More than 1% look beyond: the halo itself is too narrow.
+        // More than 1% look beyond: the halo itself is too narrow. (Robust fits are costly: those
+        // this halo certified are kept, the rest fitted again.)
+        std::vector<std::int64_t> rest;
+        if (robust) {
+          std::vector<char> keep(needed.size());
+          for (std::size_t i = 0; i < needed.size(); ++i) {
+            keep[i] = needed[i] <= halo;
+            if (!keep[i]) rest.push_back(points.global_index[(*points.own)[i]]);
+          }
+          keepOnly(points, looked.fit, keep);
+          if (!points.own->empty()) consume(points, looked.fit);
+        }
         halo = std::isfinite(p99) ? 1.05 * p99 : 2.0 * halo + box.sizes().norm();
         points = gather(t, grown(box, halo));
+        if (robust) points.own = positionsOf(points, rest);
         ++local.halo_growths;
         continue;
       }

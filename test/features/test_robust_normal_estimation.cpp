@@ -594,6 +594,72 @@ TEST(RobustNormals, PlanesWidenFromExactlyTheGraphsWidth) {
   EXPECT_EQ(r.failed, 0);
 }
 
+TEST(RobustNormals, AReachBoundsEveryRowItsWiderPlanesReadAndFollowsItsDefinition) {
+  // A noisy plane: the planes widen to the last level. Truth: every node c within twelve steps of
+  // q along the rows (their 32 nearest), with its row's radius, lies within the reach:
+  // |c - q| + rho_c <= reach (the tiles' certificate rests on it). Definition: the reach is U of
+  // the last level tried (widening_planes.h), here the twelfth, formed again from the rows.
+  std::mt19937 rng(4);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  Sampling sampling;
+  sampling.resolution = 60;  // 3,600 points, h = 0.033
+  SurfaceSample s = makePlane(sampling);
+  for (Eigen::Index i = 0; i < s.points.cols(); ++i) s.points(2, i) += noise(rng);
+  const auto cloud = toCloud(s.points);
+  Robust estimator;
+  estimator.setInputCloud(cloud);
+  estimator.setSearchMethod(std::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  estimator.setReportReaches(true);
+  Normals normals;
+  estimator.compute(normals);
+  const std::vector<double>& reach = estimator.getReaches();
+  ASSERT_EQ(reach.size(), cloud->size());
+
+  const int n = static_cast<int>(cloud->size());
+  pcl::search::KdTree<pcl::PointXYZ> tree;
+  tree.setInputCloud(cloud);
+  std::vector<std::vector<int>> rows(n);
+  std::vector<double> radius(n, 0.0);
+  const auto at = [&](int j) { return (*cloud)[j].getVector3fMap().cast<double>(); };
+  for (int j = 0; j < n; ++j) {
+    std::vector<float> distances;
+    tree.nearestKSearch(*cloud, j, kWideGraphWidth, rows[j], distances);
+    for (const int m : rows[j]) radius[j] = std::max(radius[j], (at(m) - at(j)).norm());
+  }
+  std::vector<double> u(radius), next(n);  // U_0 is the row's radius
+  for (int level = 1; level < kWideLevels; ++level) {
+    for (int r = 0; r < n; ++r) {
+      next[r] = 0.0;
+      for (const int m : rows[r]) next[r] = std::max(next[r], (at(m) - at(r)).norm() + u[m]);
+    }
+    std::swap(u, next);
+  }
+  const float last = static_cast<float>(kWideGraphWidth * kWideLevels);
+  int checked = 0;
+  for (int q = 0; q < n; q += 7) {
+    if (estimator.getScales()[q] != last) continue;  // kept the last level: tried every level
+    ++checked;
+    EXPECT_NEAR(reach[q], u[q], 1e-12 * u[q]) << q;
+    std::vector<int> hops(n, -1);
+    std::vector<int> frontier{q};
+    hops[q] = 0;
+    double farthest = radius[q];
+    for (int h = 1; h < kWideLevels; ++h) {
+      std::vector<int> further;
+      for (const int r : frontier)
+        for (const int m : rows[r])
+          if (hops[m] < 0) {
+            hops[m] = h;
+            further.push_back(m);
+            farthest = std::max(farthest, (at(m) - at(q)).norm() + radius[m]);
+          }
+      frontier = std::move(further);
+    }
+    EXPECT_GE(reach[q] * (1.0 + 1e-12), farthest) << q;
+  }
+  EXPECT_GT(checked, n / 7 / 2);  // most points widen to the last level on this noisy plane
+}
+
 TEST(WidestPlanes, EqualTheSumsOfWalksOverTheGraphComputedByBruteForce) {
   // widening_planes.h: level l's moments at node j sum the points x_m weighted by the number of
   // (l + 1)-step walks from j to m along the rows, W_l = G^(l + 1) (G_jm = 1 for m in row j).

@@ -119,6 +119,31 @@ TEST(InnerBall, TheSameFarFromTheOriginWoundInwardOrWithADoubledVertex) {
   EXPECT_GT(shared_copy[n], 0.3 * 0.7);
 }
 
+TEST(InnerBall, StartingFromASmallerBallGivesTheSameRadiiBelowIt) {
+  // A tangent ball is empty exactly while its radius is at most the vertex's r, and each shrink
+  // lands on a radius no smaller: from any start the iteration ends on min(start, r), bit for bit
+  // where r is below the start (the same last vertex decides it) by more than the emptiness
+  // test's tolerance (1e-9). Starts below, at and above the torus's tube radius.
+  const SurfaceSample torus = makeTorus({48, 0.0, 1}, 1.0, 0.3);
+  const MeshTopology topology = topologyOf(torus);
+  const Eigen::VectorXd radii = innerBallRadii(topology, torus.points);
+  for (const double largest : {0.2, 0.3, 0.5, 10.0}) {
+    const Eigen::VectorXd capped = innerBallRadii(topology, torus.points, largest);
+    int below = 0;
+    for (Eigen::Index v = 0; v < radii.size(); ++v) {
+      if (radii[v] < largest * (1.0 - 1e-9)) {
+        EXPECT_EQ(capped[v], radii[v]) << v << " from " << largest;
+        ++below;
+      } else if (radii[v] >= largest) {
+        EXPECT_EQ(capped[v], largest) << v << " from " << largest;
+      } else {  // within the emptiness test's tolerance of the start (the tube's own radius)
+        EXPECT_NEAR(capped[v], radii[v], 1e-9 * largest) << v << " from " << largest;
+      }
+    }
+    if (largest >= 0.3) EXPECT_GT(below, radii.size() / 2) << largest;
+  }
+}
+
 TEST(InnerBall, AnOpenSurfaceKeepsTheSideItsFacesGive) {
   // A cap of a unit sphere (z > 0.3: open, consistently oriented). Wound outward its inner side
   // is the sphere's inside: every ball is the sphere's (radius 1, the 20 % a normal's tilt can

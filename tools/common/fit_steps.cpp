@@ -14,6 +14,7 @@
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/features/fit_choices.h"
 #include "pcl_ddg/features/robust_normal_estimation.h"
+#include "pcl_ddg/io/cloud_pieces.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/vertex_positions.h"
@@ -317,9 +318,11 @@ void fitOutOfCore(const char* tool_name, const ToolArguments& args, const std::s
                   const ResultFields& fields) {
   OutOfCoreOptions limits;
   limits.memory_budget = memoryArgument(args);
-  Timer timer(std::string("Fitting ") +
-              (options.method == LocalFitMethod::PCA ? "planes" : "quadrics") +
-              " out of core (budget " + *args.value("memory") + ")");
+  const char* fits = options.method == LocalFitMethod::PCA       ? "planes"
+                     : options.method == LocalFitMethod::Quadric ? "quadrics"
+                                                                 : "robust planes";
+  Timer timer(std::string("Fitting ") + fits + " out of core (budget " + *args.value("memory") +
+              ")");
   const OutOfCoreReport report = [&] {
     const QuietPCLWarnings quiet;
     return fitCloudFileOutOfCore(input, output, options, limits, fields);
@@ -355,14 +358,19 @@ int fitEachInputOutOfCore(const char* tool_name, const ToolArguments& args,
                           const LocalFitOptions& options, FieldPrecision precision,
                           const PieceFields& add) {
   memoryArgument(args);  // checked before any file is read
-  return forEachInput(args, tool_name, {"ply", "pcd", "las", "laz"},
-                      [&](const std::string& input, const std::string& output) {
-                        LocalFitOptions for_input = options;
-                        const std::string ext = fileExtension(input);
-                        orientLasUp(tool_name, args, ext == "las" || ext == "laz", for_input);
-                        fitOutOfCore(tool_name, args, input, output, for_input,
-                                     outOfCoreFields(output, precision, add));
-                      });
+  return forEachInput(
+      args, tool_name, {"ply", "pcd", "las", "laz"},
+      [&](const std::string& input, const std::string& output) {
+        LocalFitOptions for_input = options;
+        const std::string ext = fileExtension(input);
+        orientLasUp(tool_name, args, ext == "las" || ext == "laz", for_input);
+        // Robust's default k, as in memory: 96 or every point if fewer.
+        if (for_input.method == LocalFitMethod::Robust && !args.has("k") && for_input.radius == 0.0)
+          for_input.k =
+              defaultNeighbours(LocalFitMethod::Robust, CloudPieceReader(input).layout().points);
+        fitOutOfCore(tool_name, args, input, output, for_input,
+                     outOfCoreFields(output, precision, add));
+      });
 }
 
 QuietPCLWarnings::QuietPCLWarnings() : level_(pcl::console::getVerbosityLevel()) {

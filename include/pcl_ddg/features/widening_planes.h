@@ -58,8 +58,9 @@ struct WidePlane {
  * For each query (at queries[q]): the plane of the widest level kept (see the file's comment).
  * A query that is a node (query_nodes[q] >= 0) has that node's moments; one that is not
  * (query_nodes[q] = -1) sums its own neighbours among the nodes, query_graph's row q. nodes and
- * queries in double relative to any common origin near the cloud. Deterministic: the same input
- * gives the same bits on any number of threads. largest_reference[q]: the most residual
+ * queries in double, in any frame (the moments are kept about their nodes, so the origin's
+ * distance costs nothing; a node in no row may be NaN). Deterministic: the same input gives the
+ * same bits on any number of threads, and a node's sums depend only on the nodes its walks reach. largest_reference[q]: the most residual
  * variance the reference level of query q may have for any level to be kept (-1: none).
  * search_points (optional): the nodes' coordinates in which their rows were searched (the
  * cloud's floats); given, each plane carries its reach.

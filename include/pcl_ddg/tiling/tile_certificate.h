@@ -49,6 +49,7 @@ inline double lookingDistance(float squared_kth) {
  *  planes read (reach: RobustNormalEstimation::getReaches, in the same float coordinates),
  *  whichever is farther, widened by the margin. */
 inline double lookingDistance(float squared_kth, double reach) {
+  if (std::isnan(reach)) return std::numeric_limits<double>::infinity();  // certifies nothing
   return std::max(lookingDistance(squared_kth), reach * (1.0 + kRoundingMargin));
 }
 

@@ -73,10 +73,12 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
     return exact ? Eigen::Vector3d(exact->col(j))
                  : Eigen::Vector3d(p.getVector3fMap().template cast<double>());
   };
+  // A non-finite point is in no row; NaN puts it last in the nodes' spatial order.
   std::vector<Eigen::Vector3d> nodes(surface.size());
   for (std::size_t j = 0; j < surface.size(); ++j)
-    nodes[j] = pcl::isXYZFinite(surface[j]) ? absolute(surface[j], static_cast<pcl::index_t>(j))
-                                            : Eigen::Vector3d::Zero();
+    nodes[j] = pcl::isXYZFinite(surface[j])
+                   ? absolute(surface[j], static_cast<pcl::index_t>(j))
+                   : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   std::vector<Eigen::Vector3d> queries(indices.size());
   for (std::size_t i = 0; i < indices.size(); ++i)
     queries[i] = absolute(input[indices[i]], indices[i]);
