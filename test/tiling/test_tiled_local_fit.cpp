@@ -51,6 +51,7 @@ void expectSameBits(const pcl::PointCloud<Point>& a, const pcl::PointCloud<Point
 
 void expectSameBits(const std::vector<float>& a, const std::vector<float>& b) {
   ASSERT_EQ(a.size(), b.size());
+  if (a.empty()) return;  // (memcmp must not be given an empty vector's null data)
   EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
 }
 
