@@ -60,10 +60,10 @@ struct WidePlane {
  * (query_nodes[q] = -1) sums its own neighbours among the nodes, query_graph's row q. nodes and
  * queries in double, in any frame (the moments are kept about their nodes, so the origin's
  * distance costs nothing; a node in no row may be NaN). Deterministic: the same input gives the
- * same bits on any number of threads, and a node's sums depend only on the nodes its walks reach. largest_reference[q]: the most residual
- * variance the reference level of query q may have for any level to be kept (-1: none).
- * search_points (optional): the nodes' coordinates in which their rows were searched (the
- * cloud's floats); given, each plane carries its reach.
+ * same bits on any number of threads, and a node's sums depend only on the nodes its walks reach.
+ * largest_reference[q]: the most residual variance the reference level of query q may have for any
+ * level to be kept (-1: none). search_points (optional): the nodes' coordinates in which their rows
+ * were searched (the cloud's floats); given, each plane carries its reach.
  */
 std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
                                     const NeighbourGraph& node_graph,
