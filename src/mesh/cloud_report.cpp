@@ -33,66 +33,87 @@ std::uint64_t hashOf(const Eigen::Vector3d& p) {
   return h;
 }
 
+}  // namespace
+
 // Finite points equal to an earlier one, in linear time (the sort of every triple took 0.5 s for
 // 10M points): the triples' hashes are sorted by radix, and only the points whose hash occurs
-// more than once are compared coordinate by coordinate, so that a collision of two distinct
-// triples is no duplicate.
-std::int64_t countDuplicates(const PositionsRef& positions) {
-  const auto n = static_cast<std::int64_t>(positions.cols());
-  std::vector<std::uint64_t> hashes(static_cast<std::size_t>(n));
+// more than once are compared coordinate by coordinate.
+CloudReportBuilder::CloudReportBuilder(std::int64_t width, std::int64_t height) {
+  report_.width = width;
+  report_.height = height;
+  if (width > 0 && height > 0) hashes_.reserve(static_cast<std::size_t>(width * height));
+}
+
+void CloudReportBuilder::count(const PositionsRef& piece) {
+  const auto n = static_cast<std::int64_t>(piece.cols());
+  const std::size_t first = hashes_.size();
+  hashes_.resize(first + static_cast<std::size_t>(n));
   std::int64_t non_finite = 0;
 #pragma omp parallel for schedule(static) reduction(+ : non_finite) if (n > 100000)
   for (std::int64_t i = 0; i < n; ++i) {
-    const bool finite = positions.col(i).allFinite();
-    hashes[static_cast<std::size_t>(i)] = finite ? hashOf(positions.col(i)) : 0;
+    const bool finite = piece.col(i).allFinite();
+    hashes_[first + static_cast<std::size_t>(i)] = finite ? hashOf(piece.col(i)) : 0;
     non_finite += finite ? 0 : 1;
   }
   if (non_finite > 0) {  // (rare) the non-finite points' places are taken out
-    std::size_t kept = 0;
+    std::size_t kept = first;
     for (std::int64_t i = 0; i < n; ++i)
-      if (positions.col(i).allFinite()) hashes[kept++] = hashes[static_cast<std::size_t>(i)];
-    hashes.resize(kept);
+      if (piece.col(i).allFinite()) hashes_[kept++] = hashes_[first + static_cast<std::size_t>(i)];
+    hashes_.resize(kept);
   }
-  boost::sort::spreadsort::integer_sort(hashes.begin(), hashes.end());
-  std::vector<std::uint64_t> repeated;
-  for (std::size_t k = 1; k < hashes.size(); ++k) {
-    if (hashes[k] == hashes[k - 1] && (repeated.empty() || repeated.back() != hashes[k]))
-      repeated.push_back(hashes[k]);
+  const BoundingBox box = boundingBox(piece);
+  if (box.min.allFinite()) bounds_.extend(Eigen::AlignedBox3d(box.min, box.max));
+  report_.points += n;
+  report_.nan_points += non_finite;
+}
+
+void CloudReportBuilder::compare(const PositionsRef& piece) {
+  if (!comparing_) {
+    comparing_ = true;
+    boost::sort::spreadsort::integer_sort(hashes_.begin(), hashes_.end());
+    for (std::size_t k = 1; k < hashes_.size(); ++k) {
+      if (hashes_[k] == hashes_[k - 1] && (repeated_.empty() || repeated_.back() != hashes_[k]))
+        repeated_.push_back(hashes_[k]);
+    }
+    std::vector<std::uint64_t>().swap(hashes_);
   }
-  std::vector<std::uint64_t>().swap(hashes);
-  if (repeated.empty()) return 0;
-  std::vector<std::array<double, 3>> suspects;
+  if (repeated_.empty()) return;
+  const auto n = static_cast<std::int64_t>(piece.cols());
 #pragma omp parallel if (n > 100000)
   {
     std::vector<std::array<double, 3>> found;
 #pragma omp for schedule(static) nowait
     for (std::int64_t i = 0; i < n; ++i) {
-      const auto p = positions.col(i);
-      if (p.allFinite() && std::binary_search(repeated.begin(), repeated.end(), hashOf(p)))
+      const auto p = piece.col(i);
+      if (p.allFinite() && std::binary_search(repeated_.begin(), repeated_.end(), hashOf(p)))
         found.push_back({p[0], p[1], p[2]});
     }
 #pragma omp critical
-    suspects.insert(suspects.end(), found.begin(), found.end());
+    suspects_.insert(suspects_.end(), found.begin(), found.end());
   }
-  std::sort(suspects.begin(), suspects.end());
-  return suspects.end() - std::unique(suspects.begin(), suspects.end());
 }
 
-}  // namespace
+CloudReport CloudReportBuilder::report() {
+  CloudReport r = report_;
+  std::sort(suspects_.begin(), suspects_.end());  // -0 and +0 are equal here, as in the hashes
+  r.duplicate_points = suspects_.end() - std::unique(suspects_.begin(), suspects_.end());
+  std::vector<std::array<double, 3>>().swap(suspects_);
+  if (!bounds_.isEmpty()) {
+    r.bounding_box.min = bounds_.min();
+    r.bounding_box.max = bounds_.max();
+  }
+  return r;
+}
 
 CloudReport makeCloudReport(const pcl::PCLPointCloud2& cloud, const PositionsRef& positions) {
   if (positions.cols() != static_cast<Eigen::Index>(cloud.width) * cloud.height)
     throw InvalidMeshException("makeCloudReport: " + std::to_string(positions.cols()) +
                                " positions for a cloud of " + std::to_string(cloud.width) + " x " +
                                std::to_string(cloud.height) + " points");
-  CloudReport r;
-  r.width = cloud.width;
-  r.height = cloud.height;
-  r.points = positions.cols();
-  r.nan_points = findNonFiniteVertices(positions).count;
-  r.duplicate_points = countDuplicates(positions);
-  r.bounding_box = boundingBox(positions);
-  return r;
+  CloudReportBuilder builder(cloud.width, cloud.height);
+  builder.count(positions);
+  builder.compare(positions);
+  return builder.report();
 }
 
 std::string CloudReport::toJson() const {

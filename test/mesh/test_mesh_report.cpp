@@ -48,6 +48,35 @@ TEST(CloudReport, DuplicatesAreExactlyEqualFinitePoints) {
   EXPECT_EQ(makeCloudReport(layout, grid).duplicate_points, n);
 }
 
+// Built a piece at a time, the report is the whole cloud's whatever the pieces: duplicates whose
+// originals lie in other pieces, NaN points, the box; the second pass in another order.
+TEST(CloudReport, BuiltInPiecesItIsTheWholeClouds) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const int n = 1000;
+  Eigen::Matrix3Xd p(3, n);
+  for (int i = 0; i < n; ++i)
+    p.col(i) = Eigen::Vector3d(5.0e5 + 0.01 * (i % 37), 5.0e6 + 0.01 * (i / 37), -3.0 * (i % 5));
+  p.col(999) = p.col(3);  // 2 duplicates, their originals in the first piece
+  p.col(640) = p.col(3);
+  p.col(500) = p.col(501);
+  p(1, 7) = nan;
+  p(0, 8) = std::numeric_limits<double>::infinity();
+  for (const int piece : {1, 7, 250, 999, 1000}) {
+    SCOPED_TRACE(piece);
+    CloudReportBuilder builder(n, 1);
+    for (int first = 0; first < n; first += piece)
+      builder.count(p.middleCols(first, std::min(piece, n - first)));
+    for (int last = n; last > 0; last -= piece)  // backwards
+      builder.compare(p.middleCols(std::max(0, last - piece), last - std::max(0, last - piece)));
+    const CloudReport r = builder.report();
+    EXPECT_EQ(r.points, n);
+    EXPECT_EQ(r.nan_points, 2);
+    EXPECT_EQ(r.duplicate_points, 3);
+    EXPECT_EQ(r.bounding_box.min, Eigen::Vector3d(5.0e5, 5.0e6, -12.0));
+    EXPECT_EQ(r.bounding_box.max, Eigen::Vector3d(5.0e5 + 0.01 * 36, 5.0e6 + 0.01 * 26, 0.0));
+  }
+}
+
 TEST(MeshReport, ZeroAreaSliverIsDegenerate) {
   Eigen::Matrix3Xd p(3, 4);
   p << 0, 1, 2, 0,  //

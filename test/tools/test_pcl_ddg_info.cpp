@@ -150,6 +150,56 @@ TEST(PclDdgInfo, LasBoxDuplicatesAndHeaderAreTheFilesExactValues) {
   EXPECT_NE(text.out.find("header vs records: agree"), std::string::npos) << text.out;
 }
 
+// A file of more points than the tool reads at once (2^19) is read a piece at a time, twice, a
+// third time when the spacing is measured: its report is the whole file's. 1.2M records on a
+// 1 m lattice (scale 1): the last ten repeat the first ten (duplicates pieces apart from their
+// originals), classes counted in every piece, and the lattice as coarse as the spacing is said
+// (the spacing's pass).
+TEST(PclDdgInfo, AFileReadInPiecesIsReportedAsAWhole) {
+  const int n = 1200000, row = 1200;
+  std::vector<Record> records(n);
+  for (int i = 0; i < n; ++i) records[i] = {i % row, i / row, (i * 7) % 5};
+  for (int i = 0; i < 10; ++i) records[n - 10 + i] = records[i];
+  const Eigen::Vector3d scale(1, 1, 1), offset(500000, 5000000, 200);
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const Record& r : records) {
+    const Eigen::Vector3d p = Eigen::Vector3d(r[0], r[1], r[2]) + offset;
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  std::string file = lasFile(scale, offset, lo, hi, records);
+  std::map<int, int> classes;
+  for (int i = 0; i < n; ++i) {
+    file[227 + 20 * static_cast<std::size_t>(i) + 15] = static_cast<char>(i % 3 + 1);
+    ++classes[i % 3 + 1];
+  }
+  const std::string dir = scratchFolder("info_pieces");
+  writeText(dir + "/lattice.las", file);
+  const ToolRun run = runInfo(dir + "/lattice.las -json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::istringstream in(run.out);
+  boost::property_tree::ptree j;
+  boost::property_tree::read_json(in, j);
+  EXPECT_EQ(j.get<int>("points"), n);
+  EXPECT_EQ(j.get<int>("duplicate_points"), 10);
+  EXPECT_EQ(vector3(j.get_child("bounding_box_min")), lo);
+  EXPECT_EQ(vector3(j.get_child("bounding_box_max")), hi);
+  EXPECT_EQ(j.get<std::string>("las.header_bounds_agree"), "true");
+  for (const auto& [c, count] : classes)
+    EXPECT_EQ(j.get_child("las.classification").get<int>(std::to_string(c)), count) << c;
+  EXPECT_NE(run.err.find("a piece at a time"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("the coordinates are rounded to 1 while the points are 1 apart"),
+            std::string::npos)
+      << run.err;
+  // The same points moved by up to 0.2 m at a millimetre's scale: no lattice.
+  for (int i = 0; i < n; ++i)
+    for (int d = 0; d < 3; ++d)
+      records[i][d] = 1000 * records[i][d] + (i * 7919 + d * 104729) % 199;
+  writeText(dir + "/fine.las", lasFile(Eigen::Vector3d::Constant(0.001), offset, lo, hi, records));
+  const ToolRun fine = runInfo(dir + "/fine.las");
+  EXPECT_EQ(fine.err.find("rounded to"), std::string::npos) << fine.err;
+}
+
 // The levels of the COPC file's octree, from its one hierarchy page read here by the COPC
 // specification's offsets (info VLR after the 375-byte header: root page offset at payload byte
 // 40, size at 48; entries of 32 bytes: depth first, point count last).

@@ -4,8 +4,11 @@
  */
 #include <pcl/PCLPointCloud2.h>
 
+#include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/mesh/positions_ref.h"
@@ -31,5 +34,34 @@ struct CloudReport {
  *  exact coordinates (MeshFile::positions), so that duplicates and the box are those of the
  *  file's values, not of their float rounding. Throws InvalidMeshException if the counts differ. */
 CloudReport makeCloudReport(const pcl::PCLPointCloud2& cloud, const PositionsRef& positions);
+
+/** The same report built from a cloud's points a piece at a time, for a file read in pieces
+ *  (pcl_ddg_info): every point is given twice, to count() and then to compare(), in pieces of any
+ *  size. Between the passes it holds a 64-bit hash of each finite point's exact coordinates;
+ *  compare() keeps only the points whose hash repeats and counts the equal ones among them, so
+ *  that two distinct points whose hashes collide are no duplicate. */
+class CloudReportBuilder {
+ public:
+  /** Room for width x height points' hashes is taken at once. */
+  CloudReportBuilder(std::int64_t width, std::int64_t height);
+  /** First pass: NaN points, the box, the finite points' hashes. */
+  void count(const PositionsRef& piece);
+  /** Second pass, the same points again (in any order): the ones whose hash repeats. */
+  void compare(const PositionsRef& piece);
+  /** The finite points counted so far. */
+  std::int64_t finitePoints() const { return report_.points - report_.nan_points; }
+  /** The finite points' box so far (empty when none is finite). */
+  const Eigen::AlignedBox3d& bounds() const { return bounds_; }
+  /** Once, after both passes. */
+  CloudReport report();
+
+ private:
+  CloudReport report_;
+  Eigen::AlignedBox3d bounds_;
+  std::vector<std::uint64_t> hashes_;    ///< first pass: one per finite point
+  std::vector<std::uint64_t> repeated_;  ///< sorted: the hashes met more than once
+  bool comparing_ = false;
+  std::vector<std::array<double, 3>> suspects_;  ///< points whose hash repeats
+};
 
 }  // namespace pcl_ddg

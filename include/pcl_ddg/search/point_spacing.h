@@ -20,7 +20,9 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 
+#include <array>
 #include <cstdint>
+#include <vector>
 
 namespace pcl_ddg {
 
@@ -32,8 +34,37 @@ struct PointSpacing {
 };
 
 /** Over the finite points; a kd-tree is built only when the quantum is at least 1e-5 of the
- *  bounding box's diagonal (below that no spacing of a real scan reaches it; spacing 0 then). */
+ *  bounding box's diagonal (CoordinateSpread::spacingMatters; spacing 0 otherwise). */
 PointSpacing measurePointSpacing(const pcl::PointCloud<pcl::PointXYZ>& cloud, int samples = 10000);
+
+/** A cloud's quantum and the diagonal of its bounding box. */
+struct CoordinateSpread {
+  double quantum = 0.0;
+  double diagonal = 0.0;
+  /** Whether the spacing can reach half the quantum: below 1e-5 of the diagonal no real scan's
+   *  spacing does, and its kd-tree is not worth building. */
+  bool spacingMatters() const { return quantum >= 1e-5 * diagonal; }
+};
+
+/** The finite points' values along x, y and z, gathered a point at a time (a file read in
+ *  pieces: pcl_ddg_info), kept as unsigned keys in the floats' order, 12 bytes a point. */
+class CoordinateValues {
+ public:
+  void reserve(std::size_t points);
+  /** Non-finite points are left out. */
+  void add(const float* xyz);
+  std::size_t size() const { return keys_[0].size(); }
+  /** Of the values added; sorts them in place. */
+  CoordinateSpread spread();
+
+ private:
+  std::array<std::vector<std::uint32_t>, 3> keys_;
+};
+
+/** The median distance from a point to its nearest distinct neighbour, over up to `samples` of
+ *  the points xyz[3 i .. 3 i + 2] (finite) taken at a regular stride; 0 for fewer than two
+ *  distinct points. */
+double medianSpacing(const std::vector<float>& xyz, int samples = 10000);
 
 struct RadiusNeighbourCounts {
   std::int64_t sampled = 0;
