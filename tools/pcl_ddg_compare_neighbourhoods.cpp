@@ -83,9 +83,7 @@ int run(int argc, char** argv) {
           tools::setColorMapFields(kName, in.mesh.cloud, output, color, c.overlap,
                                    colorize(c.overlap, ColorMap::Sequential, {0.0, 100.0}));
         }
-        tools::saveResult(kName, output, in.mesh, in.positions(),
-                          tools::coordinatePrecision(in.coordinate_precision, precision),
-                          in.sensor_pose, in.las, in.outputFaces());
+        tools::saveResult(kName, output, in, precision);
       });
 }
 

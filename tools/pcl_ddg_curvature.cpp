@@ -178,9 +178,7 @@ int run(int argc, char** argv) {
               color == "mean" || color == "gauss" ? color + "_curvature" : color, values,
               colorize(values, ColorMap::Diverging, {percentile, 100.0 - percentile}));
         }
-        tools::saveResult(kName, output, in.mesh, in.positions(),
-                          tools::coordinatePrecision(in.coordinate_precision, precision),
-                          in.sensor_pose, in.las, in.outputFaces());
+        tools::saveResult(kName, output, in, precision);
       });
 }
 

@@ -218,9 +218,7 @@ int run(int argc, char** argv) {
           if (spanning_tree) reportSpanningTree(result.orientation);
           if (args.has("normal_map")) saveNormalMap(*args.value("normal_map"), map_normals);
         }
-        tools::saveResult(kName, output, in.mesh, in.positions(),
-                          tools::coordinatePrecision(in.coordinate_precision, precision),
-                          in.sensor_pose, in.las, in.outputFaces());
+        tools::saveResult(kName, output, in, precision);
       });
 }
 

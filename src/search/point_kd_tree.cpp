@@ -1,7 +1,6 @@
 #include "pcl_ddg/search/point_kd_tree.h"
 
-#include <flann/algorithms/dist.h>
-#include <flann/algorithms/kdtree_single_index.h>
+#include <nanoflann.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -14,7 +13,8 @@ namespace pcl_ddg {
 namespace detail {
 namespace {
 
-// Measured as fast as 10 (FLANN's default) for k = 16 and 112, with half the nodes.
+// Points per leaf: as fast as 10 at k = 16 on a 10M-point terrain with half the nodes (32: 4 %
+// slower).
 constexpr int kLeafSize = 20;
 
 // The smallest float above d >= 0: its bits plus one (infinity stays), without a libm call in the
@@ -29,7 +29,7 @@ float nextFloatUp(float d) {
   return d;
 }
 
-// The caller's id of FLANN's point index.
+// The caller's id of the tree's point index.
 struct CallerIds {
   const pcl::index_t* ids;  ///< null: the same
   pcl::index_t operator()(std::size_t index) const {
@@ -41,20 +41,20 @@ struct CallerIds {
 // the point's index, so the answer is one set in one order whatever the tree's shape or the order
 // the points were visited in (a tile of a cloud, indexed in the cloud's order, gets the same
 // neighbours as the whole cloud; see pcl_ddg/tiling). Indices are the caller's from the start.
-class NearestK : public flann::ResultSet<float> {
+class NearestK {
  public:
   NearestK(std::size_t k, CallerIds ids, pcl::Indices& indices, std::vector<float>& distances)
       : k_(k), ids_(ids), indices_(indices), distances_(distances) {
     indices_.resize(k);
     distances_.resize(k);
   }
-  bool full() const override { return count_ == k_; }
-  // FLANN admits a point or a cell only strictly below this: one ulp above the k-th distance lets
-  // the ties through, to be decided by index.
-  float worstDist() const override { return worst_; }
-  void addPoint(float distance, std::size_t index) override {
+  bool full() const { return count_ == k_; }
+  // nanoflann admits a point only strictly below this: one ulp above the k-th distance lets the
+  // ties through, to be decided by index.
+  float worstDist() const { return worst_; }
+  bool addPoint(float distance, std::uint32_t index) {
     const pcl::index_t id = ids_(index);
-    if (count_ == k_ && !precedes(distance, id, k_ - 1)) return;
+    if (count_ == k_ && !precedes(distance, id, k_ - 1)) return true;
     std::size_t i = count_ < k_ ? count_++ : k_ - 1;
     for (; i > 0 && precedes(distance, id, i - 1); --i) {
       distances_[i] = distances_[i - 1];
@@ -63,6 +63,7 @@ class NearestK : public flann::ResultSet<float> {
     distances_[i] = distance;
     indices_[i] = id;
     if (count_ == k_) worst_ = nextFloatUp(distances_[k_ - 1]);
+    return true;  // search on
   }
   std::size_t count() const { return count_; }
 
@@ -79,19 +80,19 @@ class NearestK : public flann::ResultSet<float> {
 };
 
 // Everything within the radius, appended to the caller's vectors.
-class WithinRadius : public flann::ResultSet<float> {
+class WithinRadius {
  public:
   WithinRadius(float squared_radius, pcl::Indices& indices, std::vector<float>& distances)
       : squared_radius_(squared_radius), indices_(indices), distances_(distances) {
     indices_.clear();
     distances_.clear();
   }
-  bool full() const override { return true; }
-  float worstDist() const override { return squared_radius_; }
-  void addPoint(float distance, std::size_t index) override {
-    if (distance > squared_radius_) return;
-    distances_.push_back(distance);
+  bool full() const { return true; }
+  float worstDist() const { return squared_radius_; }
+  bool addPoint(float distance, std::uint32_t index) {
+    distances_.push_back(distance);  // below the radius: nanoflann admits only those
     indices_.push_back(static_cast<pcl::index_t>(index));
+    return true;
   }
 
  private:
@@ -102,34 +103,44 @@ class WithinRadius : public flann::ResultSet<float> {
 
 }  // namespace
 
-// FLANN's single kd-tree, searched in its own copy of the points in the tree's order ("reorder":
-// 20 % faster at k = 112 than reading them where they lie).
-struct PointKdTree::Index : flann::KDTreeSingleIndex<flann::L2_Simple<float>> {
-  explicit Index(const flann::Matrix<float>& points)
-      : KDTreeSingleIndex(points, flann::KDTreeSingleIndexParams(kLeafSize, /*reorder=*/true)) {}
-  void build() {
-    buildIndex();
-    // Searches read the reordered copy only (FLANN 1.9's searchLevel): the pointer to each point
-    // the build read through (8 bytes a point) is let go.
-    std::vector<float*>().swap(this->flann::NNIndex<flann::L2_Simple<float>>::points_);
+// Point i at xyz[stride * i .. stride * i + 2], read where it lies (nanoflann's dataset adaptor).
+struct StridedPoints {
+  const float* xyz;
+  std::size_t stride, count;
+  std::size_t kdtree_get_point_count() const { return count; }
+  float kdtree_get_pt(std::size_t i, std::size_t d) const { return xyz[stride * i + d]; }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;  // nanoflann measures it
   }
 };
 
-// FLANN takes no const data but only reads it, during the build.
-void PointKdTree::build(const float* xyz, std::size_t stride) {
-  if (size_ == 0) return;
-  index_ = std::make_unique<Index>(
-      flann::Matrix<float>(const_cast<float*>(xyz), size_, 3, stride * sizeof(float)));
-  index_->build();
-}
+// nanoflann's single kd-tree over the points where they lie: 4 bytes a point for its order and
+// about 5 for its nodes (FLANN's, which searched its own reordered copy, held 23, and 31 while it
+// was built). Its squared distances are those of pcl::search::KdTree (FLANN's) to the bit, the
+// same float sums in the same order, and so are the neighbours, ties broken by index above.
+struct PointKdTree::Index {
+  using Tree =
+      nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, StridedPoints>,
+                                          StridedPoints, 3, std::uint32_t>;
+  Index(const float* xyz, std::size_t stride, std::size_t count)
+      : points{xyz, stride, count},
+        tree(3, points, nanoflann::KDTreeSingleIndexAdaptorParams(kLeafSize)) {}
+  template <class Result>
+  void search(Result& result, const float* query) const {
+    tree.findNeighbors(result, query, nanoflann::SearchParams());
+  }
+  StridedPoints points;  // before tree, which keeps a reference to it
+  Tree tree;
+};
 
 PointKdTree::PointKdTree(std::vector<float> xyz, std::vector<pcl::index_t> ids)
-    : ids_(std::move(ids)), size_(ids_.size()) {
-  build(xyz.data(), 3);
+    : xyz_(std::move(xyz)), ids_(std::move(ids)), size_(ids_.size()) {
+  if (size_ > 0) index_ = std::make_unique<Index>(xyz_.data(), 3, size_);
 }
 
 PointKdTree::PointKdTree(const float* xyz, std::size_t stride, std::size_t count) : size_(count) {
-  build(xyz, stride);
+  if (size_ > 0) index_ = std::make_unique<Index>(xyz, stride, size_);
 }
 
 PointKdTree::~PointKdTree() = default;
@@ -143,7 +154,7 @@ int PointKdTree::nearestK(const float* query, int k, pcl::Indices& indices,
   }
   NearestK result(std::min<std::size_t>(k, size_), CallerIds{ids_.empty() ? nullptr : ids_.data()},
                   indices, squared_distances);
-  index_->findNeighbors(result, query, flann::SearchParams(-1, 0.0f));
+  index_->search(result, query);
   indices.resize(result.count());
   squared_distances.resize(result.count());
   return static_cast<int>(indices.size());
@@ -172,7 +183,7 @@ int PointKdTree::withinRadius(const float* query, double radius, pcl::Indices& i
   }
   const CallerIds id{ids_.empty() ? nullptr : ids_.data()};
   WithinRadius result(squared_radius, indices, squared_distances);
-  index_->findNeighbors(result, query, flann::SearchParams(-1, 0.0f));
+  index_->search(result, query);
   if (sorted) {
     // Sort (distance, index) pairs through a permutation.
     std::vector<std::size_t> order(indices.size());

@@ -135,9 +135,10 @@ TEST_F(SurveyCoordinates, FarDoublePlyAndLasGiveTheNormalsOfTheShapeAtTheOrigin)
 }
 
 // The fit shifts a tool's own positions about the local origin and back, or keeps a float
-// cloud's only in its floats: the output's coordinates are the input's to the last bit (a double
-// PLY far away, and double and float ones around the origin with -0 in them, which a shift by 0
-// and back would turn into +0), every fitting tool.
+// cloud's only in its floats, then in its rows: the output's coordinates are the input's to the
+// last bit (a double PLY far away, one whose floats about its origin are exact but not its rows'
+// floats, and double and float ones around the origin with -0 in them, which a shift by 0 and
+// back would turn into +0; float ones written as doubles), every fitting tool.
 TEST_F(SurveyCoordinates, TheOutputsCoordinatesAreTheInputsBitForBit) {
   Eigen::Matrix3Xd signed_zeros = scene();
   for (Eigen::Index i = 0; i < signed_zeros.cols(); i += 7) signed_zeros(2, i) = -0.0;
@@ -153,15 +154,23 @@ TEST_F(SurveyCoordinates, TheOutputsCoordinatesAreTheInputsBitForBit) {
   partly(1, 3) = std::numeric_limits<double>::quiet_NaN();
   partly(0, 3) = 1e-300;
   save(path("far_nan.ply"), partly, FieldPrecision::Double);
+  // Quarters of a metre 5,000 km away: exact in float about the origin, not in a float row.
+  const Eigen::Matrix3Xd quarters =
+      scene().unaryExpr([](double v) { return std::round(v * 4.0) / 4.0; }).colwise() + kOffset;
+  save(path("far_quarters.ply"), quarters, FieldPrecision::Double);
   const auto same = [](double a, double b) {
     return (std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, sizeof a) == 0;
   };
   for (const char* name :
-       {"far.ply", "zeros.ply", "zeros_float.ply", "far_float.ply", "far_nan.ply", "far.las"}) {
-    const Eigen::Matrix3Xd in = readMeshFile(path(name)).positions;
+       {"far.ply", "zeros.ply", "zeros_float.ply", "far_float.ply", "far_nan.ply", "far.las",
+        "far_quarters.ply", "zeros_float.ply -precision double"}) {
+    const std::string file = std::string(name).substr(0, std::string(name).find(' '));
+    const std::string options = std::string(name).substr(file.size());
+    const Eigen::Matrix3Xd in = readMeshFile(path(file)).positions;
     for (const char* tool : {PCL_DDG_NORMALS_TOOL, PCL_DDG_CURVATURE_TOOL}) {
-      const std::string out = path("same_" + std::string(name));
-      const ToolRun run = runTool(tool, path(name) + " " + out + " -method quadric -k 16");
+      const std::string out = path("same_" + file);
+      const ToolRun run =
+          runTool(tool, path(file) + " " + out + " -method quadric -k 16" + options);
       ASSERT_EQ(run.exit_code, 0) << run.err;
       const Eigen::Matrix3Xd got = readMeshFile(out).positions;
       ASSERT_EQ(got.cols(), in.cols());

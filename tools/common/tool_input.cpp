@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 
@@ -91,6 +92,10 @@ ToolInput::ToolInput(const std::string& path, const char* tool_name, InputKind k
 }
 
 const Eigen::Matrix3Xd& ToolInput::positions() const {
+  if (held_ == Held::InRows) {
+    *positions_ = vertexPositions(mesh.cloud, NonFinitePolicy::Keep);
+    held_ = Held::AsRead;
+  }
   if (held_ != Held::AsRead)
     throw std::logic_error(
         "ToolInput::positions() while local() holds them (releaseLocal() first)");
@@ -178,8 +183,40 @@ void ToolInput::separateLocal() {
   held_ = Held::AsRead;
 }
 
+bool ToolInput::rowsHoldTheFloats() const {
+  const auto field = [&](const char* name) -> const pcl::PCLPointField* {
+    for (const pcl::PCLPointField& f : mesh.cloud.fields)
+      if (f.name == name && f.datatype == pcl::PCLPointField::FLOAT32 && f.count == 1) return &f;
+    return nullptr;
+  };
+  const pcl::PCLPointField* axes[] = {field("x"), field("y"), field("z")};
+  if (!axes[0] || !axes[1] || !axes[2]) return false;
+  const Eigen::Vector3d& origin = local_->origin;
+  const std::uint8_t* row = mesh.cloud.data.data();
+  for (Eigen::Index i = 0; i < point_count_; ++i, row += mesh.cloud.point_step) {
+    const pcl::PointXYZ& p = (*points_)[static_cast<std::size_t>(i)];
+    for (int d = 0; d < 3; ++d) {
+      // As restoreFromFloats() would restore it: a float, and the row's to the bit.
+      const double restored = origin[d] == 0.0 ? double{p.data[d]} : double{p.data[d]} + origin[d];
+      const auto written = static_cast<float>(restored);
+      if (double{written} != restored ||
+          std::memcmp(&written, row + axes[d]->offset, sizeof written) != 0)
+        return false;
+    }
+  }
+  return true;
+}
+
 void ToolInput::releaseLocal() {
-  if (held_ == Held::InFloats) restoreFromFloats();
+  if (held_ == Held::InFloats) {
+    if (rowsHoldTheFloats()) {  // a float file's cloud: its rows are its coordinates
+      points_.reset();
+      local_.reset();
+      held_ = Held::InRows;
+      return;
+    }
+    restoreFromFloats();
+  }
   if (held_ == Held::Shifted) moveFinitePoints(*positions_, local_->origin);
   held_ = Held::AsRead;
   points_.reset();

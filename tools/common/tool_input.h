@@ -51,6 +51,9 @@ class ToolInput {
   /** The coordinates in double, as read (LAS: X * scale + offset). Throws std::logic_error
    *  while local() holds them about its origin (until releaseLocal()). */
   const Eigen::Matrix3Xd& positions() const;
+  /** The coordinates are mesh.cloud's float x, y, z alone (a float cloud after releaseLocal()):
+   *  writing positions() there as floats would change no bit. */
+  bool coordinatesInRows() const { return held_ == Held::InRows; }
   Eigen::Index pointCount() const { return point_count_; }
   /** The bounding box of the finite positions, in world coordinates, whenever asked. */
   BoundingBox bounds() const;
@@ -75,7 +78,9 @@ class ToolInput {
   /** Frees local() once the fits are done (the output needs positions and the cloud only), and
    *  shifts positions back to the coordinates read: local()'s memory is then free for the
    *  output's fields. A later local() makes it anew, without the changes made through points().
-   */
+   *  A float cloud whose rows hold its coordinates as its floats did (checked bit for bit) keeps
+   *  them there alone: positions() makes the doubles again only when asked, and saveResult
+   *  writes the rows as they are. */
   void releaseLocal();
   /** h: a mesh's mean edge length, a cloud's mean distance to the nearest other point (over up to
    *  10,000 points, exact duplicates skipped: it costs a kd-tree). Measured on the first call. */
@@ -83,14 +88,18 @@ class ToolInput {
 
  private:
   /** Where the coordinates read are while local() lives: positions_ as read, positions_ about
-   *  local_->origin (shared with local_), or only in local_'s floats (positions_ empty). */
-  enum class Held { AsRead, Shifted, InFloats };
+   *  local_->origin (shared with local_), only in local_'s floats (positions_ empty), or only in
+   *  mesh.cloud's float x, y, z (after releaseLocal(); positions_ empty). */
+  enum class Held { AsRead, Shifted, InFloats, InRows };
   /** positions_ from local_'s floats, exactly the coordinates read. */
   void restoreFromFloats();
+  /** Whether mesh.cloud's float x, y, z are the coordinates restoreFromFloats() would make,
+   *  exactly. */
+  bool rowsHoldTheFloats() const;
 
   std::shared_ptr<Eigen::Matrix3Xd> positions_;
   Eigen::Index point_count_ = 0;
-  Held held_ = Held::AsRead;
+  mutable Held held_ = Held::AsRead;  ///< positions() makes InRows' doubles when asked
   std::optional<LocalCloud> local_;
   pcl::PointCloud<pcl::PointXYZ>::Ptr points_;  ///< local_'s, not const
   std::optional<double> spacing_;

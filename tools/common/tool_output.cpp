@@ -108,11 +108,12 @@ FieldPrecision coordinatePrecision(FieldPrecision input, FieldPrecision requeste
              : FieldPrecision::Float;
 }
 
-void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh& mesh,
-                const Eigen::Matrix3Xd& positions, FieldPrecision coordinates,
-                const SensorPose& sensor_pose, const std::shared_ptr<const LasLayout>& las,
-                const std::shared_ptr<const FaceRows>& faces) {
-  setVertexCoordinates(mesh.cloud, positions, coordinates);
+namespace {
+
+// The mesh as its x, y, z stand, through saveMesh.
+void saveMeshAsItIs(const char* tool_name, const std::string& path, pcl::PolygonMesh& mesh,
+                    const SensorPose& sensor_pose, const std::shared_ptr<const LasLayout>& las,
+                    const std::shared_ptr<const FaceRows>& faces) {
   if (fileExtension(path) == "pcd") {
     std::string doubles;
     for (const auto& f : mesh.cloud.fields) {
@@ -132,6 +133,27 @@ void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh
   options.faces = faces;
   saveMesh(path, mesh, options);
   timer.done(static_cast<std::size_t>(mesh.cloud.width) * mesh.cloud.height);
+}
+
+}  // namespace
+
+void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh& mesh,
+                const Eigen::Matrix3Xd& positions, FieldPrecision coordinates,
+                const SensorPose& sensor_pose, const std::shared_ptr<const LasLayout>& las,
+                const std::shared_ptr<const FaceRows>& faces) {
+  setVertexCoordinates(mesh.cloud, positions, coordinates);
+  saveMeshAsItIs(tool_name, path, mesh, sensor_pose, las, faces);
+}
+
+void saveResult(const char* tool_name, const std::string& path, ToolInput& in,
+                FieldPrecision requested) {
+  const FieldPrecision coordinates = coordinatePrecision(in.coordinate_precision, requested);
+  if (in.coordinatesInRows() && coordinates == FieldPrecision::Float) {
+    saveMeshAsItIs(tool_name, path, in.mesh, in.sensor_pose, in.las, in.outputFaces());
+    return;
+  }
+  saveResult(tool_name, path, in.mesh, in.positions(), coordinates, in.sensor_pose, in.las,
+             in.outputFaces());
 }
 
 }  // namespace tools

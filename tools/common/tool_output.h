@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/tool_common.h"
+#include "common/tool_input.h"
 #include "pcl_ddg/features/local_fit.h"
 #include "pcl_ddg/io/mesh_io.h"
 #include "pcl_ddg/io/vertex_fields.h"
@@ -80,6 +81,13 @@ void saveResult(const char* tool_name, const std::string& path, pcl::PolygonMesh
                 const SensorPose& sensor_pose = {},
                 const std::shared_ptr<const LasLayout>& las = nullptr,
                 const std::shared_ptr<const FaceRows>& faces = nullptr);
+
+/** saveResult of an input with its own coordinates, in coordinatePrecision(its precision,
+ *  requested), its sensor pose, LAS layout and faces; a cloud whose float rows hold the
+ *  coordinates (ToolInput::coordinatesInRows) is written as it is, without its doubles made
+ *  again (24 bytes a point). */
+void saveResult(const char* tool_name, const std::string& path, ToolInput& in,
+                FieldPrecision requested);
 
 }  // namespace tools
 }  // namespace pcl_ddg

@@ -27,7 +27,7 @@ enum class LocalFitMethod { PCA, Quadric, Robust };
 
 enum class NeighbourhoodKind {
   MeshRings,  ///< MeshRingSearch over the mesh's edges (needs a topology)
-  KdTree,     ///< Euclidean: KdTreeSearch (FLANN)
+  KdTree,     ///< Euclidean: KdTreeSearch (nanoflann)
   Grid        ///< an organized cloud's pixel grid: OrganizedGridSearch
 };
 

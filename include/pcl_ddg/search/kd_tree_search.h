@@ -1,8 +1,8 @@
 #pragma once
 /** \file
- * Euclidean neighbourhoods from a FLANN kd-tree, as a PCL search method: the same answers as
- * pcl::search::KdTree (exact k nearest, squared distances in float), without its per-query
- * overhead (see point_kd_tree.h), so estimators that are parallel over points scale.
+ * Euclidean neighbourhoods from a kd-tree (point_kd_tree.h), as a PCL search method: the same
+ * answers as pcl::search::KdTree (exact k nearest, squared distances in float), without its
+ * per-query overhead (see point_kd_tree.h), so estimators that are parallel over points scale.
  *
  * Non-finite points are never indexed nor returned. With indices in setInputCloud only those
  * points are searched, and an index query (nearestKSearch(i, ...)) means the i-th of them, as in
