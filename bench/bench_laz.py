@@ -13,7 +13,6 @@ benchmark peer and test oracle only, never shipped); without node and npm its co
 """
 import json
 import os
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -23,49 +22,9 @@ import numpy as np
 
 from bench_las_end_to_end import write_las
 
-LAZPERF_JOB = r"""
-const fs = require('fs');
-const { createLazPerf } = require('laz-perf');
-(async () => {
-  const [lazPath, lasPath] = process.argv.slice(2);
-  const lp = await createLazPerf();
-  const laz = fs.readFileSync(lazPath);
-  const filePtr = lp._malloc(laz.length);
-  lp.HEAPU8.set(laz, filePtr);
-  let best = Infinity, out = null, count = 0, len = 0;
-  for (let rep = 0; rep < 3; ++rep) {
-    const t0 = process.hrtime.bigint();
-    const reader = new lp.LASZip();
-    reader.open(filePtr, laz.length);
-    count = reader.getCount(); len = reader.getPointLength();
-    const point = lp._malloc(len);
-    out = Buffer.alloc(count * len);
-    for (let i = 0; i < count; ++i) {
-      reader.getPoint(point);
-      out.set(lp.HEAPU8.subarray(point, point + len), i * len);
-    }
-    lp._free(point);
-    reader.delete();
-    best = Math.min(best, Number(process.hrtime.bigint() - t0) / 1e9);
-  }
-  const las = fs.readFileSync(lasPath);
-  const at = las.readUInt32LE(96);
-  console.log(JSON.stringify({seconds: best, points: count,
-                              same: las.subarray(at, at + count * len).equals(out)}));
-})();
-"""
-
-
-def lazperf_folder():
-    """A folder whose node_modules holds laz-perf, or None without node and npm."""
-    if not (shutil.which("node") and shutil.which("npm")):
-        return None
-    folder = os.path.expanduser("~/.cache/pcl_ddg_bench/node")
-    if not os.path.isdir(os.path.join(folder, "node_modules", "laz-perf")):
-        os.makedirs(folder, exist_ok=True)
-        subprocess.run(["npm", "install", "--silent", "--prefix", folder, "laz-perf"], check=True)
-    return folder
-
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python",
+                                "tests"))
+from lazperf_oracle import decode, lazperf_folder  # noqa: E402
 
 def main():
     if len(sys.argv) < 2:
@@ -108,15 +67,11 @@ def main():
         for name, las in (("format 3", f3), ("format 7", f7)):
             peer, same = None, None
             if node:
-                script = os.path.join(folder, "lazperf_job.js")
-                with open(script, "w") as out:
-                    out.write(LAZPERF_JOB)
-                job = subprocess.run(["node", script, lazs[las], las], check=True,
-                                     capture_output=True, text=True,
-                                     env=dict(os.environ, NODE_PATH=os.path.join(node,
-                                                                                 "node_modules")))
-                result = json.loads(job.stdout)
-                peer, same = result["points"] / result["seconds"], result["same"]
+                records, seconds = decode(node, lazs[las], repeats=3)
+                with open(las, "rb") as f:
+                    ours = f.read()
+                at = int.from_bytes(ours[96:100], "little")
+                peer, same = points / seconds, ours[at:at + len(records)] == records
             one = rates[f"laz_decode/{las}/1/real_time"]
             two = rates[f"laz_decode/{las}/2/real_time"]
             size = os.path.getsize(lazs[las]) / os.path.getsize(las)

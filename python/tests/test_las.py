@@ -323,57 +323,25 @@ def test_laz_reads_as_its_uncompressed_twin_and_writes_back(tmp_path):
     np.testing.assert_array_equal(back.fields["gps_time"], twin.fields["gps_time"])
 
 
-LAZPERF_DECODE = r"""
-const fs = require('fs');
-const { createLazPerf } = require('laz-perf');
-(async () => {
-  const [lazPath, outPath] = process.argv.slice(2);
-  const lp = await createLazPerf();
-  const laz = fs.readFileSync(lazPath);
-  const file = lp._malloc(laz.length);
-  lp.HEAPU8.set(laz, file);
-  const reader = new lp.LASZip();
-  reader.open(file, laz.length);
-  const count = reader.getCount(), len = reader.getPointLength();
-  const point = lp._malloc(len), out = Buffer.alloc(count * len);
-  for (let i = 0; i < count; ++i) {
-    reader.getPoint(point);
-    out.set(lp.HEAPU8.subarray(point, point + len), i * len);
-  }
-  fs.writeFileSync(outPath, out);
-})();
-"""
-
-
 def test_our_laz_decodes_with_laz_perf(tmp_path):
     """An independent decoder (LAZperf's WebAssembly build from npm, run by node; a test oracle,
     never shipped) reads what our encoder writes, formats 3 and 7, to the records of the .las
     written from the same cloud. Optional: without node and npm (or the npm registry), skipped."""
-    import shutil
-    import subprocess
+    from lazperf_oracle import decode, lazperf_folder
 
-    if not (shutil.which("node") and shutil.which("npm")):
-        pytest.skip("node and npm are not installed: no independent LAZ decoder")
-    cache = os.path.expanduser("~/.cache/pcl_ddg_bench/node")
-    if not os.path.isdir(os.path.join(cache, "node_modules", "laz-perf")):
-        install = subprocess.run(["npm", "install", "--silent", "--prefix", cache, "laz-perf"],
-                                 capture_output=True, text=True, timeout=300)
-        if install.returncode != 0:
-            pytest.skip("laz-perf could not be installed from npm: " + install.stderr[-200:])
-    script = tmp_path / "decode.js"
-    script.write_text(LAZPERF_DECODE)
+    folder = lazperf_folder()
+    if folder is None:
+        pytest.skip(lazperf_folder.error + ": no independent LAZ decoder")
     for name in ("autzen_trim.las", "autzen_trim_7.las"):
         m = pcl_ddg.read(las_path(name))
         pcl_ddg.write(tmp_path / "ours.las", m.points, fields=m.fields, las=m.las)
         pcl_ddg.write(tmp_path / "ours.laz", m.points, fields=m.fields, las=m.las)
-        subprocess.run(["node", str(script), str(tmp_path / "ours.laz"), str(tmp_path / "dec")],
-                       check=True, timeout=300,
-                       env=dict(os.environ, NODE_PATH=os.path.join(cache, "node_modules")))
+        decoded, _ = decode(folder, tmp_path / "ours.laz")
         written = (tmp_path / "ours.las").read_bytes()
         header = parse_header(written)
         records = written[header["point_offset"]:]
         records = records[:header["points"] * header["record_length"]]
-        assert (tmp_path / "dec").read_bytes() == records, name
+        assert decoded == records, name
 
 
 def test_bad_fields_are_refused(tmp_path):

@@ -131,17 +131,18 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
     Eigen::Vector3d at;
     double look;
   };
+  // What a far point looks at (the whole cloud when its look is not finite).
+  const auto lookBox = [&](const FarPoint& f) {
+    return std::isfinite(f.look) ? grown(Eigen::AlignedBox3d(f.at, f.at), f.look) : bounds;
+  };
   // Fits far points with what lies in a box about them, a group of near ones at a time (one box
   // for all would gather much of the cloud), again in a wider box for those that look past it
   // (each round at least doubles a look; the cloud's bounds certify every point).
   const auto fitRobustApart = [&](std::vector<FarPoint> far) {
     local.far_points += static_cast<std::int64_t>(far.size());
-    const auto box = [&](const FarPoint& f) {
-      return std::isfinite(f.look) ? grown(Eigen::AlignedBox3d(f.at, f.at), f.look) : bounds;
-    };
     while (!far.empty()) {
       // The group: the points within the first one's look of it.
-      const Eigen::AlignedBox3d seed = box(far.front());
+      const Eigen::AlignedBox3d seed = lookBox(far.front());
       std::vector<FarPoint> group, rest;
       Eigen::AlignedBox3d region;
       for (const FarPoint& f : far) {
@@ -150,7 +151,7 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
           continue;
         }
         group.push_back(f);
-        region.extend(box(f));
+        region.extend(lookBox(f));
       }
       region = region.intersection(grown(bounds, 1.0));
       std::vector<std::int64_t> wanted;
@@ -235,20 +236,12 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
       local.widest_halo = std::max(local.widest_halo, halo);
       // The points that look beyond the halo are fitted apart, with what lies around them.
       std::vector<FarPoint> far;
-      Eigen::AlignedBox3d around;
-      auto inside = std::make_shared<pcl::Indices>();
       std::vector<char> keep(needed.size());
       for (std::size_t i = 0; i < needed.size(); ++i) {
         const pcl::index_t at = (*points.own)[i];
         keep[i] = needed[i] <= halo;
-        if (keep[i]) {
-          inside->push_back(at);
-          continue;
-        }
-        const Eigen::Vector3d q = position((*points.points)[at]);
-        far.push_back({points.global_index[at], q, looking[i]});
-        around.extend(std::isfinite(looking[i]) ? grown(Eigen::AlignedBox3d(q, q), looking[i])
-                                                : bounds);
+        if (!keep[i])
+          far.push_back({points.global_index[at], position((*points.points)[at]), looking[i]});
       }
       if (robust) {
         keepOnly(points, looked.fit, keep);
@@ -256,9 +249,14 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
         fitRobustApart(std::move(far));
         break;
       }
+      auto inside = std::make_shared<pcl::Indices>();
+      for (std::size_t i = 0; i < keep.size(); ++i)
+        if (keep[i]) inside->push_back((*points.own)[i]);
       points.own = inside;
       fit(points);
       if (!far.empty()) {
+        Eigen::AlignedBox3d around;
+        for (const FarPoint& f : far) around.extend(lookBox(f));
         TilePoints far_points = gather(-1, around.intersection(grown(bounds, 1.0)));
         std::vector<std::int64_t> wanted;
         for (const FarPoint& f : far) wanted.push_back(f.index);
