@@ -516,12 +516,18 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
                 far = np.zeros(0, np.int64)
                 break
             lo, hi = core_lo - halo, core_hi + halo
-            # Fitted at once (the certified points); thrown away when the halo must widen.
+            # Fitted at once: the certified points' fits are the whole cloud's, kept even when
+            # the halo must widen for the others (robust fits are costly).
             rec, ok, look, reach, f1, f2 = _fit(plan, xyz, exact, own_at, options, lo, hi,
                                                 "certified")
             needed = np.maximum(0.0, halo + look - reach)
             p99 = np.sort(needed)[len(needed) - 1 - len(needed) // 100]
             if p99 > halo and round_ < 2:
+                failed += f1
+                fallback += f2
+                results_index.append(index[own_at[ok]])
+                results.append(rec[ok])
+                rest = index[own_at[~ok]]
                 halo = 1.05 * p99 if np.isfinite(p99) else 2 * halo + float(
                     np.linalg.norm(core_hi - core_lo))
                 growths += 1
@@ -529,6 +535,7 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
                 del xyz, exact, index, own, rec
                 xyz, exact, index, own = _gather(plan, paths, firsts, core_lo - halo,
                                                  core_hi + halo, tile)
+                own &= np.isin(index, rest)
                 largest = max(largest, len(xyz))
                 continue
             far = own_at[~ok]

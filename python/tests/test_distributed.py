@@ -647,6 +647,8 @@ def test_halos_widen_where_the_density_drops_as_the_tool_fits(tmp_path, client, 
     sparse_tiles = int(np.count_nonzero(np.linspace(0.0, 1494.0, nx + 1)[:-1] >= 300.0))
     assert sparse_tiles >= 2
     assert summary["halo_growths"] >= sparse_tiles, (summary["halo_growths"], sparse_tiles)
+    # Each point fitted once: a widened tile keeps its certified fits and refits only the rest.
+    assert sum(r["points"] for r in summary["tile_reports"]) == summary["finite_points"]
 
 
 def test_bad_inputs(tmp_path, client, scene):
