@@ -1,8 +1,8 @@
 // One implicit cotangent smoothing step on a 1.15M-vertex torus, everything included (rebuilding
-// L and M from the positions, assembling M - tau L, factorising, solving for x, y, z): the first
-// step with CHOLMOD's supernodal LLT and with Eigen's SimplicialLDLT, then a later step (pattern
-// analysed already). Then the factorisation alone: the first one (ordering and analysis included),
-// and a later one with the symbolic analysis reused and redone.
+// L and M from the positions, assembling M - tau L, solving for x, y, z): the first step by the
+// default solver, by CHOLMOD's supernodal LLT and by Eigen's SimplicialLDLT, then a later step
+// (pattern analysed already). Then the factorisation alone: the first one (ordering and analysis
+// included), and a later one with the symbolic analysis reused and redone.
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -11,6 +11,7 @@
 #include "bench_support.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
 #include "pcl_ddg/operators/sparse_cholesky.h"
+#include "pcl_ddg/surface/implicit_solver.h"
 #include "pcl_ddg/surface/mesh_smoothing.h"
 
 namespace pcl_ddg {
@@ -38,10 +39,11 @@ const Fixture& fixture() {
   return f;
 }
 
-void implicitStep(benchmark::State& state, CholeskyBackend backend) {
+void implicitStep(benchmark::State& state, ImplicitSolver method, CholeskyBackend backend) {
   const Fixture& f = fixture();
   MeshSmoothingParameters p;
   p.time_step = f.tau;
+  p.implicit_solver = method;
   p.solver = backend;
   for (auto _ : state) {
     const Eigen::Matrix3Xd x = smoothMeshPositions(f.topology, f.mesh.points, p);
@@ -49,12 +51,20 @@ void implicitStep(benchmark::State& state, CholeskyBackend backend) {
   }
   state.counters["vertices"] = static_cast<double>(f.mesh.points.cols());
 }
-BENCHMARK_CAPTURE(implicitStep, cholmod, CholeskyBackend::Cholmod)
+// The default (one small step: conjugate gradients), CHOLMOD forced, and Eigen's SimplicialLDLT
+// forced (the solver of libigl's smoothing tutorial).
+BENCHMARK_CAPTURE(implicitStep, automatic, ImplicitSolver::Automatic, CholeskyBackend::Automatic)
     ->Name("ours/implicit_step")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Iterations(2);
-BENCHMARK_CAPTURE(implicitStep, simplicial, CholeskyBackend::SimplicialLDLT)
+BENCHMARK_CAPTURE(implicitStep, cholmod, ImplicitSolver::Cholesky, CholeskyBackend::Cholmod)
+    ->Name("ours/implicit_step_cholmod")
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
+BENCHMARK_CAPTURE(implicitStep, simplicial, ImplicitSolver::Cholesky,
+                  CholeskyBackend::SimplicialLDLT)
     ->Name("baseline/implicit_step")
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
