@@ -14,9 +14,7 @@
 #include <sstream>
 #include <vector>
 
-#include "common/fit_steps.h"
 #include "common/tool_common.h"
-#include "common/tool_input.h"
 #include "pcl_ddg/io/cloud_pieces.h"
 #include "pcl_ddg/io/copc.h"
 #include "pcl_ddg/io/las_layout.h"
