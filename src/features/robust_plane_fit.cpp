@@ -67,15 +67,26 @@ double medianResidualBelow(const Eigen::Matrix3Xd& x, int count, const Plane& pl
 
 using detail::PointMoments;
 
+/** Whether a point lies within band of the plane whose offset n . c is given. */
+bool inBand(const Plane& plane, double offset, const Eigen::Vector3d& point, double band) {
+  return std::abs((plane.normal.dot(point) - offset) / band) < 1.0;
+}
+
 /** Moments of those of the first count columns of x within band of plane. */
 PointMoments within(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double band) {
   PointMoments m;
   const double offset = plane.normal.dot(plane.centroid);
-  for (int i = 0; i < count; ++i) {
-    const double u = (plane.normal.dot(x.col(i)) - offset) / band;
-    if (std::abs(u) < 1.0) m.add(x.col(i));
-  }
+  for (int i = 0; i < count; ++i)
+    if (inBand(plane, offset, x.col(i), band)) m.add(x.col(i));
   return m;
+}
+
+/** How many of the first count columns of x lie within band of plane. */
+int countWithin(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double band) {
+  const double offset = plane.normal.dot(plane.centroid);
+  int inside = 0;
+  for (int i = 0; i < count; ++i) inside += inBand(plane, offset, x.col(i), band);
+  return inside;
 }
 
 /** The least-squares height-field quadric w = a u^2 + b uv + c v^2 + d u + e v + f over the
@@ -265,11 +276,11 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
     result.surface_variation = fit.surface_variation;
     result.residual = fit.eigenvalues[0] * all.count() / std::max(all.count() - 3, 1);
   }
-  const PointMoments inliers = within(x, used, plane, band);
+  const int inliers = countWithin(x, used, plane, band);
   result.normal = plane.normal;
   result.centroid = plane.centroid;
-  result.scale = inliers.count();
-  result.confidence = static_cast<double>(inliers.count()) / count;
+  result.scale = inliers;
+  result.confidence = static_cast<double>(inliers) / count;
   result.valid = result.normal.allFinite() && std::isfinite(result.surface_variation);
   return result;
 }
