@@ -154,9 +154,12 @@ TEST_F(SurveyCoordinates, TheOutputsCoordinatesAreTheInputsBitForBit) {
   partly(1, 3) = std::numeric_limits<double>::quiet_NaN();
   partly(0, 3) = 1e-300;
   save(path("far_nan.ply"), partly, FieldPrecision::Double);
-  // Quarters of a metre 5,000 km away: exact in float about the origin, not in a float row.
-  const Eigen::Matrix3Xd quarters =
-      scene().unaryExpr([](double v) { return std::round(v * 4.0) / 4.0; }).colwise() + kOffset;
+  // Quarters of a metre 5,000 km away: exact in float about the origin, not in a float row;
+  // heights about 0 with -0 among them (restored from the floats, they stay -0).
+  Eigen::Matrix3Xd quarters =
+      scene().unaryExpr([](double v) { return std::round(v * 4.0) / 4.0; }).colwise() +
+      Eigen::Vector3d(kOffset.x(), kOffset.y(), 0.0);
+  for (Eigen::Index i = 0; i < quarters.cols(); i += 7) quarters(2, i) = -0.0;
   save(path("far_quarters.ply"), quarters, FieldPrecision::Double);
   const auto same = [](double a, double b) {
     return (std::isnan(a) && std::isnan(b)) || std::memcmp(&a, &b, sizeof a) == 0;
