@@ -71,7 +71,9 @@ def main():
                 with open(las, "rb") as f:
                     ours = f.read()
                 at = int.from_bytes(ours[96:100], "little")
-                peer, same = points / seconds, ours[at:at + len(records)] == records
+                length = int.from_bytes(ours[105:107], "little")
+                peer = len(records) // length / seconds
+                same = len(records) == points * length and ours[at:at + len(records)] == records
             one = rates[f"laz_decode/{las}/1/real_time"]
             two = rates[f"laz_decode/{las}/2/real_time"]
             size = os.path.getsize(lazs[las]) / os.path.getsize(las)

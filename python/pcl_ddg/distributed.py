@@ -506,7 +506,7 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
     largest = len(xyz)
     results_index = [np.zeros(0, np.int64)]
     results = [np.zeros((0, floats), np.float32)]
-    failed = fallback = far_count = 0
+    failed = fallback = far_count = certified_before = 0
     if own.any():
         for round_ in range(3):
             own_at = np.flatnonzero(own)
@@ -521,12 +521,18 @@ def run_tile(tile: int, plan: Plan, paths: List[str], firsts: List[int], options
             rec, ok, look, reach, f1, f2 = _fit(plan, xyz, exact, own_at, options, lo, hi,
                                                 "certified")
             needed = np.maximum(0.0, halo + look - reach)
+            if options["method"] != "robust":
+                # The 99th percentile over every point of the tile, as fitTiles measures it (the
+                # points certified before need no more than the halo they had): robust's is over
+                # the points left, as there.
+                needed = np.concatenate([needed, np.zeros(certified_before)])
             p99 = np.sort(needed)[len(needed) - 1 - len(needed) // 100]
             if p99 > halo and round_ < 2:
                 failed += f1
                 fallback += f2
                 results_index.append(index[own_at[ok]])
                 results.append(rec[ok])
+                certified_before += int(np.count_nonzero(ok))
                 rest = index[own_at[~ok]]
                 halo = 1.05 * p99 if np.isfinite(p99) else 2 * halo + float(
                     np.linalg.norm(core_hi - core_lo))

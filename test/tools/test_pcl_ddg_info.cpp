@@ -231,6 +231,9 @@ TEST(PclDdgInfo, CopcOctreeAndCompressionAreReported) {
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("(36-byte records), compressed (LAZ)\n"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("COPC level 0:      1 node, "), std::string::npos) << text.out;
+  // Its EVLR (the hierarchy) is listed: a file with EVLRs is read whole, not in pieces.
+  EXPECT_NE(text.out.find("EVLR:              copc 1000 (2080 bytes"), std::string::npos)
+      << text.out;
   EXPECT_EQ(json(sharedData("las/laz/autzen_trim.laz")).get<std::string>("las.copc"), "null");
   EXPECT_EQ(json(sharedData("las/laz/autzen_trim.laz")).get<std::string>("las.storage"), "laz");
   EXPECT_EQ(json(sharedData("las/autzen_trim.las")).get<std::string>("las.storage"), "las");

@@ -103,6 +103,7 @@ const Eigen::Matrix3Xd& ToolInput::positions() const {
 }
 
 BoundingBox ToolInput::bounds() const {
+  if (held_ == Held::InRows) positions();  // made again from the rows
   if (held_ == Held::AsRead) return boundingBox(*positions_);
   BoundingBox box;
   if (held_ == Held::Shifted) {
@@ -134,6 +135,7 @@ void ToolInput::restoreFromFloats() {
 
 const LocalCloud& ToolInput::local() {
   if (local_) return *local_;
+  if (held_ == Held::InRows) positions();  // made again from the rows
   const Eigen::Vector3d origin = localOrigin(*positions_);
   moveFinitePoints(*positions_, -origin);
   try {

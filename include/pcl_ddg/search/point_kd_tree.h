@@ -8,8 +8,9 @@
  * costs as much as the search itself; and FLANN searches its own reordered copy of the points
  * (12 bytes a point, 31 with its index while it is built). Here the tree reads the points where
  * they lie (4 bytes a point for its order, about 5 for its nodes) and each query writes straight
- * into the caller's vectors. Reading in place is as fast on scans stored in acquisition order and
- * about 40 % slower on a cloud larger than the cache whose points are in random order.
+ * into the caller's vectors. Reading in place is faster on scans stored in acquisition order and
+ * slower on a cloud larger than the cache whose points are in random order (bench_kd_tree: 1.5x
+ * faster than pcl::search::KdTree in grid order, 7 % slower shuffled).
  */
 #include <pcl/types.h>
 

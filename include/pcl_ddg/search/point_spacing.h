@@ -61,9 +61,9 @@ class CoordinateValues {
   std::array<std::vector<std::uint32_t>, 3> keys_;
 };
 
-/** The median distance from a point to its nearest distinct neighbour, over up to `samples` of
- *  the points xyz[3 i .. 3 i + 2] (finite) taken at a regular stride; 0 for fewer than two
- *  distinct points. */
+/** The median distance from a point to its nearest distinct neighbour, over the points
+ *  xyz[3 i .. 3 i + 2] (finite) taken at a regular stride of n / samples, at least 1 (at most
+ *  2 x `samples` of them); 0 for fewer than two distinct points. */
 double medianSpacing(const std::vector<float>& xyz, int samples = 10000);
 
 struct RadiusNeighbourCounts {
