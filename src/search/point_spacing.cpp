@@ -33,9 +33,14 @@ detail::PointKdTree treeOf(const pcl::PointCloud<pcl::PointXYZ>& cloud,
   return detail::PointKdTree(std::move(xyz), std::move(finite));
 }
 
+/** The stride that takes about `samples` of n points (at least 1). */
+std::size_t sampleStride(std::size_t n, int samples) {
+  return std::max<std::size_t>(1, n / std::max(1, samples));
+}
+
 /** Every stride-th of the finite points, about `samples` of them. */
 std::vector<pcl::index_t> sample(const std::vector<pcl::index_t>& finite, int samples) {
-  const std::size_t stride = std::max<std::size_t>(1, finite.size() / std::max(1, samples));
+  const std::size_t stride = sampleStride(finite.size(), samples);
   std::vector<pcl::index_t> chosen;
   for (std::size_t i = 0; i < finite.size(); i += stride) chosen.push_back(finite[i]);
   return chosen;
@@ -104,7 +109,7 @@ double medianSpacing(const std::vector<float>& xyz, int samples) {
   const std::size_t n = xyz.size() / 3;
   if (n < 2) return 0.0;
   const detail::PointKdTree tree(xyz.data(), 3, n);
-  const std::size_t stride = std::max<std::size_t>(1, n / std::max(1, samples));
+  const std::size_t stride = sampleStride(n, samples);
   std::vector<double> nearest;
   pcl::Indices found;
   std::vector<float> distances;
