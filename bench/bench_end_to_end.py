@@ -18,7 +18,7 @@ import statistics
 import sys
 import tempfile
 
-from fresh_process import measured
+from fresh_process import machine_state, measured
 
 
 def write_torus_off(path, around=1600, tube=720, major=1.0, minor=0.4):
@@ -58,6 +58,7 @@ def main():
     folder = tempfile.mkdtemp(prefix="pcl_ddg_e2e_")
     mesh = os.path.join(folder, "torus.off")
     write_torus_off(mesh)
+    print(machine_state())
     print(f"mesh: {mesh} ({os.path.getsize(mesh) / 1e6:.0f} MB ascii OFF)")
     ours_command = [tool, mesh, os.path.join(folder, "ours.ply"), "-method", "area"]
     try:
@@ -72,15 +73,23 @@ def main():
     theirs_command = [sys.executable, "-c", OPEN3D_JOB, mesh, os.path.join(folder, "open3d.ply")]
     # Open3D's process includes Python and the import: what an empty job costs is printed too.
     baseline = measured([sys.executable, "-c", OPEN3D_JOB, "", ""])
-    ours, theirs = [], []
+    # The tool as it runs, and without the huge pages it asks glibc for on a large input
+    # (tools/common/huge_pages.h): what they give on this machine, in the same run.
+    small_pages = dict(os.environ, PCL_DDG_HUGE_PAGES="0")
+    ours, ours_small, theirs = [], [], []
     for _ in range(repetitions):
         ours.append(measured(ours_command))
+        ours_small.append(measured(ours_command, small_pages))
         theirs.append(measured(theirs_command))
     o_time = statistics.median(r[0] for r in ours)
     t_time = statistics.median(float(r[1]) for r in theirs)
     print(f"pcl_ddg_normals -method area (the process)  {o_time * 1000:8.0f} ms"
           f"  peak {statistics.median(r[2] for r in ours):6.0f} MB"
           f"  {statistics.median(r[3] for r in ours):8.0f} minor faults")
+    print(f"  the same, PCL_DDG_HUGE_PAGES=0            "
+          f"{statistics.median(r[0] for r in ours_small) * 1000:8.0f} ms"
+          f"  peak {statistics.median(r[2] for r in ours_small):6.0f} MB"
+          f"  {statistics.median(r[3] for r in ours_small):8.0f} minor faults")
     print(f"Open3D read + normals + write (the calls)   {t_time * 1000:8.0f} ms"
           f"  peak {statistics.median(r[2] for r in theirs):6.0f} MB"
           f"  {statistics.median(r[3] for r in theirs):8.0f} minor faults (the process)")

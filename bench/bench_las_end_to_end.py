@@ -25,7 +25,7 @@ import tempfile
 
 import numpy as np
 
-from fresh_process import measured
+from fresh_process import machine_state, measured
 
 LIBRARY_JOB = """
 import sys, time
@@ -95,24 +95,32 @@ def main():
     build = sys.argv[1]
     repetitions = int(sys.argv[2]) if len(sys.argv) > 2 else 3
     points = int(sys.argv[3]) if len(sys.argv) > 3 else 10_000_000
+    print(machine_state())
     with tempfile.TemporaryDirectory(prefix="pcl_ddg_las_e2e_") as folder:
         survey = os.path.join(folder, "survey.las")
         n = write_las(survey, points)
         size = os.path.getsize(survey) / 2**20
         print(f"{survey}: {n} points, point format 3, {size:.0f} MiB; {os.cpu_count()} cores")
         tools = os.path.join(build, "tools")
+        info = [os.path.join(tools, "pcl_ddg_info"), survey]
+        normals = [os.path.join(tools, "pcl_ddg_normals"), survey, os.path.join(folder, "tool.las"),
+                   "-k", "16"]
+        # The tools also without the huge pages they ask glibc for on a large input
+        # (tools/common/huge_pages.h): what those give on this machine, in the same run.
+        small_pages = dict(os.environ, PCL_DDG_HUGE_PAGES="0")
         jobs = {
-            "pcl_ddg_info": [os.path.join(tools, "pcl_ddg_info"), survey],
-            "pcl_ddg_normals -k 16": [os.path.join(tools, "pcl_ddg_normals"), survey,
-                                      os.path.join(folder, "tool.las"), "-k", "16"],
-            "library read + fit + write": [sys.executable, "-c", LIBRARY_JOB, survey,
-                                           os.path.join(folder, "library.las"),
-                                           os.path.join(build, "python")],
+            "pcl_ddg_info": (info, None),
+            "  PCL_DDG_HUGE_PAGES=0": (info, small_pages),
+            "pcl_ddg_normals -k 16": (normals, None),
+            "  PCL_DDG_HUGE_PAGES=0 ": (normals, small_pages),
+            "library read + fit + write": ([sys.executable, "-c", LIBRARY_JOB, survey,
+                                            os.path.join(folder, "library.las"),
+                                            os.path.join(build, "python")], None),
         }
         runs = {name: [] for name in jobs}
         for _ in range(repetitions):
-            for name, command in jobs.items():
-                runs[name].append(measured(command))
+            for name, (command, environment) in jobs.items():
+                runs[name].append(measured(command, environment))
         outputs = {"pcl_ddg_normals -k 16": os.path.join(folder, "tool.las"),
                    "library read + fit + write": os.path.join(folder, "library.las")}
         for name, results in runs.items():

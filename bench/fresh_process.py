@@ -5,17 +5,35 @@ import tempfile
 import time
 
 
-def measured(command):
+def measured(command, environment=None):
     """Runs command as a fresh process: (wall seconds, its stdout, peak resident MB, minor page
     faults), the last two by /usr/bin/time -f '%M %R' (which forks the command from its own small
     process: a child forked from this Python would start with this Python's peak). Exits with the
-    command's last lines of stderr if it fails."""
+    command's last lines of stderr if it fails. environment: the command's, if not this one's."""
     with tempfile.NamedTemporaryFile("r", suffix=".time") as report:
         start = time.perf_counter()
         run = subprocess.run(["/usr/bin/time", "-o", report.name, "-f", "%M %R", *command],
-                             stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=environment)
         wall = time.perf_counter() - start
         if run.returncode != 0:
             sys.exit(f"{command[0]} failed ({run.returncode}): {run.stderr.decode()[-400:]}")
         peak_kb, faults = report.read().split()[-2:]
     return wall, run.stdout.decode(), int(peak_kb) / 1024.0, int(faults)
+
+
+def machine_state():
+    """A line saying how long the machine has been up and what a first touch of a fresh 4 kB page
+    costs now (64 MiB newly mapped, one write a page; not NumPy's memory, which asks for huge
+    pages): in a freshly booted VM that is where a fault is dearest, and what the benches'
+    page-fault counts are worth in time."""
+    import mmap
+    with open("/proc/uptime") as f:
+        up_minutes = float(f.read().split()[0]) / 60
+    size = 64 << 20
+    block = mmap.mmap(-1, size)
+    start = time.perf_counter()
+    for offset in range(0, size, 4096):
+        block[offset] = 1
+    touch = (time.perf_counter() - start) / (size // 4096)
+    block.close()
+    return f"machine: up {up_minutes:.0f} min; a first touch of a 4 kB page {touch * 1e6:.2f} us"

@@ -1,13 +1,13 @@
 #include "file_bytes.h"
 
 #include <fcntl.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 
+#include "detail/populated_memory.h"
 #include "pcl_ddg/exceptions.h"
 
 namespace pcl_ddg {
@@ -49,23 +49,21 @@ FileBytes::FileBytes(const std::string& path) {
   if (fstat(file.get(), &status) != 0) failWithErrno("");
   size_ = static_cast<std::size_t>(status.st_size);
   if (size_ == 0) return;
-  // Memory populated in one call and read into, not a zero-filled string faulted in page by page:
-  // page faults are what loading costs in a VM (a 44 MB binary PLY: 67-188 ms -> 41 ms). The
-  // file is copied, not mapped, so that a file truncated while it is parsed cannot raise SIGBUS.
-  void* block = mmap(nullptr, size_, PROT_READ | PROT_WRITE,
-                     MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
-  if (block == MAP_FAILED) failWithErrno("cannot allocate memory for the file: ");
-  data_ = static_cast<char*>(block);
+  // Memory populated in one call and read into, not a zero-filled string faulted in page by page
+  // (detail/populated_memory.h). The file is copied, not mapped, so that a file truncated while
+  // it is parsed cannot raise SIGBUS.
+  data_ = static_cast<char*>(mapPopulated(size_));
+  if (data_ == nullptr) failWithErrno("cannot allocate memory for the file: ");
   std::size_t done = 0;
   while (done < size_) {
     const ssize_t got = read(file.get(), data_ + done, size_ - done);
     if (got < 0 && errno == EINTR) continue;
     if (got < 0) {
-      munmap(data_, size_);
+      unmapPopulated(data_, size_);
       failWithErrno("cannot read: ");
     }
     if (got == 0) {
-      munmap(data_, size_);
+      unmapPopulated(data_, size_);
       throw FileFormatException("cannot read the whole file (it changed while being read?)");
     }
     done += static_cast<std::size_t>(got);
@@ -73,7 +71,7 @@ FileBytes::FileBytes(const std::string& path) {
 }
 
 FileBytes::~FileBytes() {
-  if (data_ != nullptr) munmap(data_, size_);
+  if (data_ != nullptr) unmapPopulated(data_, size_);
 }
 
 }  // namespace detail

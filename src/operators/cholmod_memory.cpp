@@ -2,12 +2,13 @@
 
 #include <SuiteSparse_config.h>
 #include <malloc.h>
-#include <sys/mman.h>
 
 #include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <unordered_map>
+
+#include "detail/populated_memory.h"
 
 namespace pcl_ddg {
 namespace detail {
@@ -34,14 +35,13 @@ std::size_t mappedLength(void* block) {
 
 void* populatedMalloc(std::size_t bytes) {
   if (bytes < kPopulatedBytes) return std::malloc(bytes);
-  void* block = mmap(nullptr, bytes, PROT_READ | PROT_WRITE,
-                     MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
-  if (block == MAP_FAILED) return nullptr;
+  void* block = mapPopulated(bytes);
+  if (block == nullptr) return nullptr;
   try {
     const std::lock_guard<std::mutex> lock(mapped_mutex);
     mappedBlocks().emplace(block, bytes);
   } catch (...) {
-    munmap(block, bytes);
+    unmapPopulated(block, bytes);
     return nullptr;
   }
   return block;
@@ -53,7 +53,7 @@ void populatedFree(void* block) {
     const std::lock_guard<std::mutex> lock(mapped_mutex);
     const auto found = mappedBlocks().find(block);
     if (found != mappedBlocks().end()) {
-      munmap(block, found->second);
+      unmapPopulated(block, found->second);
       mappedBlocks().erase(found);
       return;
     }

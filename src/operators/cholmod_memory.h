@@ -3,8 +3,8 @@
 //
 // The supernodal factor of a 1M-vertex mesh is about a gigabyte, allocated fresh and first
 // touched by CHOLMOD's memset. Faulted in one page at a time, that first touch costs microseconds
-// a page in a VM (clear_page was 18% of the first implicit step); mapped with MAP_POPULATE the
-// kernel fills the pages in one call, about half the cost.
+// a page in a VM (clear_page was 18% of the first implicit step); populated in one call, on huge
+// pages where the kernel has them (detail/populated_memory.h), it costs about half or less.
 
 #include <cstddef>
 

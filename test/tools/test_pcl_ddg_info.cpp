@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <sstream>
 #include <vector>
@@ -309,6 +310,57 @@ TEST(PclDdgInfo, DoubleCloudBoxAndDuplicatesAreTheFilesExactValues) {
   EXPECT_EQ(j.get<int>("duplicate_points"), 1);
   EXPECT_EQ(vector3(j.get_child("bounding_box_min")), Eigen::Vector3d(500000.001, 4000000.002, 10));
   EXPECT_EQ(vector3(j.get_child("bounding_box_max")), Eigen::Vector3d(500000.002, 4000000.002, 10));
+}
+
+/** How many times the dynamic loader handed a program control in a run with LD_DEBUG=files:
+ *  one start, or two when the tool started itself again. */
+int programStarts(const std::string& loader_log) {
+  int starts = 0;
+  for (std::size_t at = loader_log.find("transferring control"); at != std::string::npos;
+       at = loader_log.find("transferring control", at + 1)) {
+    ++starts;
+  }
+  return starts;
+}
+
+TEST(PclDdgInfo, ALargeInputIsReadOnHugePagesWithTheSameReport) {
+  // tools/common/huge_pages.h: an input of 32 MiB or more makes the tool start itself again once
+  // with glibc's huge pages; what it reports is the same. A binary PLY cloud of a 1500 x 2000
+  // grid of float points, 36 MB, and its first 1,000,000 points, 12 MB.
+  const std::string dir = scratchFolder("info_huge_pages");
+  const auto writeGrid = [&](const std::string& path, int points) {
+    std::ofstream out(path, std::ios::binary);
+    out << "ply\nformat binary_little_endian 1.0\nelement vertex " << points
+        << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    std::vector<float> xyz;
+    xyz.reserve(3 * static_cast<std::size_t>(points));
+    for (int i = 0; i < points; ++i) {
+      const float x = static_cast<float>(i % 1500) * 0.01f,
+                  y = static_cast<float>(i / 1500) * 0.01f;
+      xyz.insert(xyz.end(), {x, y, 0.25f * x - 0.5f * y});
+    }
+    out.write(reinterpret_cast<const char*>(xyz.data()),
+              static_cast<std::streamsize>(xyz.size() * sizeof(float)));
+  };
+  writeGrid(dir + "/large.ply", 1500 * 2000);
+  writeGrid(dir + "/small.ply", 1000000);
+  const std::string tool = std::string("LD_DEBUG=files ") + PCL_DDG_INFO_TOOL;
+  const ToolRun large = runTool(tool, dir + "/large.ply");
+  const ToolRun large_small_pages = runTool("PCL_DDG_HUGE_PAGES=0 " + tool, dir + "/large.ply");
+  const ToolRun users_choice =
+      runTool("GLIBC_TUNABLES=glibc.malloc.hugetlb=0 " + tool, dir + "/large.ply");
+  const ToolRun small = runTool(tool, dir + "/small.ply");
+  for (const ToolRun* run : {&large, &large_small_pages, &users_choice, &small}) {
+    ASSERT_EQ(run->exit_code, 0) << run->err.substr(run->err.size() > 600 ? run->err.size() - 600
+                                                                          : 0);
+  }
+  EXPECT_EQ(programStarts(large.err), 2);
+  EXPECT_EQ(programStarts(large_small_pages.err), 1);
+  EXPECT_EQ(programStarts(users_choice.err), 1);
+  EXPECT_EQ(programStarts(small.err), 1);
+  EXPECT_NE(large.out.find("3000000"), std::string::npos) << large.out;
+  EXPECT_EQ(large.out, large_small_pages.out);
+  EXPECT_EQ(large.out, users_choice.out);
 }
 
 TEST(PclDdgInfo, CountsDefectsInsteadOfRefusing) {

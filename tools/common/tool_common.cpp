@@ -1,5 +1,7 @@
 #include "common/tool_common.h"
 
+#include "common/huge_pages.h"
+
 #include <malloc.h>
 #include <pcl/exceptions.h>
 #include <unistd.h>
@@ -327,8 +329,9 @@ int runBody(const char* name, const char* description, const char* syntax,
 
 int runTool(const char* name, const char* description, const char* syntax,
             const std::function<int()>& body) {
-  AtomicFile::removeUncommittedFilesOnInterrupt();  // Ctrl-C leaves no temporary behind
   // A tool is the whole process: its global state is ours.
+  restartOnHugePagesForLargeInputs();
+  AtomicFile::removeUncommittedFilesOnInterrupt();  // Ctrl-C leaves no temporary behind
   keepFreedMemoryForReuse();
   tuneCholmodForLargeSystems();
   const int code = runBody(name, description, syntax, body);
