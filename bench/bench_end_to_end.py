@@ -18,7 +18,7 @@ import statistics
 import sys
 import tempfile
 
-from fresh_process import machine_state, measured
+from fresh_process import environment, machine_state, measured
 
 
 def write_torus_off(path, around=1600, tube=720, major=1.0, minor=0.4):
@@ -55,31 +55,37 @@ print(time.perf_counter() - start)
 def main():
     tool = sys.argv[1] if len(sys.argv) > 1 else "build/tools/pcl_ddg_normals"
     repetitions = int(sys.argv[2]) if len(sys.argv) > 2 else 5
+    print(machine_state())  # before the mesh is written: its page cache is touched memory too
     folder = tempfile.mkdtemp(prefix="pcl_ddg_e2e_")
     mesh = os.path.join(folder, "torus.off")
     write_torus_off(mesh)
-    print(machine_state())
     print(f"mesh: {mesh} ({os.path.getsize(mesh) / 1e6:.0f} MB ascii OFF)")
     ours_command = [tool, mesh, os.path.join(folder, "ours.ply"), "-method", "area"]
+    # The tool as it runs, and without the huge pages it asks glibc for on a large input
+    # (tools/common/huge_pages.h): what they give on this machine, in the same run.
+    huge_pages, small_pages = environment(), environment(PCL_DDG_HUGE_PAGES="0")
     try:
         import open3d  # noqa: F401  (only whether it is there)
     except ImportError:
-        runs = [measured(ours_command) for _ in range(repetitions)]
-        print(f"pcl_ddg_normals -method area  {statistics.median(r[0] for r in runs) * 1000:8.0f} ms"
-              f"  peak {statistics.median(r[2] for r in runs):6.0f} MB"
-              f"  {statistics.median(r[3] for r in runs):8.0f} minor faults")
+        for name, env in (("", huge_pages), (", PCL_DDG_HUGE_PAGES=0", small_pages)):
+            runs = [measured(ours_command, env) for _ in range(repetitions)]
+            print(f"pcl_ddg_normals -method area{name}"
+                  f"  {statistics.median(r[0] for r in runs) * 1000:8.0f} ms"
+                  f"  peak {statistics.median(r[2] for r in runs):6.0f} MB"
+                  f"  {statistics.median(r[3] for r in runs):8.0f} minor faults")
         print("open3d not installed (apt-get install python3-open3d): no baseline")
         return
     theirs_command = [sys.executable, "-c", OPEN3D_JOB, mesh, os.path.join(folder, "open3d.ply")]
     # Open3D's process includes Python and the import: what an empty job costs is printed too.
     baseline = measured([sys.executable, "-c", OPEN3D_JOB, "", ""])
-    # The tool as it runs, and without the huge pages it asks glibc for on a large input
-    # (tools/common/huge_pages.h): what they give on this machine, in the same run.
-    small_pages = dict(os.environ, PCL_DDG_HUGE_PAGES="0")
     ours, ours_small, theirs = [], [], []
-    for _ in range(repetitions):
-        ours.append(measured(ours_command))
-        ours_small.append(measured(ours_command, small_pages))
+    for repetition in range(repetitions):
+        # Which of ours runs first alternates: on a fresh machine the first touches memory anew.
+        first, second = (huge_pages, small_pages) if repetition % 2 == 0 else (small_pages, huge_pages)
+        runs = {id(first): measured(ours_command, first)}
+        runs[id(second)] = measured(ours_command, second)
+        ours.append(runs[id(huge_pages)])
+        ours_small.append(runs[id(small_pages)])
         theirs.append(measured(theirs_command))
     o_time = statistics.median(r[0] for r in ours)
     t_time = statistics.median(float(r[1]) for r in theirs)

@@ -25,7 +25,7 @@ import tempfile
 
 import numpy as np
 
-from fresh_process import machine_state, measured
+from fresh_process import environment, machine_state, measured
 
 LIBRARY_JOB = """
 import sys, time
@@ -103,29 +103,36 @@ def main():
         print(f"{survey}: {n} points, point format 3, {size:.0f} MiB; {os.cpu_count()} cores")
         tools = os.path.join(build, "tools")
         info = [os.path.join(tools, "pcl_ddg_info"), survey]
-        normals = [os.path.join(tools, "pcl_ddg_normals"), survey, os.path.join(folder, "tool.las"),
-                   "-k", "16"]
+
+        def normals(output):
+            return [os.path.join(tools, "pcl_ddg_normals"), survey, os.path.join(folder, output),
+                    "-k", "16"]
         # The tools also without the huge pages they ask glibc for on a large input
         # (tools/common/huge_pages.h): what those give on this machine, in the same run.
-        small_pages = dict(os.environ, PCL_DDG_HUGE_PAGES="0")
+        huge_pages, small_pages = environment(), environment(PCL_DDG_HUGE_PAGES="0")
         jobs = {
-            "pcl_ddg_info": (info, None),
-            "  PCL_DDG_HUGE_PAGES=0": (info, small_pages),
-            "pcl_ddg_normals -k 16": (normals, None),
-            "  PCL_DDG_HUGE_PAGES=0 ": (normals, small_pages),
+            "pcl_ddg_info": (info, huge_pages),
+            "pcl_ddg_info, PCL_DDG_HUGE_PAGES=0": (info, small_pages),
+            "pcl_ddg_normals -k 16": (normals("tool.las"), huge_pages),
+            "pcl_ddg_normals, PCL_DDG_HUGE_PAGES=0": (normals("tool_small_pages.las"), small_pages),
             "library read + fit + write": ([sys.executable, "-c", LIBRARY_JOB, survey,
                                             os.path.join(folder, "library.las"),
-                                            os.path.join(build, "python")], None),
+                                            os.path.join(build, "python")], huge_pages),
         }
         runs = {name: [] for name in jobs}
-        for _ in range(repetitions):
-            for name, (command, environment) in jobs.items():
-                runs[name].append(measured(command, environment))
+        for repetition in range(repetitions):
+            # The order reverses every other repetition: on a fresh machine whichever runs first
+            # touches memory anew.
+            names = list(jobs) if repetition % 2 == 0 else list(reversed(jobs))
+            for name in names:
+                command, env = jobs[name]
+                runs[name].append(measured(command, env))
         outputs = {"pcl_ddg_normals -k 16": os.path.join(folder, "tool.las"),
+                   "pcl_ddg_normals, PCL_DDG_HUGE_PAGES=0": os.path.join(folder, "tool_small_pages.las"),
                    "library read + fit + write": os.path.join(folder, "library.las")}
         for name, results in runs.items():
             wall = statistics.median(r[0] for r in results)
-            line = (f"{name:28s} {wall:7.2f} s  peak {statistics.median(r[2] for r in results):6.0f}"
+            line = (f"{name:38s} {wall:7.2f} s  peak {statistics.median(r[2] for r in results):6.0f}"
                     f" MB  {statistics.median(r[3] for r in results):8.0f} minor faults")
             if name in outputs:
                 out = os.path.getsize(outputs[name]) / 2**20
@@ -136,9 +143,11 @@ def main():
         tool = statistics.median(r[0] for r in runs["pcl_ddg_normals -k 16"])
         library = statistics.median(float(r[1]) for r in runs["library read + fit + write"])
         print(f"tool / library calls: {tool / library:.2f}")
-        same = (open(outputs["pcl_ddg_normals -k 16"], "rb").read() ==
-                open(outputs["library read + fit + write"], "rb").read())
-        print("the tool's and the library's .las are " + ("the same bytes" if same else "different"))
+        library_bytes = open(outputs["library read + fit + write"], "rb").read()
+        for name in ("pcl_ddg_normals -k 16", "pcl_ddg_normals, PCL_DDG_HUGE_PAGES=0"):
+            same = open(outputs[name], "rb").read() == library_bytes
+            print(f"{name}: its .las and the library's are "
+                  + ("the same bytes" if same else "different"))
 
 
 if __name__ == "__main__":

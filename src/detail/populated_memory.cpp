@@ -2,19 +2,34 @@
 
 #include <sys/mman.h>
 
+// Linux 5.14's value; older C library headers do not name it, and older kernels refuse it (EINVAL).
+#ifndef MADV_POPULATE_WRITE
+#define MADV_POPULATE_WRITE 23
+#endif
+
 namespace pcl_ddg {
 namespace detail {
+namespace {
 
-void* mapPopulated(std::size_t bytes) {
-  void* block = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-  if (block == MAP_FAILED) return nullptr;
-  // Advice before the pages exist: a range already populated in 4 kB pages stays so. Both calls
-  // are hints: where the kernel refuses either, the pages come one fault at a time as before.
+void* mapAnonymous(std::size_t bytes, int extra_flags) {
+  void* block = mmap(nullptr, bytes, PROT_READ | PROT_WRITE,
+                     MAP_PRIVATE | MAP_ANONYMOUS | extra_flags, -1, 0);
+  return block == MAP_FAILED ? nullptr : block;
+}
+
+}  // namespace
+
+void* mapPopulated(std::size_t bytes, PageSize pages) {
+  if (pages == PageSize::kSmall) return mapAnonymous(bytes, MAP_POPULATE);
+  void* block = mapAnonymous(bytes, 0);
+  if (block == nullptr) return nullptr;
+  // The advice must come before the pages exist: a range populated in 4 KiB pages stays so
+  // (until khugepaged merges it, if ever). Where the kernel gives no huge pages, the advice is
+  // without effect and the populate call makes small ones.
   madvise(block, bytes, MADV_HUGEPAGE);
-#ifdef MADV_POPULATE_WRITE
-  madvise(block, bytes, MADV_POPULATE_WRITE);
-#endif
-  return block;
+  if (madvise(block, bytes, MADV_POPULATE_WRITE) == 0) return block;
+  munmap(block, bytes);
+  return mapAnonymous(bytes, MAP_POPULATE);
 }
 
 void unmapPopulated(void* block, std::size_t bytes) {

@@ -49,10 +49,11 @@ FileBytes::FileBytes(const std::string& path) {
   if (fstat(file.get(), &status) != 0) failWithErrno("");
   size_ = static_cast<std::size_t>(status.st_size);
   if (size_ == 0) return;
-  // Memory populated in one call and read into, not a zero-filled string faulted in page by page
-  // (detail/populated_memory.h). The file is copied, not mapped, so that a file truncated while
-  // it is parsed cannot raise SIGBUS.
-  data_ = static_cast<char*>(mapPopulated(size_));
+  // Memory populated in one call on huge pages and read into, not a zero-filled string faulted in
+  // page by page (detail/populated_memory.h: 92 MiB in 13 ms against 120-170 ms on a fresh VM).
+  // The file is copied, not mapped, so that a file truncated while it is parsed cannot raise
+  // SIGBUS.
+  data_ = static_cast<char*>(mapPopulated(size_, PageSize::kHuge));
   if (data_ == nullptr) failWithErrno("cannot allocate memory for the file: ");
   std::size_t done = 0;
   while (done < size_) {

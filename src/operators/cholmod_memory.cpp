@@ -35,7 +35,7 @@ std::size_t mappedLength(void* block) {
 
 void* populatedMalloc(std::size_t bytes) {
   if (bytes < kPopulatedBytes) return std::malloc(bytes);
-  void* block = mapPopulated(bytes);
+  void* block = mapPopulated(bytes, PageSize::kSmall);
   if (block == nullptr) return nullptr;
   try {
     const std::lock_guard<std::mutex> lock(mapped_mutex);

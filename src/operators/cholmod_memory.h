@@ -3,8 +3,9 @@
 //
 // The supernodal factor of a 1M-vertex mesh is about a gigabyte, allocated fresh and first
 // touched by CHOLMOD's memset. Faulted in one page at a time, that first touch costs microseconds
-// a page in a VM (clear_page was 18% of the first implicit step); populated in one call, on huge
-// pages where the kernel has them (detail/populated_memory.h), it costs about half or less.
+// a page in a VM (clear_page was 18% of the first implicit step); populated in one call
+// (detail/populated_memory.h) it costs about half. In 4 KiB pages: huge pages made the first step
+// slower on a VM whose freed memory goes back to the host (docs/design/implicit-solver.md).
 
 #include <cstddef>
 

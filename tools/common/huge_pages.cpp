@@ -1,8 +1,10 @@
 #include "common/huge_pages.h"
 
+#include <gnu/libc-version.h>
 #include <unistd.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -18,7 +20,21 @@ namespace {
 
 constexpr std::uintmax_t kLargeInputBytes = std::uintmax_t{32} << 20;
 
-/** This process's arguments, argv[0] included, as the kernel holds them. */
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr bool kSanitizerAllocator = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
+    __has_feature(memory_sanitizer)
+constexpr bool kSanitizerAllocator = true;
+#else
+constexpr bool kSanitizerAllocator = false;
+#endif
+#else
+constexpr bool kSanitizerAllocator = false;
+#endif
+
+/** This process's arguments, argv[0] included, as the kernel holds them (also right when the
+ *  tool was started through the dynamic loader, which /proc/self/exe then is). */
 std::vector<std::string> ownArguments() {
   std::ifstream file("/proc/self/cmdline", std::ios::binary);
   const std::string all((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
@@ -32,56 +48,92 @@ std::vector<std::string> ownArguments() {
   return arguments;
 }
 
-/** The bytes of the regular files among the arguments and directly inside the folders among
- *  them; options and values that name no file count nothing. */
-std::uintmax_t inputBytes(const std::vector<std::string>& arguments) {
+/** Whether the regular files among the arguments and directly inside the folders among them hold
+ *  kLargeInputBytes or more; options and values that name no file count nothing. */
+bool largeInputs(const std::vector<std::string>& arguments) {
   namespace fs = std::filesystem;
   std::uintmax_t bytes = 0;
-  std::error_code error;
+  const auto add = [&bytes](const fs::directory_entry& entry) {
+    std::error_code error;
+    if (!entry.is_regular_file(error) || error) return false;
+    const std::uintmax_t size = entry.file_size(error);
+    if (!error) bytes += size;
+    return bytes >= kLargeInputBytes;
+  };
   for (std::size_t i = 1; i < arguments.size(); ++i) {
-    const fs::path path(arguments[i]);
-    if (fs::is_regular_file(path, error)) {
-      bytes += fs::file_size(path, error);
-    } else if (fs::is_directory(path, error)) {
-      for (fs::directory_iterator it(path, error), end; !error && it != end; it.increment(error)) {
-        if (it->is_regular_file(error)) bytes += it->file_size(error);
-      }
+    std::error_code error;
+    const fs::directory_entry entry(arguments[i], error);
+    if (error) continue;
+    if (add(entry)) return true;
+    if (!entry.is_directory(error) || error) continue;
+    for (fs::directory_iterator it(entry.path(), error), end; !error && it != end;
+         it.increment(error)) {
+      if (add(*it)) return true;
     }
-    if (bytes >= kLargeInputBytes) return bytes;
   }
-  return bytes;
+  return false;
 }
 
 bool contains(const char* text, const char* part) {
   return text != nullptr && std::strstr(text, part) != nullptr;
 }
 
+/** glibc.malloc.hugetlb=1 does something: glibc 2.35 or later, and the kernel's transparent huge
+ *  pages in "madvise" mode (in "always" mode they come without it, in "never" not at all). */
+bool tunableTakesEffect() {
+  int major = 0, minor = 0;
+  if (std::sscanf(gnu_get_libc_version(), "%d.%d", &major, &minor) != 2) return false;
+  if (major < 2 || (major == 2 && minor < 35)) return false;
+  std::ifstream mode("/sys/kernel/mm/transparent_hugepage/enabled");
+  const std::string modes((std::istreambuf_iterator<char>(mode)), std::istreambuf_iterator<char>());
+  return modes.find("[madvise]") != std::string::npos;
+}
+
+/** The executable's own path, so that the restarted process keeps its name in ps and top
+ *  (exec of /proc/self/exe would name it "exe"); /proc/self/exe itself if that path is gone. */
+std::string ownExecutable() {
+  std::error_code error;
+  const std::string path = std::filesystem::read_symlink("/proc/self/exe", error).string();
+  const std::string deleted = " (deleted)";
+  if (error || path.empty() ||
+      (path.size() >= deleted.size() &&
+       path.compare(path.size() - deleted.size(), deleted.size(), deleted) == 0)) {
+    return "/proc/self/exe";
+  }
+  return path;
+}
+
 }  // namespace
 
 void restartOnHugePagesForLargeInputs() {
-  const char* tunables = std::getenv("GLIBC_TUNABLES");
+  if (kSanitizerAllocator) return;
+  const char* tunables_now = std::getenv("GLIBC_TUNABLES");
   const char* wanted = std::getenv("PCL_DDG_HUGE_PAGES");
-  if (contains(tunables, "glibc.malloc.hugetlb") ||
+  if (contains(tunables_now, "glibc.malloc.hugetlb") ||
       (wanted != nullptr && std::strcmp(wanted, "0") == 0) ||
       contains(std::getenv("LD_PRELOAD"), "vgpreload")) {
     return;
   }
   std::vector<std::string> arguments = ownArguments();
-  if (arguments.empty() || inputBytes(arguments) < kLargeInputBytes) return;
-  const std::string set = tunables == nullptr || *tunables == '\0'
-                              ? std::string("glibc.malloc.hugetlb=1")
-                              : std::string(tunables) + ":glibc.malloc.hugetlb=1";
+  for (const std::string& argument : arguments) {
+    if (argument == "-memory") return;
+  }
+  if (arguments.empty() || !largeInputs(arguments) || !tunableTakesEffect()) return;
+  const bool had_tunables = tunables_now != nullptr;
+  const std::string tunables = had_tunables ? tunables_now : "";  // a copy: setenv may move it
+  const std::string set = tunables.empty() ? std::string("glibc.malloc.hugetlb=1")
+                                           : tunables + ":glibc.malloc.hugetlb=1";
   if (setenv("GLIBC_TUNABLES", set.c_str(), 1) != 0) return;
   std::vector<char*> argv;
   for (std::string& argument : arguments) argv.push_back(argument.data());
   argv.push_back(nullptr);
-  execv("/proc/self/exe", argv.data());
+  execv(ownExecutable().c_str(), argv.data());
   // Still here: the exec failed. The tool runs without huge pages, and the variable set above
   // would name what this process does not have.
-  if (tunables == nullptr) {
-    unsetenv("GLIBC_TUNABLES");
+  if (had_tunables) {
+    setenv("GLIBC_TUNABLES", tunables.c_str(), 1);
   } else {
-    setenv("GLIBC_TUNABLES", tunables, 1);
+    unsetenv("GLIBC_TUNABLES");
   }
 }
 

@@ -1,24 +1,27 @@
 #pragma once
 // A tool on a large input runs with glibc's transparent huge pages.
 //
-// Every first touch of a 4 kB page is a fault, and in a VM a fault and a TLB miss go through the
-// hypervisor: on a freshly booted 2-core VM (Firecracker, PVM) a fault cost 11-18 us, and the bench
-// mesh run (docs/benchmarks.md, "End to end") took 1.06-1.26 s with 42,900 faults, against
-// 0.59-0.84 s and 2,100-2,400 faults with GLIBC_TUNABLES=glibc.malloc.hugetlb=1, which advises
-// every block malloc takes from the kernel for 2 MB pages. glibc reads its tunables only when a
-// process starts, so the tool starts itself again once with the tunable set.
+// Every first touch of a 4 KiB page is a fault, and in a VM a fault goes through the hypervisor:
+// on a freshly booted 2-core VM (Firecracker, PVM) one cost 11-18 us. With
+// GLIBC_TUNABLES=glibc.malloc.hugetlb=1, malloc advises the memory it takes from the kernel for
+// 2 MiB pages (glibc 2.35 and later, with the kernel's THP in "madvise" mode): there, the
+// 10M-point LAS normals went from 15.5 to 11.8 s and 377,197 to 42,901 faults
+// (docs/benchmarks.md, "LAS end to end"). glibc reads its tunables only when a process starts, so
+// the tool starts itself again once, with the tunable set.
 
 namespace pcl_ddg {
 namespace tools {
 
 /**
- * Re-executes this process (/proc/self/exe, the same arguments) with glibc.malloc.hugetlb=1 added
+ * Re-executes this process (its executable, the same arguments) with glibc.malloc.hugetlb=1 added
  * to GLIBC_TUNABLES when the regular files among its arguments, and those directly inside the
- * folders among them, hold at least 32 MiB. Returns without doing so (and the tool runs as it
- * is) when they hold less (a start costs more than huge pages save on a small file), when
- * GLIBC_TUNABLES already names glibc.malloc.hugetlb (the user's choice, and the started process
- * itself), when PCL_DDG_HUGE_PAGES=0, under valgrind (whose tool would not follow the exec), or
- * when the exec fails.
+ * folders among them, hold at least 32 MiB. Returns without doing so, and the tool runs as it is:
+ * when they hold less (a second start costs more than huge pages save on a small file); when the
+ * tunable would do nothing (glibc before 2.35, the kernel's THP not in "madvise" mode, a
+ * sanitizer's allocator); when GLIBC_TUNABLES already names glibc.malloc.hugetlb (the user's
+ * choice, and the restarted process itself); when PCL_DDG_HUGE_PAGES=0; with -memory (a budget
+ * measured in 4 KiB pages); under valgrind (whose tool would not follow the exec); or when the
+ * exec fails.
  */
 void restartOnHugePagesForLargeInputs();
 

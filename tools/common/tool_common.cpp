@@ -1,7 +1,5 @@
 #include "common/tool_common.h"
 
-#include "common/huge_pages.h"
-
 #include <malloc.h>
 #include <pcl/exceptions.h>
 #include <unistd.h>
@@ -16,6 +14,7 @@
 #include <iostream>
 #include <utility>
 
+#include "common/huge_pages.h"
 #include "pcl_ddg/exceptions.h"
 #include "pcl_ddg/io/atomic_file.h"
 #include "pcl_ddg/io/mesh_io.h"
