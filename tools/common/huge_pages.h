@@ -5,7 +5,7 @@
 // on a freshly booted 2-core VM (Firecracker, PVM) one cost 11-18 us. With
 // GLIBC_TUNABLES=glibc.malloc.hugetlb=1, malloc advises the memory it takes from the kernel for
 // 2 MiB pages (glibc 2.35 and later, with the kernel's THP in "madvise" mode): there, the
-// 10M-point LAS normals went from 15.5 to 11.8 s and 377,197 to 42,901 faults
+// 10M-point LAS normals went from 15.6 to 12.1 s and 368,603 to 43,848 faults
 // (docs/benchmarks.md, "LAS end to end"). glibc reads its tunables only when a process starts, so
 // the tool starts itself again once, with the tunable set.
 
