@@ -5,7 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <memory>
+#include <new>
 #include <numeric>
+#include <type_traits>
 #include <vector>
 
 #include "detail/disjoint_sets.h"
@@ -20,6 +24,31 @@ namespace pcl_ddg {
 namespace {
 
 using GraphEdge = std::pair<int, int>;  ///< point indices
+
+/** Room for count edges, each constructed in place by the code that fills it, none before: the
+ *  pages are first touched where the edges are written. GraphEdge needs no destruction. */
+class EdgeSlots {
+ public:
+  explicit EdgeSlots(std::size_t count)
+      : count_(count), data_(std::allocator<GraphEdge>().allocate(count)) {}
+  ~EdgeSlots() { std::allocator<GraphEdge>().deallocate(data_, count_); }
+  EdgeSlots(const EdgeSlots&) = delete;
+  EdgeSlots& operator=(const EdgeSlots&) = delete;
+  GraphEdge* data() const { return data_; }
+
+ private:
+  static_assert(std::is_trivially_destructible_v<GraphEdge>);
+  std::size_t count_;
+  GraphEdge* data_;
+};
+
+/** The edges a spanning forest is grown over, wherever they are stored. */
+struct EdgeSpan {
+  const GraphEdge* data;
+  std::size_t count;
+  std::size_t size() const { return count; }
+  const GraphEdge& operator[](std::size_t e) const { return data[e]; }
+};
 
 /** Points with a finite coordinate and normal. */
 std::vector<char> orientablePoints(const pcl::PointCloud<pcl::PointXYZ>& cloud,
@@ -135,7 +164,7 @@ ConsistentOrientationReport orientByReference(const pcl::PointCloud<pcl::PointXY
 ConsistentOrientationReport orientAlongSpanningForest(const pcl::PointCloud<pcl::PointXYZ>& cloud,
                                                       pcl::PointCloud<pcl::Normal>& normals,
                                                       const std::vector<char>& usable,
-                                                      const std::vector<GraphEdge>& edges,
+                                                      EdgeSpan edges,
                                                       const ConsistentOrientationOptions& options) {
   const int n = static_cast<int>(cloud.size());
   constexpr int kBuckets = 1 << 16;
@@ -251,8 +280,11 @@ ConsistentOrientationReport orientNormalsConsistently(const pcl::PointCloud<pcl:
   const std::vector<pcl::index_t> points = ids;
   const detail::PointKdTree tree(std::move(xyz), std::move(ids));
   // Each point's k nearest others fill its own k slots: the edge list does not depend on threads.
+  // The slots are constructed there, by the point, not filled before the search: on a fresh VM
+  // the first touch of n k slots' pages alone took longer than Ctrl-C may wait.
   const int k = options.k;
-  std::vector<GraphEdge> slots(points.size() * static_cast<std::size_t>(k), GraphEdge{-1, -1});
+  const std::size_t slot_count = points.size() * static_cast<std::size_t>(k);
+  const EdgeSlots slots(slot_count);
   detail::InterruptionPoll interruption;
 #ifdef _OPENMP
   const int threads =
@@ -267,18 +299,22 @@ ConsistentOrientationReport orientNormalsConsistently(const pcl::PointCloud<pcl:
       if (interruption.stopped()) continue;
       const int i = points[p];
       tree.nearestK(cloud[i].data, k + 1, found, distances);
+      GraphEdge* own = slots.data() + p * k;
       int slot = 0;
       for (const pcl::index_t j : found) {
         if (j == i || slot == k) continue;
-        slots[p * k + slot++] = GraphEdge{std::min<int>(i, j), std::max<int>(i, j)};
+        new (own + slot++) GraphEdge(std::min<int>(i, j), std::max<int>(i, j));
       }
+      while (slot < k) new (own + slot++) GraphEdge(-1, -1);  // fewer neighbours than k
     }
   }
   interruption.throwIfStopped();
-  slots.erase(
-      std::remove_if(slots.begin(), slots.end(), [](const GraphEdge& e) { return e.first < 0; }),
-      slots.end());
-  return orientAlongSpanningForest(cloud, normals, usable, slots, options);
+  // Every slot holds an edge now (GraphEdge is trivially destructible: none is destroyed).
+  GraphEdge* const end = std::remove_if(slots.data(), slots.data() + slot_count,
+                                        [](const GraphEdge& e) { return e.first < 0; });
+  return orientAlongSpanningForest(cloud, normals, usable,
+                                   {slots.data(), static_cast<std::size_t>(end - slots.data())},
+                                   options);
 }
 
 ConsistentOrientationReport orientNormalsConsistently(const MeshTopology& topology,
@@ -297,7 +333,7 @@ ConsistentOrientationReport orientNormalsConsistently(const MeshTopology& topolo
     const int a = topology.edgeVertices()(0, e), b = topology.edgeVertices()(1, e);
     if (usable[a] && usable[b]) edges.emplace_back(a, b);
   }
-  return orientAlongSpanningForest(cloud, normals, usable, edges, options);
+  return orientAlongSpanningForest(cloud, normals, usable, {edges.data(), edges.size()}, options);
 }
 
 ConsistentOrientationReport orientNormalsConsistently(const pcl::PointCloud<pcl::PointXYZ>& cloud,
@@ -316,7 +352,8 @@ ConsistentOrientationReport orientNormalsConsistently(const pcl::PointCloud<pcl:
     }
     if (usable[a] && usable[b]) usable_edges.emplace_back(a, b);
   }
-  return orientAlongSpanningForest(cloud, normals, usable, usable_edges, options);
+  return orientAlongSpanningForest(cloud, normals, usable,
+                                   {usable_edges.data(), usable_edges.size()}, options);
 }
 
 ConsistentOrientationReport orientNormalsConsistently(
@@ -337,7 +374,7 @@ ConsistentOrientationReport orientNormalsConsistently(
       if (usable[j]) edges.emplace_back(i, j);
     }
   }
-  return orientAlongSpanningForest(*cloud, normals, usable, edges, options);
+  return orientAlongSpanningForest(*cloud, normals, usable, {edges.data(), edges.size()}, options);
 }
 
 }  // namespace pcl_ddg
