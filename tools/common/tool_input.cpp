@@ -18,6 +18,12 @@ namespace pcl_ddg {
 namespace tools {
 namespace {
 
+/** A coordinate about the local origin made exact again: an axis about 0 was not moved, so its
+ *  -0 stays -0. */
+double restoredCoordinate(float local, double origin) {
+  return origin == 0.0 ? double{local} : double{local} + origin;
+}
+
 // Room for what a tool adds to a LAS or PCD cloud's rows in place: double coordinates, normals and
 // curvature in double, robust's scale and confidence (reserved, not touched until written).
 constexpr std::size_t kSparePointBytes = 24 + 4 * 8 + 2 * 8;
@@ -127,8 +133,7 @@ void ToolInput::restoreFromFloats() {
   const Eigen::Vector3d& origin = local_->origin;
   for (Eigen::Index i = 0; i < point_count_; ++i) {
     const Eigen::Vector3f& p = (*points_)[static_cast<std::size_t>(i)].getVector3fMap();
-    for (int d = 0; d < 3; ++d)  // an axis about 0 was not moved: its -0 stays -0
-      (*positions_)(d, i) = origin[d] == 0.0 ? double{p[d]} : double{p[d]} + origin[d];
+    for (int d = 0; d < 3; ++d) (*positions_)(d, i) = restoredCoordinate(p[d], origin[d]);
   }
   held_ = Held::AsRead;
 }
@@ -199,7 +204,7 @@ bool ToolInput::rowsHoldTheFloats() const {
     const pcl::PointXYZ& p = (*points_)[static_cast<std::size_t>(i)];
     for (int d = 0; d < 3; ++d) {
       // As restoreFromFloats() would restore it: a float, and the row's to the bit.
-      const double restored = origin[d] == 0.0 ? double{p.data[d]} : double{p.data[d]} + origin[d];
+      const double restored = restoredCoordinate(p.data[d], origin[d]);
       const auto written = static_cast<float>(restored);
       if (double{written} != restored ||
           std::memcmp(&written, row + axes[d]->offset, sizeof written) != 0)
