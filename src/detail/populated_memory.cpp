@@ -2,6 +2,10 @@
 
 #include <sys/mman.h>
 
+#include <new>
+
+#include "pcl_ddg/large_array.h"
+
 // Linux 5.14's value; older C library headers do not name it, and older kernels refuse it (EINVAL).
 #ifndef MADV_POPULATE_WRITE
 #define MADV_POPULATE_WRITE 23
@@ -34,6 +38,16 @@ void* mapPopulated(std::size_t bytes, PageSize pages) {
 
 void unmapPopulated(void* block, std::size_t bytes) {
   munmap(block, bytes);
+}
+
+void* allocateLargeArray(std::size_t bytes) {
+  void* block = mapPopulated(bytes, PageSize::kHuge);
+  if (block == nullptr) throw std::bad_alloc();
+  return block;
+}
+
+void releaseLargeArray(void* block, std::size_t bytes) noexcept {
+  unmapPopulated(block, bytes);
 }
 
 }  // namespace detail

@@ -19,6 +19,7 @@ constexpr int kSmallestScale = 16;     ///< nested scales 16, 24, 32, 48, 64, 96
 constexpr int kAnchorNeighbours = 8;   ///< planes pass through the centroid of these
 constexpr int kSeedNeighbours = 6;     ///< planes through the query and two of these
 constexpr int kScoredNeighbours = 64;  ///< the least median of squares is over these nearest
+constexpr int kFewLargest = 8;  ///< a median this near the top of its residuals: no selection
 constexpr double kMadToSigma = 1.4826;
 constexpr double kBand = 3.0;           ///< inliers are within this many sigma-hat of the plane
 constexpr double kNoiseFloor = 1e-6;    ///< of the neighbourhood's radius
@@ -29,8 +30,8 @@ constexpr int kMaxRefinements = 5;
 constexpr double kConverged = 1e-5;  ///< normal change (radians) that ends the refinement
 
 struct Plane {
-  Eigen::Vector3d normal;
-  Eigen::Vector3d centroid;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
 };
 
 /** The median of |n . (x_i - c)| over the first count columns of x (element count / 2 of them
@@ -56,9 +57,24 @@ double medianResidualBelow(const Eigen::Matrix3Xd& x, int count, const Plane& pl
     if (!nan && under + (count - 1 - i) < needed) return std::numeric_limits<double>::infinity();
   }
   if (!nan) {
-    const auto middle = smaller.begin() + count / 2;
-    std::nth_element(smaller.begin(), middle, smaller.begin() + under);
-    return *middle;
+    // The median is the `largest`-th largest of them: few when the plane is about as good as the
+    // best so far (most planes that get here), found by insertion into a short descending list.
+    const int largest = under - count / 2;
+    if (largest > kFewLargest) {
+      const auto middle = smaller.begin() + count / 2;
+      std::nth_element(smaller.begin(), middle, smaller.begin() + under);
+      return *middle;
+    }
+    double top[kFewLargest];
+    int held = 0;
+    for (int i = 0; i < under; ++i) {
+      const double r = smaller[i];
+      if (held == largest && !(r > top[held - 1])) continue;
+      int at = held < largest ? held++ : held - 1;
+      for (; at > 0 && top[at - 1] < r; --at) top[at] = top[at - 1];
+      top[at] = r;
+    }
+    return top[largest - 1];
   }
   const auto middle = residuals.begin() + count / 2;
   std::nth_element(residuals.begin(), middle, residuals.end());
@@ -67,9 +83,11 @@ double medianResidualBelow(const Eigen::Matrix3Xd& x, int count, const Plane& pl
 
 using detail::PointMoments;
 
-/** Whether a point lies within band of the plane whose offset n . c is given. */
+/** Whether a point lies within band of the plane whose offset n . c is given. (|r| < band, not
+ *  |r / band| < 1: the same answer for every r and band, a correctly rounded quotient below 1
+ *  being the exact one's, without a division per point.) */
 bool inBand(const Plane& plane, double offset, const Eigen::Vector3d& point, double band) {
-  return std::abs((plane.normal.dot(point) - offset) / band) < 1.0;
+  return std::abs(plane.normal.dot(point) - offset) < band;
 }
 
 /** Moments of those of the first count columns of x within band of plane. */
@@ -101,33 +119,39 @@ class NestedQuadric {
         origin_(frame.centroid),
         scale_(scale) {}
 
-  /** Adds the columns begin .. end - 1 of x. The sums stay in locals over the range (as members
-   *  they went through memory at every point), and the whole outer product is added, whose
-   *  columns vectorize: its lower triangle, all that is read, is the same products added in the
-   *  same order as entry by entry. */
+  /** Adds the columns begin .. end - 1 of x: to each of the 21 sums of the normal matrix's lower
+   *  triangle (all the solver reads) a_i a_j, to the right side w a_i. The sums stay in locals over
+   *  the range (as an Eigen row built in memory and read back in pairs, each point stalled on the
+   *  store), in the order they were always added. */
   void add(const Eigen::Matrix3Xd& x, int begin, int end) {
-    Eigen::Matrix<double, 6, 6> products = normal_matrix_;
-    Row right = right_;
+    double sums[kLower], right[6];
+    for (int s = 0; s < kLower; ++s) sums[s] = lower_[s];
+    for (int i = 0; i < 6; ++i) right[i] = right_[i];
     double squares = squares_;
     for (int i = begin; i < end; ++i) {
       const Eigen::Vector3d d = (x.col(i) - origin_) / scale_;
       const double u = d.dot(t1_), v = d.dot(t2_), w = d.dot(normal_);
-      Row a;
-      a << u * u, u * v, v * v, u, v, 1.0;
-      products.noalias() += a * a.transpose();
-      right += w * a;
+      const double a[6] = {u * u, u * v, v * v, u, v, 1.0};
+      int s = 0;
+      for (int r = 0; r < 6; ++r)
+        for (int c = 0; c <= r; ++c) sums[s++] += a[r] * a[c];
+      for (int r = 0; r < 6; ++r) right[r] += w * a[r];
       squares += w * w;
     }
-    normal_matrix_ = products;
-    right_ = right;
+    for (int s = 0; s < kLower; ++s) lower_[s] = sums[s];
+    for (int i = 0; i < 6; ++i) right_[i] = right[i];
     squares_ = squares;
     count_ += end - begin;
   }
   /** Residual variance SSR / (m - 6) in length^2; NaN when the system is singular. */
   double variance() const {
     if (count_ <= 6) return std::numeric_limits<double>::quiet_NaN();
+    Eigen::Matrix<double, 6, 6> normal_matrix;
+    int s = 0;
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c <= r; ++c) normal_matrix(r, c) = lower_[s++];
     const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> solver(
-        normal_matrix_.selfadjointView<Eigen::Lower>());
+        normal_matrix.selfadjointView<Eigen::Lower>());
     if (solver.info() != Eigen::Success || !solver.isPositive())
       return std::numeric_limits<double>::quiet_NaN();
     const double residual = std::max(squares_ - right_.dot(solver.solve(right_)), 0.0);
@@ -138,7 +162,8 @@ class NestedQuadric {
   using Row = Eigen::Matrix<double, 6, 1>;
   Eigen::Vector3d t1_, t2_, normal_, origin_;
   double scale_;
-  Eigen::Matrix<double, 6, 6> normal_matrix_ = Eigen::Matrix<double, 6, 6>::Zero();
+  static constexpr int kLower = 21;  ///< entries (r, c <= r) of the 6 x 6 normal matrix, by row
+  double lower_[kLower] = {};
   Row right_ = Row::Zero();
   double squares_ = 0.0;
   int count_ = 0;
@@ -193,21 +218,36 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   //    neighbours as well as a quadric does, up to kScaleVariance (an F-test of the nested
   //    models): there the residual is noise, not curvature, and more neighbours only average it.
   //    Clean curved data keeps the smallest scale, noisy data nearly flat at its size all.
+  //    The quadric's sums at every scale first, then its variances from the largest scale down
+  //    to the first explained (noisy data solve one or two of the six systems, not all).
   int chosen = scales.empty() ? -1 : 0;
   bool smooth = false;  // the smallest scale is a smooth surface: a quadric explains it
   if (!scales.empty()) {
+    thread_local std::vector<NestedQuadric> prefixes;
+    prefixes.clear();
     NestedQuadric quadric(scales.back().plane, radius);
     int added = 0;
-    for (std::size_t j = 0; j < scales.size(); ++j) {
-      const int k = scales[j].k;
-      quadric.add(x, added, k);
-      added = k;
-      const double plane = scales[j].l0 * k / std::max(k - 3, 1);
-      const double fitted = quadric.variance();
-      if (std::isnan(fitted)) continue;  // no quadric: neither smooth nor explained by the plane
-      const double curved = std::max(fitted, floor * floor);
-      if (j == 0) smooth = curved < kSmooth * plane;
-      if (plane <= kScaleVariance * curved) chosen = static_cast<int>(j);
+    for (const Scale& scale : scales) {
+      quadric.add(x, added, scale.k);
+      added = scale.k;
+      prefixes.push_back(quadric);
+    }
+    // The plane's residual variance at scale j and the quadric's (NaN: no quadric, so neither
+    // smooth nor explained by the plane).
+    const auto planeVariance = [&](std::size_t j) {
+      return scales[j].l0 * scales[j].k / std::max(scales[j].k - 3, 1);
+    };
+    const auto curvedVariance = [&](std::size_t j) {
+      const double fitted = prefixes[j].variance();
+      return std::isnan(fitted) ? fitted : std::max(fitted, floor * floor);
+    };
+    const double smallest = curvedVariance(0);
+    smooth = smallest < kSmooth * planeVariance(0);
+    for (std::size_t j = scales.size(); j-- > 0;) {
+      if (planeVariance(j) <= kScaleVariance * (j == 0 ? smallest : curvedVariance(j))) {
+        chosen = static_cast<int>(j);
+        break;
+      }
     }
   }
   const int used = chosen < 0 ? count : scales[chosen].k;

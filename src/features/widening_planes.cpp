@@ -7,6 +7,7 @@
 
 #include "pcl_ddg/features/plane_fit.h"
 #include "pcl_ddg/features/spatial_order.h"
+#include "pcl_ddg/large_array.h"
 #include "point_moments.h"
 
 namespace pcl_ddg {
@@ -19,7 +20,7 @@ using detail::PointMoments;
  *  as its moments of the previous level. */
 PointMoments sumOverRow(const Eigen::Vector3d& at, const int* row, int width,
                         const std::vector<Eigen::Vector3d>& nodes,
-                        const std::vector<PointMoments>* previous) {
+                        const detail::LargeArray<PointMoments>* previous) {
   static const PointMoments kPoint{1.0};
   PointMoments sum;
   for (int n = 0; n < width; ++n) {
@@ -27,6 +28,30 @@ PointMoments sumOverRow(const Eigen::Vector3d& at, const int* row, int width,
     if (j >= 0) sum.addMoved(previous ? (*previous)[j] : kPoint, nodes[j] - at);
   }
   return sum;
+}
+
+/** rows[r] = (the rows as given)[order[r]] for each row of width entries, order a permutation:
+ *  in place (the graph is the largest array here), following each cycle of the permutation once
+ *  with one row held aside. */
+template <typename Rows>
+void gatherRows(Rows& rows, int width, const std::vector<int>& order) {
+  std::vector<char> placed(order.size(), 0);
+  std::vector<typename Rows::value_type> held(static_cast<std::size_t>(width));
+  const auto row = [&](std::size_t r) { return rows.begin() + r * width; };
+  for (std::size_t start = 0; start < order.size(); ++start) {
+    if (placed[start]) continue;
+    std::copy_n(row(start), width, held.begin());
+    for (std::size_t r = start;;) {
+      placed[r] = 1;
+      const auto from = static_cast<std::size_t>(order[r]);
+      if (from == start) {
+        std::copy_n(held.begin(), width, row(r));
+        break;
+      }
+      std::copy_n(row(from), width, row(r));
+      r = from;
+    }
+  }
 }
 
 /** U_l of a row (widening_planes.h): the farthest its members' own reach extends along the row,
@@ -46,7 +71,7 @@ double rowReach(const Eigen::Vector3f& at, const int* row, int width,
 }  // namespace
 
 std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
-                                    const NeighbourGraph& node_graph,
+                                    NeighbourGraph node_graph,
                                     const std::vector<Eigen::Vector3d>& queries,
                                     const std::vector<int>& query_nodes,
                                     const NeighbourGraph& query_graph,
@@ -61,19 +86,18 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
   const int width = node_graph.width;
   std::vector<Eigen::Vector3d> at(nodes.size());
   std::vector<Eigen::Vector3f> searched_at(search_points ? nodes.size() : 0);
-  std::vector<int> rows(node_graph.neighbours.size());
   for (std::size_t r = 0; r < order.size(); ++r) {
     at[r] = nodes[order[r]];
     if (search_points) searched_at[r] = (*search_points)[order[r]];
-    for (int n = 0; n < width; ++n) {
-      const int j = node_graph.neighbours[static_cast<std::size_t>(order[r]) * width + n];
-      rows[r * width + n] = j < 0 ? -1 : rank[j];
-    }
   }
+  detail::LargeArray<int>& rows = node_graph.neighbours;  // renumbered and reordered where they are
+  for (int& j : rows)
+    if (j >= 0) j = rank[j];
+  gatherRows(rows, width, order);
   // Rows of the queries that are not nodes (none where every query is one).
   const bool all_nodes =
       std::all_of(query_nodes.begin(), query_nodes.end(), [](int node) { return node >= 0; });
-  std::vector<int> query_rows(all_nodes ? 0 : query_graph.neighbours.size());
+  detail::LargeArray<int> query_rows(all_nodes ? 0 : query_graph.neighbours.size());
   for (std::size_t i = 0; i < query_rows.size(); ++i)
     query_rows[i] = query_graph.neighbours[i] < 0 ? -1 : rank[query_graph.neighbours[i]];
 
@@ -86,16 +110,17 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
   };
   std::stable_sort(visit.begin(), visit.end(), [&](int a, int b) { return key(a) < key(b); });
   std::vector<WidePlane> kept(queries.size());
-  std::vector<double> reference(queries.size());      // lambda0 of level kFirstWideLevel - 1
-  std::vector<char> stopped(queries.size(), 0);       // a level's residual was too large
-  std::vector<PointMoments> level_moments, previous;  // A_l and A_{l-1} of the nodes
-  std::vector<double> level_reach, previous_reach;    // U_l and U_{l-1} (search_points given)
+  std::vector<double> reference(queries.size());  // lambda0 of level kFirstWideLevel - 1
+  std::vector<char> stopped(queries.size(), 0);   // a level's residual was too large
+  using Moments = detail::LargeArray<PointMoments>;
+  Moments level_moments, previous;                  // A_l and A_{l-1} of the nodes
+  std::vector<double> level_reach, previous_reach;  // U_l and U_{l-1} (search_points given)
   for (int level = 0; level < kWideLevels; ++level) {
     std::swap(previous, level_moments);
     std::swap(previous_reach, level_reach);
     level_moments.resize(at.size());
     level_reach.resize(searched_at.size());
-    const std::vector<PointMoments>* below = level == 0 ? nullptr : &previous;
+    const Moments* below = level == 0 ? nullptr : &previous;
     const std::vector<double>* reach_below = level == 0 ? nullptr : &previous_reach;
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (std::ptrdiff_t r = 0; r < static_cast<std::ptrdiff_t>(at.size()); ++r) {
@@ -141,9 +166,11 @@ std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
     }
     if (widening == 0) break;  // clean data: no plane widens, no need for the next level
   }
-  std::vector<WidePlane> planes(queries.size());
-  for (std::size_t v = 0; v < visit.size(); ++v) planes[visit[v]] = kept[v];
-  return planes;
+  // Back to the queries' order: kept[q] = kept[v] of the v that visited q.
+  std::vector<int> visited_at(visit.size());
+  for (std::size_t v = 0; v < visit.size(); ++v) visited_at[visit[v]] = static_cast<int>(v);
+  gatherRows(kept, 1, visited_at);
+  return kept;
 }
 
 }  // namespace pcl_ddg

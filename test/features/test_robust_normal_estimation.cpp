@@ -20,6 +20,7 @@
 #include "pcl_ddg/features/robust_normal_estimation.h"
 #include "pcl_ddg/features/robust_plane_fit.h"
 #include "pcl_ddg/features/widening_planes.h"
+#include "pcl_ddg/large_array.h"
 
 namespace pcl_ddg {
 namespace test {
@@ -760,6 +761,23 @@ TEST(WidestPlanes, EqualTheSumsOfWalksOverTheGraphComputedByBruteForce) {
   EXPECT_GT(none, n / 10);
   EXPECT_GT(some, n / 20);
   EXPECT_GT(widest, 10);
+}
+
+// The graph's rows and the levels' moments live in LargeArray: a block of a huge page or more is
+// a mapping of its own, a smaller one the heap's; growing across the boundary and moving keep
+// every value, and a new array is zero-filled either way.
+TEST(LargeArray, KeepsItsValuesAcrossTheHugePageBoundary) {
+  const std::size_t boundary = detail::kLargeArrayBytes / sizeof(int);
+  for (const std::size_t size : {boundary - 1, boundary, 3 * boundary + 5}) {
+    detail::LargeArray<int> values(size);
+    EXPECT_TRUE(std::all_of(values.begin(), values.end(), [](int v) { return v == 0; }));
+    for (std::size_t i = 0; i < size; ++i) values[i] = static_cast<int>(i * 7 + 1);
+    values.resize(size + boundary);  // across the boundary (from below it) or further above
+    detail::LargeArray<int> moved = std::move(values);
+    for (std::size_t i = 0; i < size; ++i) ASSERT_EQ(moved[i], static_cast<int>(i * 7 + 1)) << i;
+    EXPECT_TRUE(std::all_of(moved.begin() + static_cast<std::ptrdiff_t>(size), moved.end(),
+                            [](int v) { return v == 0; }));
+  }
 }
 
 }  // namespace

@@ -29,13 +29,15 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "pcl_ddg/large_array.h"
+
 namespace pcl_ddg {
 
 /** Neighbour lists of a fixed width, row-major: node i's are neighbours[i * width + n], -1 for
  *  none. */
 struct NeighbourGraph {
   int width = 0;
-  std::vector<int> neighbours;
+  detail::LargeArray<int> neighbours;
 };
 
 /** Levels 0 .. kWideLevels - 1 are formed; the first kFirstWideLevel only lead up to the rest,
@@ -63,10 +65,11 @@ struct WidePlane {
  * same bits on any number of threads, and a node's sums depend only on the nodes its walks reach.
  * largest_reference[q]: the most residual variance the reference level of query q may have for any
  * level to be kept (-1: none). search_points (optional): the nodes' coordinates in which their rows
- * were searched (the cloud's floats); given, each plane carries its reach.
+ * were searched (the cloud's floats); given, each plane carries its reach. node_graph is taken
+ * by value: moved in, its rows are renumbered in place rather than copied.
  */
 std::vector<WidePlane> widestPlanes(const std::vector<Eigen::Vector3d>& nodes,
-                                    const NeighbourGraph& node_graph,
+                                    NeighbourGraph node_graph,
                                     const std::vector<Eigen::Vector3d>& queries,
                                     const std::vector<int>& query_nodes,
                                     const NeighbourGraph& query_graph,

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <numeric>
 #include <utility>
 
 #include "pcl_ddg/features/robust_normal_estimation.h"
@@ -79,28 +80,45 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
     nodes[j] = pcl::isXYZFinite(surface[j])
                    ? absolute(surface[j], static_cast<pcl::index_t>(j))
                    : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
-  std::vector<Eigen::Vector3d> queries(indices.size());
-  for (std::size_t i = 0; i < indices.size(); ++i)
-    queries[i] = absolute(input[indices[i]], indices[i]);
+  // Every point of the cloud queried in its own order (the usual call): the queries are the nodes
+  // and their rows the nodes' rows, taken over rather than copied (13 MB per 100k points, on a
+  // fresh machine a page fault per 4 kB of them).
+  const bool nodes_in_order =
+      this->surface_ == this->input_ && indices.size() == surface.size() &&
+      std::all_of(indices.begin(), indices.end(),
+                  [i = pcl::index_t{0}](pcl::index_t index) mutable { return index == i++; });
+  std::vector<Eigen::Vector3d> queries;
+  if (!nodes_in_order) {
+    queries.resize(indices.size());
+    for (std::size_t i = 0; i < indices.size(); ++i)
+      queries[i] = absolute(input[indices[i]], indices[i]);
+  }
 
   // The nodes' rows: on the input itself a query is its node and brings its row; the other
   // nodes (all of a separate search surface) search for theirs.
   const std::size_t width = kWideGraphWidth;
   NeighbourGraph node_graph;
   node_graph.width = kWideGraphWidth;
-  node_graph.neighbours.assign(surface.size() * width, -1);
   std::vector<char> has_row(surface.size(), 0);
   std::vector<int> query_nodes(indices.size(), -1);
-  if (this->surface_ == this->input_) {
-    for (std::size_t i = 0; i < indices.size(); ++i) {
-      const pcl::index_t node = indices[i];
-      query_nodes[i] = node;
-      if (has_row[node]) continue;
-      has_row[node] = 1;
-      std::copy_n(query_graph.neighbours.begin() + i * width, width,
-                  node_graph.neighbours.begin() + static_cast<std::size_t>(node) * width);
+  if (nodes_in_order) {
+    std::iota(query_nodes.begin(), query_nodes.end(), 0);
+    std::fill(has_row.begin(), has_row.end(), 1);
+    node_graph = std::move(query_graph);
+    query_graph = NeighbourGraph();
+  } else {
+    node_graph.neighbours.assign(surface.size() * width, -1);
+    if (this->surface_ == this->input_) {
+      for (std::size_t i = 0; i < indices.size(); ++i) {
+        const pcl::index_t node = indices[i];
+        query_nodes[i] = node;
+        if (has_row[node]) continue;
+        has_row[node] = 1;
+        std::copy_n(query_graph.neighbours.begin() + i * width, width,
+                    node_graph.neighbours.begin() + static_cast<std::size_t>(node) * width);
+      }
+      query_graph = NeighbourGraph();  // every query is a node: its rows are no longer needed
     }
-    query_graph = NeighbourGraph();  // every query is a node: its rows are no longer needed
   }
   detail::InterruptionPoll interruption;
 #pragma omp parallel num_threads(threads)
@@ -127,8 +145,8 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
     for (std::size_t j = 0; j < surface.size(); ++j) searched[j] = surface[j].getVector3fMap();
   }
   const std::vector<WidePlane> planes =
-      widestPlanes(nodes, node_graph, queries, query_nodes, query_graph, largest_reference, threads,
-                   report_reaches_ ? &searched : nullptr);
+      widestPlanes(nodes, std::move(node_graph), nodes_in_order ? nodes : queries, query_nodes,
+                   query_graph, largest_reference, threads, report_reaches_ ? &searched : nullptr);
   const std::int64_t finite =
       cloud_points_ > 0 ? cloud_points_
                         : std::count_if(surface.begin(), surface.end(),
