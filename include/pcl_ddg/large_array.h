@@ -5,9 +5,9 @@
  *
  * A fresh 4 KiB page costs a fault, and in a VM the fault goes through the hypervisor: 11-18 us
  * a page on a freshly booted 2-core VM, more than filling it. A block of at least one huge page
- * (2 MiB) is mapped, advised for huge pages and populated in one call; smaller ones come from the
- * heap. Where the kernel gives no huge pages (THP "never"), the block is populated in 4 KiB pages
- * in that one call.
+ * (2 MiB) is mapped from a huge page's boundary, advised for huge pages and populated in one
+ * call; smaller ones come from the heap. Where the kernel gives no huge pages (THP "never"), the
+ * one call populates 4 KiB pages. Where hugePagesAllowed() says no, every block is the heap's.
  */
 #include <cstddef>
 #include <memory>
@@ -16,11 +16,17 @@
 namespace pcl_ddg {
 namespace detail {
 
-/** The smallest block allocateLargeArray maps rather than takes from the heap. */
+/** The smallest block allocateLargeArray takes. */
 constexpr std::size_t kLargeArrayBytes = std::size_t{2} << 20;
 
-/** A zero-filled block of bytes >= kLargeArrayBytes on huge pages, populated; throws
- *  std::bad_alloc when the memory cannot be had. */
+/** Whether this process asks for huge pages (large arrays here, the tools' heap in
+ *  tools/common/huge_pages.h): not in a sanitizer build (whose checks do not see mapped blocks),
+ *  not under valgrind, not with the environment variable PCL_DDG_HUGE_PAGES=0. Read once, at the
+ *  first call, and the same for the rest of the process. */
+bool hugePagesAllowed();
+
+/** A block of bytes >= kLargeArrayBytes: mapped on huge pages and populated, or the heap's where
+ *  hugePagesAllowed() says no; throws std::bad_alloc when the memory cannot be had. */
 void* allocateLargeArray(std::size_t bytes);
 
 /** Releases a block of allocateLargeArray(bytes). */

@@ -20,9 +20,10 @@ enum class PageSize {
 };
 
 /** A private anonymous mapping of `bytes` (> 0), zero-filled, its pages populated before it
- *  returns: MAP_POPULATE for small pages; for huge pages the advice first, then
- *  MADV_POPULATE_WRITE, or MAP_POPULATE's small pages on a kernel without it (before 5.14).
- *  nullptr if the memory cannot be had. Release it with unmapPopulated(block, bytes). */
+ *  returns: MAP_POPULATE for small pages; for huge pages a mapping from a huge page's boundary,
+ *  the advice first, then MADV_POPULATE_WRITE, or MAP_POPULATE's small pages on a kernel without
+ *  it (before 5.14). nullptr, errno set, if the memory cannot be had. Release it with
+ *  unmapPopulated(block, bytes). */
 void* mapPopulated(std::size_t bytes, PageSize pages);
 
 /** Releases a block of mapPopulated(bytes, ...). */

@@ -84,8 +84,8 @@ double medianResidualBelow(const Eigen::Matrix3Xd& x, int count, const Plane& pl
 using detail::PointMoments;
 
 /** Whether a point lies within band of the plane whose offset n . c is given. (|r| < band, not
- *  |r / band| < 1: the same answer for every r and band, a correctly rounded quotient below 1
- *  being the exact one's, without a division per point.) */
+ *  |r / band| < 1: the same answer for every r and every band >= 0 or NaN, all this file passes, a
+ * correctly rounded quotient below 1 being the exact one's, without a division per point.) */
 bool inBand(const Plane& plane, double offset, const Eigen::Vector3d& point, double band) {
   return std::abs(plane.normal.dot(point) - offset) < band;
 }

@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <random>
@@ -764,13 +765,17 @@ TEST(WidestPlanes, EqualTheSumsOfWalksOverTheGraphComputedByBruteForce) {
 }
 
 // The graph's rows and the levels' moments live in LargeArray: a block of a huge page or more is
-// a mapping of its own, a smaller one the heap's; growing across the boundary and moving keep
+// a mapping of its own (the heap's where huge pages are not allowed: sanitizer builds), a smaller
+// one the heap's; growing across the boundary and moving keep
 // every value, and a new array is zero-filled either way.
 TEST(LargeArray, KeepsItsValuesAcrossTheHugePageBoundary) {
   const std::size_t boundary = detail::kLargeArrayBytes / sizeof(int);
   for (const std::size_t size : {boundary - 1, boundary, 3 * boundary + 5}) {
     detail::LargeArray<int> values(size);
     EXPECT_TRUE(std::all_of(values.begin(), values.end(), [](int v) { return v == 0; }));
+    // A mapped block starts on a huge page's boundary: only whole aligned 2 MiB spans get one.
+    if (detail::hugePagesAllowed() && size * sizeof(int) >= detail::kLargeArrayBytes)
+      EXPECT_EQ(reinterpret_cast<std::uintptr_t>(values.data()) % detail::kLargeArrayBytes, 0u);
     for (std::size_t i = 0; i < size; ++i) values[i] = static_cast<int>(i * 7 + 1);
     values.resize(size + boundary);  // across the boundary (from below it) or further above
     detail::LargeArray<int> moved = std::move(values);

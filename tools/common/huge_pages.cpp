@@ -14,24 +14,13 @@
 #include <system_error>
 #include <vector>
 
+#include "pcl_ddg/large_array.h"
+
 namespace pcl_ddg {
 namespace tools {
 namespace {
 
 constexpr std::uintmax_t kLargeInputBytes = std::uintmax_t{32} << 20;
-
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr bool kSanitizerAllocator = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
-    __has_feature(memory_sanitizer)
-constexpr bool kSanitizerAllocator = true;
-#else
-constexpr bool kSanitizerAllocator = false;
-#endif
-#else
-constexpr bool kSanitizerAllocator = false;
-#endif
 
 /** This process's arguments, argv[0] included, as the kernel holds them (also right when the
  *  tool was started through the dynamic loader, which /proc/self/exe then is). */
@@ -106,18 +95,16 @@ std::string ownExecutable() {
 }  // namespace
 
 void restartOnHugePagesForLargeInputs() {
-  if (kSanitizerAllocator) return;
-  const char* tunables_now = std::getenv("GLIBC_TUNABLES");
-  const char* wanted = std::getenv("PCL_DDG_HUGE_PAGES");
-  if (contains(tunables_now, "glibc.malloc.hugetlb") ||
-      (wanted != nullptr && std::strcmp(wanted, "0") == 0) ||
-      contains(std::getenv("LD_PRELOAD"), "vgpreload")) {
-    return;
-  }
   std::vector<std::string> arguments = ownArguments();
   for (const std::string& argument : arguments) {
-    if (argument == "-memory") return;
+    // A budget measured in 4 KiB pages: the library's large arrays too stay on them.
+    if (argument == "-memory") {
+      setenv("PCL_DDG_HUGE_PAGES", "0", 1);
+      return;
+    }
   }
+  const char* tunables_now = std::getenv("GLIBC_TUNABLES");
+  if (!detail::hugePagesAllowed() || contains(tunables_now, "glibc.malloc.hugetlb")) return;
   if (arguments.empty() || !largeInputs(arguments) || !tunableTakesEffect()) return;
   const bool had_tunables = tunables_now != nullptr;
   const std::string tunables = had_tunables ? tunables_now : "";  // a copy: setenv may move it

@@ -17,11 +17,12 @@ namespace tools {
  * to GLIBC_TUNABLES when the regular files among its arguments, and those directly inside the
  * folders among them, hold at least 32 MiB. Returns without doing so, and the tool runs as it is:
  * when they hold less (a second start costs more than huge pages save on a small file); when the
- * tunable would do nothing (glibc before 2.35, the kernel's THP not in "madvise" mode, a
- * sanitizer's allocator); when GLIBC_TUNABLES already names glibc.malloc.hugetlb (the user's
- * choice, and the restarted process itself); when PCL_DDG_HUGE_PAGES=0; with -memory (a budget
- * measured in 4 KiB pages); under valgrind (whose tool would not follow the exec); or when the
- * exec fails.
+ * tunable would do nothing (glibc before 2.35, the kernel's THP not in "madvise" mode); when
+ * GLIBC_TUNABLES already names glibc.malloc.hugetlb (the user's choice, and the restarted process
+ * itself); where detail::hugePagesAllowed() says no (a sanitizer build, valgrind, whose tool would
+ * not follow the exec, or PCL_DDG_HUGE_PAGES=0); or when the exec fails. With -memory (a budget
+ * measured in 4 KiB pages) it sets PCL_DDG_HUGE_PAGES=0, so the library's large arrays
+ * (pcl_ddg/large_array.h) stay on 4 KiB pages too; call it before any of them is made.
  */
 void restartOnHugePagesForLargeInputs();
 

@@ -83,10 +83,9 @@ void RobustNormalEstimation<PointInT, PointOutT>::widen(
   // Every point of the cloud queried in its own order (the usual call): the queries are the nodes
   // and their rows the nodes' rows, taken over rather than copied (13 MB per 100k points, on a
   // fresh machine a page fault per 4 kB of them).
-  const bool nodes_in_order =
-      this->surface_ == this->input_ && indices.size() == surface.size() &&
-      std::all_of(indices.begin(), indices.end(),
-                  [i = pcl::index_t{0}](pcl::index_t index) mutable { return index == i++; });
+  bool nodes_in_order = this->surface_ == this->input_ && indices.size() == surface.size();
+  for (std::size_t i = 0; nodes_in_order && i < indices.size(); ++i)
+    nodes_in_order = indices[i] == static_cast<pcl::index_t>(i);
   std::vector<Eigen::Vector3d> queries;
   if (!nodes_in_order) {
     queries.resize(indices.size());
