@@ -90,12 +90,17 @@ bool inBand(const Plane& plane, double offset, const Eigen::Vector3d& point, dou
   return std::abs(plane.normal.dot(point) - offset) < band;
 }
 
-/** Moments of those of the first count columns of x within band of plane. */
-PointMoments within(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double band) {
+/** Moments of those of the first count columns of x within band of plane; inside[i] says
+ *  whether column i is one of them. */
+PointMoments within(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double band,
+                    std::vector<char>& inside) {
   PointMoments m;
+  inside.resize(static_cast<std::size_t>(count));
   const double offset = plane.normal.dot(plane.centroid);
-  for (int i = 0; i < count; ++i)
-    if (inBand(plane, offset, x.col(i), band)) m.add(x.col(i));
+  for (int i = 0; i < count; ++i) {
+    inside[i] = inBand(plane, offset, x.col(i), band);
+    if (inside[i]) m.add(x.col(i));
+  }
   return m;
 }
 
@@ -177,17 +182,29 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
 
   // Buffers reused by each thread's next neighbourhood: a fit takes microseconds.
   thread_local std::vector<std::pair<double, int>> by_distance;
-  thread_local Eigen::Matrix3Xd x;
+  thread_local Eigen::Matrix3Xd sorted;
   thread_local std::vector<double> residuals, smaller;
-  // The neighbours nearest first (k-d tree searches give them so; ties keep their order).
-  by_distance.resize(static_cast<std::size_t>(count));
-  for (int i = 0; i < count; ++i) by_distance[i] = {points.col(i).squaredNorm(), i};
-  const auto nearer = [](const auto& a, const auto& b) { return a.first < b.first; };
-  if (!std::is_sorted(by_distance.begin(), by_distance.end(), nearer))
-    std::stable_sort(by_distance.begin(), by_distance.end(), nearer);
-  x.resize(3, count);
-  for (int i = 0; i < count; ++i) x.col(i) = points.col(by_distance[i].second);
-  const double radius = std::sqrt(by_distance.back().first);
+  thread_local std::vector<char> inside, was_inside;
+  // The neighbours nearest first: as given when they are (k-d tree searches give them so), else
+  // a sorted copy (ties keep their order).
+  double farthest = points.col(0).squaredNorm();
+  int in_order = 1;
+  for (; in_order < count; ++in_order) {
+    const double distance = points.col(in_order).squaredNorm();
+    if (distance < farthest) break;
+    farthest = distance;
+  }
+  if (in_order < count) {
+    by_distance.resize(static_cast<std::size_t>(count));
+    for (int i = 0; i < count; ++i) by_distance[i] = {points.col(i).squaredNorm(), i};
+    std::stable_sort(by_distance.begin(), by_distance.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    sorted.resize(3, count);
+    for (int i = 0; i < count; ++i) sorted.col(i) = points.col(by_distance[i].second);
+    farthest = by_distance.back().first;
+  }
+  const Eigen::Matrix3Xd& x = in_order < count ? sorted : points;
+  const double radius = std::sqrt(farthest);
   const double floor = kNoiseFloor * radius;
 
   // 1. Nested least-squares planes, through the centroid of the nearest few (near the surface:
@@ -290,12 +307,20 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
   if (!std::isfinite(best_median)) return result;
 
   // 4. Noise scale and band, then the least-squares plane of the scale's neighbours within the
-  //    band, until it settles.
+  //    band, until it settles. The same points within the band as the last plane's give the same
+  //    sums, so the same plane again: it has settled (and its inliers are counted).
   result.noise = std::max(kMadToSigma * best_median, floor);
   const double band = kBand * result.noise;
   result.surface_variation = std::numeric_limits<double>::quiet_NaN();
+  int inliers = -1;
+  was_inside.clear();
   for (int iteration = 0; iteration < kMaxRefinements; ++iteration) {
-    const PointMoments m = within(x, used, plane, band);
+    const PointMoments m = within(x, used, plane, band, inside);
+    if (inside == was_inside) {
+      inliers = m.count();
+      break;
+    }
+    std::swap(inside, was_inside);
     if (m.count() < 3) break;
     const Eigen::Matrix3d covariance = m.covariance();
     const PlaneNormal fit = fitPlaneNormal(covariance);
@@ -316,7 +341,7 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
     result.surface_variation = fit.surface_variation;
     result.residual = fit.eigenvalues[0] * all.count() / std::max(all.count() - 3, 1);
   }
-  const int inliers = countWithin(x, used, plane, band);
+  if (inliers < 0) inliers = countWithin(x, used, plane, band);
   result.normal = plane.normal;
   result.centroid = plane.centroid;
   result.scale = inliers;

@@ -17,7 +17,10 @@
 #   --reuse DIR     use the scratch folder a --keep run left (its build is updated incrementally)
 #   --in-place DIR  no copy: mutate the repository itself and rebuild DIR (a configured, built
 #                   Release build of it, tests and tools ON) incrementally; each file is restored
-#                   after its mutant, and DIR's targets are rebuilt unmutated at the end (CI)
+#                   after its mutant, and DIR's targets are rebuilt unmutated at the end
+#   --no-rebuild    with --in-place: DIR's mutated targets are left to the next build (whose
+#                   sources are restored and newer) instead of rebuilt at the end (CI's last step:
+#                   a mutant of a header the estimators include costs minutes of rebuilding)
 #   --pick N        run N mutants chosen from the commit hash (git rev-parse HEAD) among the
 #                   selected ones: each commit checks another pair, the same pair on every rerun
 #
@@ -57,6 +60,7 @@ jobs=$(nproc 2>/dev/null || echo 2)
 check_only=0
 all_tests=0
 in_place=""
+rebuild_after=1
 pick=0
 timeout_override=""
 report=""
@@ -64,7 +68,7 @@ keep=0
 reuse=""
 selected=()
 
-usage() { sed -n '2,17p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,/^# How it runs:/p' "${BASH_SOURCE[0]}" | sed '$d; s/^# \{0,1\}//'; }
 die() { echo "run_mutants: $*" >&2; exit 2; }
 
 while (($#)); do
@@ -79,6 +83,7 @@ while (($#)); do
     --keep) keep=1; shift ;;
     --reuse) [[ $# -ge 2 ]] || die "--reuse needs a folder"; reuse=$2; keep=1; shift 2 ;;
     --in-place) [[ $# -ge 2 ]] || die "--in-place needs a build folder"; in_place=$2; shift 2 ;;
+    --no-rebuild) rebuild_after=0; shift ;;
     --pick) [[ $# -ge 2 && $2 =~ ^[1-9][0-9]*$ ]] || die "--pick needs a number"; pick=$2; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     -*) usage >&2; die "unknown option $1" ;;
@@ -229,7 +234,7 @@ restore_current() {
 }
 cleanup() {
   restore_current
-  if [[ -n $in_place && -s $scratch/rebuild ]]; then
+  if [[ -n $in_place ]] && ((rebuild_after)) && [[ -s $scratch/rebuild ]]; then
     # The mutated targets, built again from the restored sources.
     # shellcheck disable=SC2046
     cmake --build "$build" -j"$jobs" --target $(sort -u "$scratch/rebuild") > "$logs/restore.log" 2>&1 ||

@@ -55,8 +55,9 @@ void expectSameBits(const std::vector<float>& a, const std::vector<float>& b) {
   EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
 }
 
-void expectTiledEqualsWhole(const LocalCloud& cloud, const LocalFitOptions& options,
-                            std::int64_t tile_points, TilingReport* report = nullptr) {
+/** The whole cloud's fit, which the tiled one is checked against. */
+LocalFitResult expectTiledEqualsWhole(const LocalCloud& cloud, const LocalFitOptions& options,
+                                      std::int64_t tile_points, TilingReport* report = nullptr) {
   const LocalFitResult whole = fitLocalSurfaces(cloud, nullptr, options);
   TilingOptions tiling;
   tiling.max_points_per_tile = tile_points;
@@ -70,6 +71,7 @@ void expectTiledEqualsWhole(const LocalCloud& cloud, const LocalFitOptions& opti
   expectSameBits(tiled.scales, whole.scales);
   expectSameBits(tiled.confidences, whole.confidences);
   if (report) *report = local;
+  return whole;
 }
 
 TEST(TiledLocalFit, PCAOnEverySharedCloudEqualsTheWholeCloudBitForBit) {
@@ -136,8 +138,7 @@ TEST(TiledLocalFit, RobustWithItsWiderPlanesEqualsTheWholeCloudBitForBit) {
   robust.k = 96;
   robust.viewpoint = Eigen::Vector3d(512350.0, 4212350.0, 200.0);
   TilingReport report;
-  expectTiledEqualsWhole(roof, robust, 3000, &report);
-  const LocalFitResult whole = fitLocalSurfaces(roof, nullptr, robust);
+  const LocalFitResult whole = expectTiledEqualsWhole(roof, robust, 3000, &report);
   EXPECT_GT(widened(whole, robust.k), static_cast<std::size_t>(n) / 2);
   EXPECT_GT(report.widest_halo, 1.0);  // the rows' reach, several times the 96 nearest's radius
   std::printf(
