@@ -10,6 +10,7 @@
 
 #include "pcl_ddg/features/plane_fit.h"
 #include "point_moments.h"
+#include "vector_lanes.h"
 
 namespace pcl_ddg {
 
@@ -112,6 +113,46 @@ int countWithin(const Eigen::Matrix3Xd& x, int count, const Plane& plane, double
   return inside;
 }
 
+/** A quadric's frame: origin, then t1, t2, n (NestedQuadric). */
+struct Frame {
+  double origin[3], t1[3], t2[3], n[3];
+};
+
+/** To each of the 21 sums of a quadric's normal matrix's lower triangle (all its solver reads)
+ *  a_i a_j, to the right side w a_i and to the squares w^2, over columns begin .. end - 1 of the
+ *  3 x n matrix x, a = (u^2, uv, v^2, u, v, 1) and (u, v, w) = (x - origin) / scale in the frame.
+ *  The sums stay in locals over the range (as an Eigen row built in memory and read back in pairs,
+ *  each point stalled on the store), in the order they were always added; a free function so
+ *  that it compiles for AVX2 too (vector_lanes.h: the same roundings). The dot products are
+ *  (a0 b0 + a1 b1) + a2 b2, as Eigen forms them. */
+PCL_DDG_WIDE_LANES void addQuadricTerms(const double* x, int begin, int end, const Frame& frame,
+                                        double scale, double* lower, double* right_side,
+                                        double& squares_sum) {
+  constexpr int kLower = 21;
+  double sums[kLower], right[6];
+  for (int s = 0; s < kLower; ++s) sums[s] = lower[s];
+  for (int i = 0; i < 6; ++i) right[i] = right_side[i];
+  double squares = squares_sum;
+  const auto dot = [](const double* a, const double* b) {
+    return (a[0] * b[0] + a[1] * b[1]) + a[2] * b[2];
+  };
+  for (int i = begin; i < end; ++i) {
+    const double* p = x + 3 * static_cast<std::ptrdiff_t>(i);
+    const double d[3] = {(p[0] - frame.origin[0]) / scale, (p[1] - frame.origin[1]) / scale,
+                         (p[2] - frame.origin[2]) / scale};
+    const double u = dot(d, frame.t1), v = dot(d, frame.t2), w = dot(d, frame.n);
+    const double a[6] = {u * u, u * v, v * v, u, v, 1.0};
+    int s = 0;
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c <= r; ++c) sums[s++] += a[r] * a[c];
+    for (int r = 0; r < 6; ++r) right[r] += w * a[r];
+    squares += w * w;
+  }
+  for (int s = 0; s < kLower; ++s) lower[s] = sums[s];
+  for (int i = 0; i < 6; ++i) right_side[i] = right[i];
+  squares_sum = squares;
+}
+
 /** The least-squares height-field quadric w = a u^2 + b uv + c v^2 + d u + e v + f over the
  *  points added so far, in a fixed frame (u, v, w along t1, t2, n about origin, in units of
  *  scale): its residual sum of squares at any prefix of the nearest-first neighbours. */
@@ -124,28 +165,13 @@ class NestedQuadric {
         origin_(frame.centroid),
         scale_(scale) {}
 
-  /** Adds the columns begin .. end - 1 of x: to each of the 21 sums of the normal matrix's lower
-   *  triangle (all the solver reads) a_i a_j, to the right side w a_i. The sums stay in locals over
-   *  the range (as an Eigen row built in memory and read back in pairs, each point stalled on the
-   *  store), in the order they were always added. */
+  /** Adds the columns begin .. end - 1 of x (addQuadricTerms). */
   void add(const Eigen::Matrix3Xd& x, int begin, int end) {
-    double sums[kLower], right[6];
-    for (int s = 0; s < kLower; ++s) sums[s] = lower_[s];
-    for (int i = 0; i < 6; ++i) right[i] = right_[i];
-    double squares = squares_;
-    for (int i = begin; i < end; ++i) {
-      const Eigen::Vector3d d = (x.col(i) - origin_) / scale_;
-      const double u = d.dot(t1_), v = d.dot(t2_), w = d.dot(normal_);
-      const double a[6] = {u * u, u * v, v * v, u, v, 1.0};
-      int s = 0;
-      for (int r = 0; r < 6; ++r)
-        for (int c = 0; c <= r; ++c) sums[s++] += a[r] * a[c];
-      for (int r = 0; r < 6; ++r) right[r] += w * a[r];
-      squares += w * w;
-    }
-    for (int s = 0; s < kLower; ++s) lower_[s] = sums[s];
-    for (int i = 0; i < 6; ++i) right_[i] = right[i];
-    squares_ = squares;
+    const Frame frame{{origin_.x(), origin_.y(), origin_.z()},
+                      {t1_.x(), t1_.y(), t1_.z()},
+                      {t2_.x(), t2_.y(), t2_.z()},
+                      {normal_.x(), normal_.y(), normal_.z()}};
+    addQuadricTerms(x.data(), begin, end, frame, scale_, lower_, right_.data(), squares_);
     count_ += end - begin;
   }
   /** Residual variance SSR / (m - 6) in length^2; NaN when the system is singular. */

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 #include <random>
 #include <utility>
 #include <vector>
@@ -530,6 +531,46 @@ TEST(RobustPlaneFit, OnAGaussianNoisyPlaneSigmaHatIsTheNoiseAndThreeSigmaKeepNea
   EXPECT_GT(confidence, 0.985);
   EXPECT_LE(confidence, 1.0);
   EXPECT_NEAR(used, confidence * count, 1e-9 * count);  // the scale is the points kept
+}
+
+TEST(RobustPlaneFit, TheOrderTheNeighboursComeInDoesNotMatter) {
+  // The fit takes the neighbours nearest first (nested scales, the nearest few as anchor): a
+  // neighbourhood in another order (a mesh ring's, a radius search's) is the same neighbourhood.
+  // Noisy points near a ridge, nearest first as a k-d tree gives them, then shuffled: the same
+  // fit, bit for bit (distinct distances: no tie to order).
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int count = 96;
+    std::vector<std::pair<double, Eigen::Vector3d>> by_distance;
+    for (int i = 0; i < count; ++i) {
+      const double x = u(rng), y = u(rng);
+      const Eigen::Vector3d p(x, y, 0.6 * std::abs(x - 0.3) - 0.18 + noise(rng));
+      by_distance.push_back({p.squaredNorm(), p});
+    }
+    std::sort(by_distance.begin(), by_distance.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    Eigen::Matrix3Xd nearest_first(3, count);
+    for (int i = 0; i < count; ++i) nearest_first.col(i) = by_distance[i].second;
+    std::vector<int> order(count);
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), rng);
+    Eigen::Matrix3Xd shuffled(3, count);
+    for (int i = 0; i < count; ++i) shuffled.col(i) = nearest_first.col(order[i]);
+    const RobustPlaneFit a = fitRobustPlane(nearest_first, count);
+    const RobustPlaneFit b = fitRobustPlane(shuffled, count);
+    ASSERT_TRUE(a.valid) << trial;
+    ASSERT_TRUE(b.valid) << trial;
+    for (int d = 0; d < 3; ++d) {
+      EXPECT_EQ(a.normal[d], b.normal[d]) << trial;
+      EXPECT_EQ(a.centroid[d], b.centroid[d]) << trial;
+    }
+    EXPECT_EQ(a.scale, b.scale) << trial;
+    EXPECT_EQ(a.noise, b.noise) << trial;
+    EXPECT_EQ(a.residual, b.residual) << trial;
+    EXPECT_EQ(a.surface_variation, b.surface_variation) << trial;
+  }
 }
 
 TEST(RobustNormals, TheCurvatureIsTheSurfaceVariationOfThePointsOfTheFinalFit) {

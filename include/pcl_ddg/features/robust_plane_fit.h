@@ -52,7 +52,9 @@ struct RobustPlaneFit {
 };
 
 /** The robust plane of the first count columns of points, given relative to the query point
- *  (which is the origin; it may be among them). Invalid below 3 points or on one line. */
+ *  (which is the origin; it may be among them), in any order: they are taken nearest first (read
+ *  in place when they come so, as from a k-d tree; ties keep their order). Invalid below 3 points
+ *  or on one line. */
 RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count);
 
 }  // namespace pcl_ddg
