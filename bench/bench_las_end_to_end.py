@@ -8,6 +8,8 @@ with GPS time, intensity, classification and colour; 340 MB):
   library: pcl_ddg.read + estimate_normals(k=16, orient="up") + pcl_ddg.write(las=...)
            in one Python process (the same work through the library; timed inside, without the
            interpreter's start and import)
+  pcl_ddg_normals survey.pcd out.pcd -k 16       the same points as a float x y z PCD (about
+           their offset, as a PCL user stores them; 114 MiB), to a compressed PCD
 
 Each is a fresh process: its wall time, peak resident memory and minor page faults
 (/usr/bin/time -f '%M %R'), medians of the repetitions (default 3), run alternately so that a
@@ -86,7 +88,17 @@ def write_las(path, points, seed=50):
     with open(path, "wb") as out:
         out.write(header)
         out.write(records.tobytes())
-    return n
+    return n, exact - offset
+
+
+def write_pcd(path, xyz):
+    """A binary PCD of x y z as float32."""
+    n = len(xyz)
+    header = ("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+              f"WIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA binary\n")
+    with open(path, "wb") as out:
+        out.write(header.encode())
+        out.write(xyz.astype("<f4").tobytes())
 
 
 def main():
@@ -98,9 +110,13 @@ def main():
     print(machine_state())
     with tempfile.TemporaryDirectory(prefix="pcl_ddg_las_e2e_") as folder:
         survey = os.path.join(folder, "survey.las")
-        n = write_las(survey, points)
+        n, local = write_las(survey, points)
         size = os.path.getsize(survey) / 2**20
         print(f"{survey}: {n} points, point format 3, {size:.0f} MiB; {os.cpu_count()} cores")
+        survey_pcd = os.path.join(folder, "survey.pcd")
+        write_pcd(survey_pcd, local)
+        del local
+        sizes = {"pcl_ddg_normals survey.pcd -k 16": os.path.getsize(survey_pcd) / 2**20}
         tools = os.path.join(build, "tools")
         info = [os.path.join(tools, "pcl_ddg_info"), survey]
 
@@ -118,6 +134,9 @@ def main():
             "library read + fit + write": ([sys.executable, "-c", LIBRARY_JOB, survey,
                                             os.path.join(folder, "library.las"),
                                             os.path.join(build, "python")], huge_pages),
+            "pcl_ddg_normals survey.pcd -k 16": ([os.path.join(tools, "pcl_ddg_normals"),
+                                                  survey_pcd, os.path.join(folder, "tool.pcd"),
+                                                  "-k", "16"], huge_pages),
         }
         runs = {name: [] for name in jobs}
         for repetition in range(repetitions):
@@ -129,14 +148,18 @@ def main():
                 runs[name].append(measured(command, env))
         outputs = {"pcl_ddg_normals -k 16": os.path.join(folder, "tool.las"),
                    "pcl_ddg_normals, PCL_DDG_HUGE_PAGES=0": os.path.join(folder, "tool_small_pages.las"),
-                   "library read + fit + write": os.path.join(folder, "library.las")}
+                   "library read + fit + write": os.path.join(folder, "library.las"),
+                   "pcl_ddg_normals survey.pcd -k 16": os.path.join(folder, "tool.pcd")}
         for name, results in runs.items():
             wall = statistics.median(r[0] for r in results)
             line = (f"{name:38s} {wall:7.2f} s  peak {statistics.median(r[2] for r in results):6.0f}"
                     f" MB  {statistics.median(r[3] for r in results):8.0f} minor faults")
             if name in outputs:
                 out = os.path.getsize(outputs[name]) / 2**20
-                line += f"  (input {size:.0f} + output {out:.0f} MiB)"
+                read = sizes.get(name, size)
+                peak = statistics.median(r[2] for r in results)
+                line += (f"  (input {read:.0f} + output {out:.0f} MiB: peak"
+                         f" {peak / (read + out):.2f}x)")
             if name.startswith("library"):
                 line += f"; the calls alone {statistics.median(float(r[1]) for r in results):.2f} s"
             print(line)

@@ -199,6 +199,7 @@ int run(int argc, char** argv) {
                              (spanning_tree ? ", oriented along a spanning tree)" : ")"));
           // Written into the output a slice at a time, never the whole pcl::Normal cloud beside it.
           tools::FitFieldWriter fields(in.mesh.cloud, output, precision, method == "robust");
+          in.lendRows();  // a float cloud's x, y, z are in the fit's floats until releaseLocal()
           pcl::PointCloud<pcl::Normal> map_normals;  // -normal_map: all of them (one slice)
           LocalFitResult result = [&] {
             const tools::QuietPCLWarnings quiet;

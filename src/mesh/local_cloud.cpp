@@ -3,6 +3,7 @@
 #include <pcl/exceptions.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string>
 
@@ -40,6 +41,56 @@ LocalCloud makeLocalCloud(const PositionsRef& positions, const Eigen::Vector3d& 
                       width);
 }
 
+namespace {
+
+/** A LocalCloud of float points about origin: organized width points per row when width > 0,
+ *  its sensor at the world origin. */
+LocalCloud localCloudOfPoints(std::shared_ptr<pcl::PointCloud<pcl::PointXYZ>> points,
+                              std::shared_ptr<Eigen::Matrix3Xd> relative,
+                              const Eigen::Vector3d& origin, std::uint32_t width) {
+  if (width > 0) {
+    if (points->size() % width != 0)
+      throw pcl::BadArgumentException("an organized cloud's rows must hold all of its points");
+    points->width = width;
+    points->height = static_cast<std::uint32_t>(points->size() / width);
+  }
+  // PCL's default sensor, the origin, where it lies in the local frame (organized clouds measure
+  // ranges from it); a caller who knows the sensor sets its own.
+  points->sensor_origin_.head<3>() = (-origin).cast<float>();
+  LocalCloud cloud;
+  cloud.points = std::move(points);
+  cloud.positions = std::move(relative);
+  cloud.origin = origin;
+  return cloud;
+}
+
+}  // namespace
+
+LocalCloud localCloudOfFloats(const std::uint8_t* rows, std::size_t stride,
+                              const std::uint32_t offsets[3], std::size_t count,
+                              const Eigen::Vector3d& origin, std::uint32_t width) {
+  auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  points->resize(count);
+  bool dense = true;
+  for (std::size_t i = 0; i < count; ++i) {
+    Eigen::Vector3d world;
+    for (int d = 0; d < 3; ++d) {
+      float value;
+      std::memcpy(&value, rows + i * stride + offsets[d], sizeof value);
+      world[d] = value;
+    }
+    const Eigen::Vector3d relative = world - origin;
+    const Eigen::Vector3f local = relative.cast<float>();
+    if (!world.allFinite())
+      dense = false;
+    else if (local.cast<double>() != relative)  // not exact (or beyond float's range)
+      return LocalCloud();
+    (*points)[i].getVector3fMap() = local;
+  }
+  points->is_dense = dense;
+  return localCloudOfPoints(std::move(points), nullptr, origin, width);
+}
+
 LocalCloud localCloudOf(std::shared_ptr<Eigen::Matrix3Xd> relative, const Eigen::Vector3d& origin,
                         std::uint32_t width) {
   auto points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
@@ -60,20 +111,7 @@ LocalCloud localCloudOf(std::shared_ptr<Eigen::Matrix3Xd> relative, const Eigen:
     exact = relative->col(i).cast<float>().cast<double>() == relative->col(i) ||
             !relative->col(i).allFinite();
   if (exact) relative.reset();
-  if (width > 0) {
-    if (points->size() % width != 0)
-      throw pcl::BadArgumentException("an organized cloud's rows must hold all of its points");
-    points->width = width;
-    points->height = static_cast<std::uint32_t>(points->size() / width);
-  }
-  // PCL's default sensor, the origin, where it lies in the local frame (organized clouds measure
-  // ranges from it); a caller who knows the sensor sets its own.
-  points->sensor_origin_.head<3>() = (-origin).cast<float>();
-  LocalCloud cloud;
-  cloud.points = std::move(points);
-  cloud.positions = std::move(relative);
-  cloud.origin = origin;
-  return cloud;
+  return localCloudOfPoints(std::move(points), std::move(relative), origin, width);
 }
 
 }  // namespace pcl_ddg

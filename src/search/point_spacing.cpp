@@ -105,17 +105,19 @@ CoordinateSpread CoordinateValues::spread() {
   return spread;
 }
 
-double medianSpacing(const std::vector<float>& xyz, int samples) {
-  const std::size_t n = xyz.size() / 3;
+namespace {
+
+/** medianSpacing of the n points x, y, z at xyz + stride * i, read where they lie. */
+double medianSpacing(const float* xyz, std::size_t stride, std::size_t n, int samples) {
   if (n < 2) return 0.0;
-  const detail::PointKdTree tree(xyz.data(), 3, n);
-  const std::size_t stride = sampleStride(n, samples);
+  const detail::PointKdTree tree(xyz, stride, n);
+  const std::size_t step = sampleStride(n, samples);
   std::vector<double> nearest;
   pcl::Indices found;
   std::vector<float> distances;
-  for (std::size_t i = 0; i < n; i += stride) {
+  for (std::size_t i = 0; i < n; i += step) {
     // Exact duplicates are skipped: the spacing is between distinct samples.
-    tree.nearestK(&xyz[3 * i], 16, found, distances);
+    tree.nearestK(xyz + stride * i, 16, found, distances);
     for (const float d : distances) {
       if (d > 0.0f) {
         nearest.push_back(std::sqrt(static_cast<double>(d)));
@@ -124,6 +126,12 @@ double medianSpacing(const std::vector<float>& xyz, int samples) {
     }
   }
   return median(std::move(nearest));
+}
+
+}  // namespace
+
+double medianSpacing(const std::vector<float>& xyz, int samples) {
+  return medianSpacing(xyz.data(), 3, xyz.size() / 3, samples);
 }
 
 PointSpacing measurePointSpacing(const pcl::PointCloud<pcl::PointXYZ>& cloud, int samples) {
@@ -137,6 +145,12 @@ PointSpacing measurePointSpacing(const pcl::PointCloud<pcl::PointXYZ>& cloud, in
   result.quantum = spread.quantum;
   if (!spread.spacingMatters()) return result;
   values = CoordinateValues();
+  // The points where they lie when all are finite (a 10M-point cloud's copy is 120 MB).
+  static_assert(sizeof(pcl::PointXYZ) == 4 * sizeof(float), "x, y, z every four floats");
+  if (finite.size() == cloud.size()) {
+    result.median_spacing = medianSpacing(cloud[0].data, 4, cloud.size(), samples);
+    return result;
+  }
   std::vector<float> xyz;
   xyz.reserve(3 * finite.size());
   for (const pcl::index_t i : finite) xyz.insert(xyz.end(), {cloud[i].x, cloud[i].y, cloud[i].z});

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <random>
@@ -368,6 +369,47 @@ TEST(LocalCloud, PositionsShiftedInPlaceAreMakeLocalCloudsAndShiftBackExactly) {
     ASSERT_EQ(std::memcmp((*in_place.points)[i].data, (*copied.points)[i].data, 12), 0) << i;
   const Eigen::Matrix3Xd back = shifted->colwise() + origin;
   EXPECT_EQ(std::memcmp(back.data(), world.data(), sizeof(double) * world.size()), 0);
+}
+
+TEST(LocalCloud, FromFloatRowsItIsMakeLocalCloudsOrNothingWhereTheFloatsWouldRound) {
+  // A float file's rows (x, y, z beside other bytes) at survey coordinates: about the local
+  // origin the floats hold them exactly, so the cloud made from the rows is makeLocalCloud's of
+  // the same coordinates as doubles, bit for bit, organized alike. About an origin that leaves a
+  // float's fraction behind it is nothing (points null): the caller makes it from the doubles.
+  const Scene scene = makeScene(600);
+  struct Row {
+    float intensity, x, y, z;
+    std::uint32_t tag;
+  };
+  std::vector<Row> rows(static_cast<std::size_t>(scene.points.cols()));
+  Eigen::Matrix3Xd world(3, scene.points.cols());
+  for (Eigen::Index i = 0; i < world.cols(); ++i) {
+    const Eigen::Vector3f f = ((0.37 * scene.points.col(i)) + kSurveyOffset).cast<float>();
+    rows[i] = {1.5f, f.x(), f.y(), f.z(), 7u};
+    world.col(i) = f.cast<double>();
+  }
+  rows[3].y = std::numeric_limits<float>::quiet_NaN();  // kept, NaN, and the cloud not dense
+  world(1, 3) = std::numeric_limits<double>::quiet_NaN();
+  const std::uint32_t offsets[3] = {4, 8, 12};
+  const auto* bytes = reinterpret_cast<const std::uint8_t*>(rows.data());
+  const Eigen::Vector3d origin = localOrigin(world);
+  const LocalCloud made = makeLocalCloud(world, origin, 20);
+  const LocalCloud from_rows =
+      localCloudOfFloats(bytes, sizeof(Row), offsets, rows.size(), origin, 20);
+  ASSERT_TRUE(from_rows.points);
+  EXPECT_FALSE(made.positions);  // the floats hold them: nothing to compare but the points
+  EXPECT_FALSE(from_rows.positions);
+  EXPECT_EQ(from_rows.origin, origin);
+  EXPECT_FALSE(from_rows.points->is_dense);
+  EXPECT_EQ(from_rows.points->width, 20u);
+  EXPECT_EQ(from_rows.points->height, made.points->height);
+  EXPECT_EQ(from_rows.points->sensor_origin_, made.points->sensor_origin_);
+  ASSERT_EQ(from_rows.points->size(), made.points->size());
+  for (std::size_t i = 0; i < made.points->size(); ++i)
+    ASSERT_EQ(std::memcmp((*from_rows.points)[i].data, (*made.points)[i].data, 12), 0) << i;
+  // Half a float's quantum off the power-of-two origin: x - origin needs more bits than a float.
+  const Eigen::Vector3d off = origin + Eigen::Vector3d(std::ldexp(1.0, -30), 0.0, 0.0);
+  EXPECT_FALSE(localCloudOfFloats(bytes, sizeof(Row), offsets, rows.size(), off).points);
 }
 
 // The pixel grid's window sums read the exact coordinates too: an organized height field far

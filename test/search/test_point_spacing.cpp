@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -51,12 +52,34 @@ TEST(PointSpacing, TheSpacingIsTheMedianDistanceToTheNearestDistinctPoint) {
   for (int i = 0; i < 50; ++i)
     for (int j = 0; j < 50; ++j)
       for (int copy = 0; copy < 2; ++copy) grid.push_back(pcl::PointXYZ(0.25f * i, 0.25f * j, 0));
+  // All finite: the kd-tree is over the points where they lie; with a NaN, over a copy of the rest.
+  EXPECT_EQ(measurePointSpacing(grid).median_spacing, 0.25);
   grid.push_back(pcl::PointXYZ(NAN, 0, 0));  // non-finite points take no part
   const PointSpacing spacing = measurePointSpacing(grid);
   EXPECT_EQ(spacing.quantum, 0.25);
   EXPECT_EQ(spacing.median_spacing, 0.25);
   EXPECT_TRUE(spacing.quantised()) << "a lattice at its own spacing";
   EXPECT_EQ(measurePointSpacing(pcl::PointCloud<pcl::PointXYZ>()).quantum, 0.0);
+}
+
+TEST(PointSpacing, TheMedianSpacingOfALatticedCloudIsTheBruteForceOne) {
+  // A float cloud at UTM northings (a 0.5 lattice: the spacing is measured), every point finite
+  // (the kd-tree reads them where they lie) and fewer than the samples (every point counts): the
+  // median over the points of the distance to the nearest distinct other, by brute force.
+  const pcl::PointCloud<pcl::PointXYZ> utm = jitteredGrid(40, 0.1, {5.1e5, 5.4e6, 300.0});
+  std::vector<double> nearest;
+  for (const pcl::PointXYZ& p : utm) {
+    float closest = std::numeric_limits<float>::infinity();
+    for (const pcl::PointXYZ& q : utm) {
+      const float d = (p.getVector3fMap() - q.getVector3fMap()).squaredNorm();
+      if (d > 0.0f) closest = std::min(closest, d);
+    }
+    nearest.push_back(std::sqrt(static_cast<double>(closest)));
+  }
+  std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
+  const PointSpacing spacing = measurePointSpacing(utm);
+  ASSERT_TRUE(spacing.quantised());
+  EXPECT_NEAR(spacing.median_spacing, nearest[nearest.size() / 2], 1e-6);
 }
 
 TEST(PointSpacing, RadiusCountsAgreeWithBruteForce) {

@@ -5,9 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include "common/tool_common.h"
 #include "pcl_ddg/mesh/mesh_geometry.h"
@@ -138,10 +141,53 @@ void ToolInput::restoreFromFloats() {
   held_ = Held::AsRead;
 }
 
+bool ToolInput::localFromFloatRows(const Eigen::Vector3d& origin) {
+  if (topology) return false;
+  const pcl::PCLPointCloud2& cloud = mesh.cloud;
+  std::uint32_t offsets[3];
+  for (int d = 0; d < 3; ++d) {
+    const auto field = std::find_if(cloud.fields.begin(), cloud.fields.end(), [&](const auto& f) {
+      return f.name == std::string(1, "xyz"[d]) && f.datatype == pcl::PCLPointField::FLOAT32 &&
+             f.count == 1;
+    });
+    if (field == cloud.fields.end()) return false;
+    offsets[d] = field->offset;
+  }
+  // The rows' floats are the positions read (a float file's), each to the bit.
+  const Eigen::Matrix3Xd& read = *positions_;
+  for (Eigen::Index i = 0; i < point_count_; ++i) {
+    const std::uint8_t* row = cloud.data.data() + static_cast<std::size_t>(i) * cloud.point_step;
+    for (int d = 0; d < 3; ++d) {
+      float value;
+      std::memcpy(&value, row + offsets[d], sizeof value);
+      const double widened = value;
+      if (std::memcmp(&widened, &read(d, i), sizeof widened) != 0) return false;
+    }
+  }
+  Eigen::Matrix3Xd().swap(*positions_);  // in the rows: not a third copy beside rows and floats
+  held_ = Held::InRows;
+  LocalCloud floats = localCloudOfFloats(cloud.data.data(), cloud.point_step, offsets,
+                                         static_cast<std::size_t>(point_count_), origin,
+                                         cloud.height > 1 ? cloud.width : 0);
+  if (!floats.points || !floats.points->is_dense) {
+    positions();  // made again from the rows, for local()'s usual way
+    return false;
+  }
+  local_ = std::move(floats);
+  points_ = std::const_pointer_cast<pcl::PointCloud<pcl::PointXYZ>>(local_->points);
+  held_ = Held::InFloats;
+  return true;
+}
+
 const LocalCloud& ToolInput::local() {
   if (local_) return *local_;
   if (held_ == Held::InRows) positions();  // made again from the rows
   const Eigen::Vector3d origin = localOrigin(*positions_);
+  if (localFromFloatRows(origin)) {
+    points_->sensor_origin_.head<3>() = (sensor_pose.origin - local_->origin).cast<float>();
+    points_->sensor_orientation_ = sensor_pose.orientation.cast<float>();
+    return *local_;
+  }
   moveFinitePoints(*positions_, -origin);
   try {
     // An organized cloud (a frame, a range image) keeps its pixel grid and its sensor.
@@ -190,6 +236,61 @@ void ToolInput::separateLocal() {
   held_ = Held::AsRead;
 }
 
+float ToolInput::rowCoordinate(const pcl::PointXYZ& p, int d) const {
+  return static_cast<float>(restoredCoordinate(p.data[d], local_->origin[d]));
+}
+
+bool ToolInput::lendRows() {
+  local();
+  pcl::PCLPointCloud2& cloud = mesh.cloud;
+  const auto axis = [&](std::size_t k, const char* name) {
+    const pcl::PCLPointField& f = cloud.fields[k];
+    return f.name == name && f.offset == 4 * k && f.datatype == pcl::PCLPointField::FLOAT32 &&
+           f.count == 1;
+  };
+  if (rows_lent_ || held_ != Held::InFloats || cloud.fields.size() != 3 || cloud.point_step != 12 ||
+      !axis(0, "x") || !axis(1, "y") || !axis(2, "z") || !rowsHoldTheFloats())
+    return false;
+  cloud.fields.clear();
+  cloud.point_step = 0;
+  cloud.row_step = 0;
+  cloud.data.clear();  // its block kept: the new fields' rows are made in it
+  rows_lent_ = true;
+  return true;
+}
+
+void ToolInput::returnRows() {
+  if (!rows_lent_) return;
+  pcl::PCLPointCloud2& cloud = mesh.cloud;
+  const std::uint32_t step = cloud.point_step, wider = step + 12;
+  const auto count = static_cast<std::size_t>(point_count_);
+  // Back to front, as relayout() grows rows: row i's new place covers only rows moved already and
+  // its own old bytes, copied aside first.
+  cloud.data.resize(count * wider);
+  std::vector<std::uint8_t> row(step);
+  for (std::size_t i = count; i-- > 0;) {
+    std::uint8_t* to = cloud.data.data() + i * wider;
+    std::memcpy(row.data(), cloud.data.data() + i * step, step);
+    for (int d = 0; d < 3; ++d) {
+      const float coordinate = rowCoordinate((*points_)[i], d);
+      std::memcpy(to + 4 * d, &coordinate, 4);
+    }
+    std::memcpy(to + 12, row.data(), step);
+  }
+  for (pcl::PCLPointField& field : cloud.fields) field.offset += 12;
+  std::vector<pcl::PCLPointField> fields(3);
+  for (int d = 0; d < 3; ++d) {
+    fields[d].name = std::string(1, "xyz"[d]);
+    fields[d].offset = 4 * d;
+    fields[d].datatype = pcl::PCLPointField::FLOAT32;
+    fields[d].count = 1;
+  }
+  cloud.fields.insert(cloud.fields.begin(), fields.begin(), fields.end());
+  cloud.point_step = wider;
+  cloud.row_step = wider * cloud.width;
+  rows_lent_ = false;
+}
+
 bool ToolInput::rowsHoldTheFloats() const {
   const auto field = [&](const char* name) -> const pcl::PCLPointField* {
     for (const pcl::PCLPointField& f : mesh.cloud.fields)
@@ -203,7 +304,7 @@ bool ToolInput::rowsHoldTheFloats() const {
   for (Eigen::Index i = 0; i < point_count_; ++i, row += mesh.cloud.point_step) {
     const pcl::PointXYZ& p = (*points_)[static_cast<std::size_t>(i)];
     for (int d = 0; d < 3; ++d) {
-      // As restoreFromFloats() would restore it: a float, and the row's to the bit.
+      // As restoreFromFloats() would restore it: a float, and the row's to the bit (rowCoordinate).
       const double restored = restoredCoordinate(p.data[d], origin[d]);
       const auto written = static_cast<float>(restored);
       if (double{written} != restored ||
@@ -215,6 +316,7 @@ bool ToolInput::rowsHoldTheFloats() const {
 }
 
 void ToolInput::releaseLocal() {
+  returnRows();
   if (held_ == Held::InFloats) {
     if (rowsHoldTheFloats()) {  // a float file's cloud: its rows are its coordinates
       points_.reset();

@@ -75,6 +75,16 @@ class ToolInput {
   /** The faces to write with the output (saveResult): faces, or the topology's triangles when
    *  faces was let go for them; null for a cloud or polygons. */
   std::shared_ptr<const FaceRows> outputFaces() const;
+  /** Lends mesh.cloud's rows to the fields a fit adds while local()'s floats hold the
+   *  coordinates: when the rows are a float cloud's x, y, z alone (12 bytes a point) and the floats
+   *  restore them to the bit, the rows lose their fields (point_step 0, the bytes kept), so that
+   *  the new fields take the coordinates' place instead of coming on top of them, until
+   *  returnRows() puts x, y, z back in front. Returns whether it lent them (false: the rows are
+   *  left as they are). A 10M-point PCD's fit then holds 12 bytes a point less at its peak. */
+  bool lendRows();
+  /** After lendRows(): x, y, z back in front of the fields added, from local()'s floats (in
+   *  place, within the rows' reserved capacity). Nothing when the rows were not lent. */
+  void returnRows();
   /** Frees local() once the fits are done (the output needs positions and the cloud only), and
    *  shifts positions back to the coordinates read: local()'s memory is then free for the
    *  output's fields. A later local() makes it anew, without the changes made through points().
@@ -91,11 +101,18 @@ class ToolInput {
    *  local_->origin (shared with local_), only in local_'s floats (positions_ empty), or only in
    *  mesh.cloud's float x, y, z (after releaseLocal(); positions_ empty). */
   enum class Held { AsRead, Shifted, InFloats, InRows };
+  /** local_ straight from a float cloud's rows (their floats are the positions read, and the
+   *  points about origin hold them exactly, all finite): positions_ is let go before the points
+   *  are made, so that the rows, the doubles and the floats are never all held at once (a 10M-point
+   *  float PCD's peak). False (nothing changed) otherwise. */
+  bool localFromFloatRows(const Eigen::Vector3d& origin);
   /** positions_ from local_'s floats, exactly the coordinates read. */
   void restoreFromFloats();
   /** Whether mesh.cloud's float x, y, z are the coordinates restoreFromFloats() would make,
    *  exactly. */
   bool rowsHoldTheFloats() const;
+  /** The coordinate of axis d of point p as the float the rows held (restoreFromFloats()'s). */
+  float rowCoordinate(const pcl::PointXYZ& p, int d) const;
 
   std::shared_ptr<Eigen::Matrix3Xd> positions_;
   Eigen::Index point_count_ = 0;
@@ -103,6 +120,7 @@ class ToolInput {
   std::optional<LocalCloud> local_;
   pcl::PointCloud<pcl::PointXYZ>::Ptr points_;  ///< local_'s, not const
   std::optional<double> spacing_;
+  bool rows_lent_ = false;  ///< lendRows(): the rows hold the new fields alone
 };
 
 /** Mean distance from a point to its nearest other point (exact duplicates skipped), over up to

@@ -73,6 +73,15 @@ LocalCloud makeLocalCloud(const PositionsRef& positions, const Eigen::Vector3d& 
 LocalCloud localCloudOf(std::shared_ptr<Eigen::Matrix3Xd> relative, const Eigen::Vector3d& origin,
                         std::uint32_t width = 0);
 
+/** The same from float coordinates where they lie (a float file's rows: x, y, z at byte offsets
+ *  offsets[0..2] of each of count rows of stride bytes, world coordinates), without a double
+ *  copy: the float points about origin when they hold every finite point's coordinates exactly
+ *  (float(x - origin) = x - origin, as about a power-of-two origin near the data), else an empty
+ *  LocalCloud (points null: make it from the doubles). */
+LocalCloud localCloudOfFloats(const std::uint8_t* rows, std::size_t stride,
+                              const std::uint32_t offsets[3], std::size_t count,
+                              const Eigen::Vector3d& origin, std::uint32_t width = 0);
+
 /** The same about positions' own local origin. */
 inline LocalCloud makeLocalCloud(const PositionsRef& positions, std::uint32_t width = 0) {
   return makeLocalCloud(positions, localOrigin(positions), width);
