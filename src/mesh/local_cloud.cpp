@@ -79,7 +79,9 @@ LocalCloud localCloudOfFloats(const std::uint8_t* rows, std::size_t stride,
       std::memcpy(&value, rows + i * stride + offsets[d], sizeof value);
       world[d] = value;
     }
-    const Eigen::Vector3d relative = world - origin;
+    Eigen::Vector3d relative;
+    for (int d = 0; d < 3; ++d)  // an axis not moved keeps -0 (-0 - -0 would be +0)
+      relative[d] = origin[d] == 0.0 ? world[d] : world[d] - origin[d];
     const Eigen::Vector3f local = relative.cast<float>();
     if (!world.allFinite())
       dense = false;

@@ -407,6 +407,17 @@ TEST(LocalCloud, FromFloatRowsItIsMakeLocalCloudsOrNothingWhereTheFloatsWouldRou
   ASSERT_EQ(from_rows.points->size(), made.points->size());
   for (std::size_t i = 0; i < made.points->size(); ++i)
     ASSERT_EQ(std::memcmp((*from_rows.points)[i].data, (*made.points)[i].data, 12), 0) << i;
+  // A flat cloud at z = -0: its origin there is -0, and the axis is not moved (-0 stays -0, as
+  // the tools' positions keep it).
+  std::vector<Row> flat = rows;
+  for (Row& row : flat) row.z = -0.0f;
+  Eigen::Matrix3Xd flat_world = world;
+  flat_world.row(2).setConstant(-0.0);
+  const LocalCloud level =
+      localCloudOfFloats(reinterpret_cast<const std::uint8_t*>(flat.data()), sizeof(Row), offsets,
+                         flat.size(), localOrigin(flat_world));
+  ASSERT_TRUE(level.points);
+  for (const pcl::PointXYZ& p : *level.points) ASSERT_TRUE(std::signbit(p.z));
   // Half a float's quantum off the power-of-two origin: x - origin needs more bits than a float.
   const Eigen::Vector3d off = origin + Eigen::Vector3d(std::ldexp(1.0, -30), 0.0, 0.0);
   EXPECT_FALSE(localCloudOfFloats(bytes, sizeof(Row), offsets, rows.size(), off).points);

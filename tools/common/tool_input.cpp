@@ -153,7 +153,8 @@ bool ToolInput::localFromFloatRows(const Eigen::Vector3d& origin) {
     if (field == cloud.fields.end()) return false;
     offsets[d] = field->offset;
   }
-  // The rows' floats are the positions read (a float file's), each to the bit.
+  // The rows' floats are the positions read (a float file's), each to the bit, all finite, and
+  // the floats about origin hold them (localCloudOfFloats' rule): decided before the doubles go.
   const Eigen::Matrix3Xd& read = *positions_;
   for (Eigen::Index i = 0; i < point_count_; ++i) {
     const std::uint8_t* row = cloud.data.data() + static_cast<std::size_t>(i) * cloud.point_step;
@@ -161,7 +162,10 @@ bool ToolInput::localFromFloatRows(const Eigen::Vector3d& origin) {
       float value;
       std::memcpy(&value, row + offsets[d], sizeof value);
       const double widened = value;
-      if (std::memcmp(&widened, &read(d, i), sizeof widened) != 0) return false;
+      const double relative = origin[d] == 0.0 ? widened : widened - origin[d];
+      if (!std::isfinite(value) || std::memcmp(&widened, &read(d, i), sizeof widened) != 0 ||
+          double{static_cast<float>(relative)} != relative)
+        return false;
     }
   }
   Eigen::Matrix3Xd().swap(*positions_);  // in the rows: not a third copy beside rows and floats
@@ -169,7 +173,7 @@ bool ToolInput::localFromFloatRows(const Eigen::Vector3d& origin) {
   LocalCloud floats = localCloudOfFloats(cloud.data.data(), cloud.point_step, offsets,
                                          static_cast<std::size_t>(point_count_), origin,
                                          cloud.height > 1 ? cloud.width : 0);
-  if (!floats.points || !floats.points->is_dense) {
+  if (!floats.points || !floats.points->is_dense) {  // not after the checks above
     positions();  // made again from the rows, for local()'s usual way
     return false;
   }
@@ -270,12 +274,12 @@ void ToolInput::returnRows() {
   std::vector<std::uint8_t> row(step);
   for (std::size_t i = count; i-- > 0;) {
     std::uint8_t* to = cloud.data.data() + i * wider;
-    std::memcpy(row.data(), cloud.data.data() + i * step, step);
+    if (step > 0) std::memcpy(row.data(), cloud.data.data() + i * step, step);
     for (int d = 0; d < 3; ++d) {
       const float coordinate = rowCoordinate((*points_)[i], d);
       std::memcpy(to + 4 * d, &coordinate, 4);
     }
-    std::memcpy(to + 12, row.data(), step);
+    if (step > 0) std::memcpy(to + 12, row.data(), step);
   }
   for (pcl::PCLPointField& field : cloud.fields) field.offset += 12;
   std::vector<pcl::PCLPointField> fields(3);

@@ -83,7 +83,8 @@ class ToolInput {
    *  left as they are). A 10M-point PCD's fit then holds 12 bytes a point less at its peak. */
   bool lendRows();
   /** After lendRows(): x, y, z back in front of the fields added, from local()'s floats (in
-   *  place, within the rows' reserved capacity). Nothing when the rows were not lent. */
+   *  place when the reader reserved room in the rows, as for PCD and LAS; else the rows grow).
+   *  Nothing when the rows were not lent. */
   void returnRows();
   /** Frees local() once the fits are done (the output needs positions and the cloud only), and
    *  shifts positions back to the coordinates read: local()'s memory is then free for the
@@ -102,9 +103,9 @@ class ToolInput {
    *  mesh.cloud's float x, y, z (after releaseLocal(); positions_ empty). */
   enum class Held { AsRead, Shifted, InFloats, InRows };
   /** local_ straight from a float cloud's rows (their floats are the positions read, and the
-   *  points about origin hold them exactly, all finite): positions_ is let go before the points
-   *  are made, so that the rows, the doubles and the floats are never all held at once (a 10M-point
-   *  float PCD's peak). False (nothing changed) otherwise. */
+   *  points about origin hold them exactly, all finite: checked first): positions_ is let go
+   *  before the points are made, so that the rows, the doubles and the floats are never all held
+   *  at once (a 10M-point float PCD's peak). False, positions_ as read, otherwise. */
   bool localFromFloatRows(const Eigen::Vector3d& origin);
   /** positions_ from local_'s floats, exactly the coordinates read. */
   void restoreFromFloats();

@@ -76,8 +76,9 @@ LocalCloud localCloudOf(std::shared_ptr<Eigen::Matrix3Xd> relative, const Eigen:
 /** The same from float coordinates where they lie (a float file's rows: x, y, z at byte offsets
  *  offsets[0..2] of each of count rows of stride bytes, world coordinates), without a double
  *  copy: the float points about origin when they hold every finite point's coordinates exactly
- *  (float(x - origin) = x - origin, as about a power-of-two origin near the data), else an empty
- *  LocalCloud (points null: make it from the doubles). */
+ *  (float(x - origin) = x - origin, as about a power-of-two origin near the data; an axis whose
+ *  origin is 0 is not moved, so -0 stays -0), else an empty LocalCloud (points null: make it
+ *  from the doubles). */
 LocalCloud localCloudOfFloats(const std::uint8_t* rows, std::size_t stride,
                               const std::uint32_t offsets[3], std::size_t count,
                               const Eigen::Vector3d& origin, std::uint32_t width = 0);
