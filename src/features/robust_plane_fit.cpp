@@ -4,6 +4,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <utility>
 #include <vector>
@@ -240,8 +241,13 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
     Plane plane;
     double l0;
   };
+  //    Their covariances first, then their planes together in the CPU's vector lanes.
   thread_local std::vector<Scale> scales;
-  scales.clear();
+  thread_local std::vector<double> xx, xy, xz, yy, yz, zz, trace, nx, ny, nz, variation;
+  thread_local std::vector<std::uint8_t> valid;
+  thread_local std::vector<int> sizes;
+  for (auto* entries : {&xx, &xy, &xz, &yy, &yz, &zz, &trace}) entries->clear();
+  sizes.clear();
   PointMoments nested;
   Eigen::Vector3d anchor = Eigen::Vector3d::Zero();
   int next = std::min(kSmallestScale, count);
@@ -251,11 +257,22 @@ RobustPlaneFit fitRobustPlane(const Eigen::Matrix3Xd& points, int count) {
     if (nested.count() != next && nested.count() != count) continue;
     if (nested.count() == next) next = (next & (next - 1)) == 0 ? next * 3 / 2 : next * 4 / 3;
     const Eigen::Matrix3d covariance = nested.covariance();
-    const PlaneNormal fit = fitPlaneNormal(covariance);
-    if (fit.valid)
-      scales.push_back(
-          {nested.count(), {fit.normal, anchor}, fit.surface_variation * covariance.trace()});
+    xx.push_back(covariance(0, 0)), xy.push_back(covariance(0, 1));
+    xz.push_back(covariance(0, 2)), yy.push_back(covariance(1, 1));
+    yz.push_back(covariance(1, 2)), zz.push_back(covariance(2, 2));
+    trace.push_back(covariance.trace());
+    sizes.push_back(nested.count());
   }
+  const int tried = static_cast<int>(sizes.size());
+  for (auto* entries : {&nx, &ny, &nz, &variation}) entries->resize(sizes.size());
+  valid.resize(sizes.size());
+  fitPlaneNormals(tried, {xx.data(), xy.data(), xz.data(), yy.data(), yz.data(), zz.data()},
+                  {nx.data(), ny.data(), nz.data(), variation.data(), valid.data()});
+  scales.clear();
+  for (int j = 0; j < tried; ++j)
+    if (valid[j])
+      scales.push_back(
+          {sizes[j], {Eigen::Vector3d(nx[j], ny[j], nz[j]), anchor}, variation[j] * trace[j]});
 
   // 2. The scale (after Mitra and Nguyen 2003): the largest at which a plane explains the
   //    neighbours as well as a quadric does, up to kScaleVariance (an F-test of the nested
