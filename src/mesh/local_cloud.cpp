@@ -43,6 +43,11 @@ LocalCloud makeLocalCloud(const PositionsRef& positions, const Eigen::Vector3d& 
 
 namespace {
 
+/** Whether floats hold a point's local coordinates exactly (beyond float's range they do not). */
+bool floatsHold(const Eigen::Vector3d& relative) {
+  return floatHolds(relative.x()) && floatHolds(relative.y()) && floatHolds(relative.z());
+}
+
 /** A LocalCloud of float points about origin: organized width points per row when width > 0,
  *  its sensor at the world origin. */
 LocalCloud localCloudOfPoints(std::shared_ptr<pcl::PointCloud<pcl::PointXYZ>> points,
@@ -80,14 +85,12 @@ LocalCloud localCloudOfFloats(const std::uint8_t* rows, std::size_t stride,
       world[d] = value;
     }
     Eigen::Vector3d relative;
-    for (int d = 0; d < 3; ++d)  // an axis not moved keeps -0 (-0 - -0 would be +0)
-      relative[d] = origin[d] == 0.0 ? world[d] : world[d] - origin[d];
-    const Eigen::Vector3f local = relative.cast<float>();
+    for (int d = 0; d < 3; ++d) relative[d] = localCoordinate(world[d], origin[d]);
     if (!world.allFinite())
       dense = false;
-    else if (local.cast<double>() != relative)  // not exact (or beyond float's range)
+    else if (!floatsHold(relative))
       return LocalCloud();
-    (*points)[i].getVector3fMap() = local;
+    (*points)[i].getVector3fMap() = relative.cast<float>();
   }
   points->is_dense = dense;
   return localCloudOfPoints(std::move(points), nullptr, origin, width);
@@ -110,8 +113,7 @@ LocalCloud localCloudOf(std::shared_ptr<Eigen::Matrix3Xd> relative, const Eigen:
   // fits read: the doubles would only cost memory and a second read per neighbour.
   bool exact = true;
   for (Eigen::Index i = 0; i < relative->cols() && exact; ++i)
-    exact = relative->col(i).cast<float>().cast<double>() == relative->col(i) ||
-            !relative->col(i).allFinite();
+    exact = floatsHold(relative->col(i)) || !relative->col(i).allFinite();
   if (exact) relative.reset();
   return localCloudOfPoints(std::move(points), std::move(relative), origin, width);
 }

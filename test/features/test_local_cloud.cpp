@@ -423,6 +423,38 @@ TEST(LocalCloud, FromFloatRowsItIsMakeLocalCloudsOrNothingWhereTheFloatsWouldRou
   EXPECT_FALSE(localCloudOfFloats(bytes, sizeof(Row), offsets, rows.size(), off).points);
 }
 
+// Why the tools never fall back from a float file's rows: about their own local origin, floats
+// are always exact. Where the origin o != 0, every coordinate x has |x| >= P (the power of two
+// not below the box's side) and |x - o| <= P, o a multiple of P: x and o are multiples of float's
+// quantum at P, so x - o is one too and needs at most 24 bits. Clouds of every size and place,
+// across 0, on one plane, at -0.
+TEST(LocalCloud, FloatRowsAreExactAboutTheirOwnOrigin) {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> exponent(-30.0, 30.0), unit(-1.0, 1.0);
+  for (int trial = 0; trial < 300; ++trial) {
+    const double place = (trial % 5 == 0 ? 0.0 : std::exp2(exponent(random))) * unit(random);
+    const double side = std::exp2(exponent(random));
+    std::vector<float> rows(3 * 64);
+    Eigen::Matrix3Xd world(3, 64);
+    for (int i = 0; i < 64; ++i)
+      for (int d = 0; d < 3; ++d) {
+        float value = static_cast<float>(place + side * unit(random));
+        if (trial % 7 == 0 && d == 2) value = trial % 2 ? -0.0f : 1.5f;  // one plane
+        rows[3 * i + d] = value;
+        world(d, i) = value;
+      }
+    const std::uint32_t offsets[3] = {0, 4, 8};
+    const LocalCloud cloud = localCloudOfFloats(reinterpret_cast<const std::uint8_t*>(rows.data()),
+                                                12, offsets, 64, localOrigin(world));
+    ASSERT_TRUE(cloud.points) << "place " << place << ", side " << side;
+    for (int i = 0; i < 64; ++i)
+      for (int d = 0; d < 3; ++d) {  // back to the coordinate read, to the bit (-0 too)
+        const double back = worldCoordinate((*cloud.points)[i].data[d], cloud.origin[d]);
+        ASSERT_EQ(std::memcmp(&back, &world(d, i), sizeof back), 0) << i << ", " << d;
+      }
+  }
+}
+
 // The pixel grid's window sums read the exact coordinates too: an organized height field far
 // away, its sensor 30 above its middle, gives the normals it gives at the origin.
 TEST(LocalFit, GridNormalsDoNotDependOnWhereTheFrameSits) {

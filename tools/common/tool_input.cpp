@@ -21,20 +21,14 @@ namespace pcl_ddg {
 namespace tools {
 namespace {
 
-/** A coordinate about the local origin made exact again: an axis about 0 was not moved, so its
- *  -0 stays -0. */
-double restoredCoordinate(float local, double origin) {
-  return origin == 0.0 ? double{local} : double{local} + origin;
-}
-
 // Room for what a tool adds to a LAS or PCD cloud's rows in place: double coordinates, normals and
 // curvature in double, robust's scale and confidence (reserved, not touched until written).
 constexpr std::size_t kSparePointBytes = 24 + 4 * 8 + 2 * 8;
 
 // Moves the finite points by `by`: exact both ways about a local origin (local_cloud.h), which
 // holds for the points its box was made of; a point with a NaN coordinate is left as read (it is
-// no one's neighbour, its other coordinates may lie anywhere). Axes not moved are not touched:
-// -0 + 0 would come back as +0.
+// no one's neighbour, its other coordinates may lie anywhere). Axes not moved are not touched,
+// as localCoordinate and worldCoordinate leave them.
 void moveFinitePoints(Eigen::Matrix3Xd& positions, const Eigen::Vector3d& by) {
   for (int d = 0; d < 3; ++d) {
     if (by[d] == 0.0) continue;
@@ -136,7 +130,7 @@ void ToolInput::restoreFromFloats() {
   const Eigen::Vector3d& origin = local_->origin;
   for (Eigen::Index i = 0; i < point_count_; ++i) {
     const Eigen::Vector3f& p = (*points_)[static_cast<std::size_t>(i)].getVector3fMap();
-    for (int d = 0; d < 3; ++d) (*positions_)(d, i) = restoredCoordinate(p[d], origin[d]);
+    for (int d = 0; d < 3; ++d) (*positions_)(d, i) = worldCoordinate(p[d], origin[d]);
   }
   held_ = Held::AsRead;
 }
@@ -153,8 +147,9 @@ bool ToolInput::localFromFloatRows(const Eigen::Vector3d& origin) {
     if (field == cloud.fields.end()) return false;
     offsets[d] = field->offset;
   }
-  // The rows' floats are the positions read (a float file's), each to the bit, all finite, and
-  // the floats about origin hold them (localCloudOfFloats' rule): decided before the doubles go.
+  // The rows' floats are the positions read (a float file's), each to the bit, and all finite:
+  // decided before the doubles go. (About this origin, the positions' own, their floats hold
+  // them: localCloudOfFloats does not refuse them.)
   const Eigen::Matrix3Xd& read = *positions_;
   for (Eigen::Index i = 0; i < point_count_; ++i) {
     const std::uint8_t* row = cloud.data.data() + static_cast<std::size_t>(i) * cloud.point_step;
@@ -162,9 +157,7 @@ bool ToolInput::localFromFloatRows(const Eigen::Vector3d& origin) {
       float value;
       std::memcpy(&value, row + offsets[d], sizeof value);
       const double widened = value;
-      const double relative = origin[d] == 0.0 ? widened : widened - origin[d];
-      if (!std::isfinite(value) || std::memcmp(&widened, &read(d, i), sizeof widened) != 0 ||
-          double{static_cast<float>(relative)} != relative)
+      if (!std::isfinite(value) || std::memcmp(&widened, &read(d, i), sizeof widened) != 0)
         return false;
     }
   }
@@ -241,7 +234,7 @@ void ToolInput::separateLocal() {
 }
 
 float ToolInput::rowCoordinate(const pcl::PointXYZ& p, int d) const {
-  return static_cast<float>(restoredCoordinate(p.data[d], local_->origin[d]));
+  return static_cast<float>(worldCoordinate(p.data[d], local_->origin[d]));
 }
 
 bool ToolInput::lendRows() {
@@ -309,9 +302,9 @@ bool ToolInput::rowsHoldTheFloats() const {
     const pcl::PointXYZ& p = (*points_)[static_cast<std::size_t>(i)];
     for (int d = 0; d < 3; ++d) {
       // As restoreFromFloats() would restore it: a float, and the row's to the bit (rowCoordinate).
-      const double restored = restoredCoordinate(p.data[d], origin[d]);
+      const double restored = worldCoordinate(p.data[d], origin[d]);
       const auto written = static_cast<float>(restored);
-      if (double{written} != restored ||
+      if (!floatHolds(restored) ||
           std::memcmp(&written, row + axes[d]->offset, sizeof written) != 0)
         return false;
     }

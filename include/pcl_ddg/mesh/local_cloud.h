@@ -32,6 +32,23 @@
 
 namespace pcl_ddg {
 
+/** A world coordinate along an axis of the local frame whose origin is origin: x - origin, exact
+ *  for every coordinate of the box the origin was chosen for (the rule above); on an axis whose
+ *  origin is 0, x itself, not moved (-0 - -0 is +0, and worldCoordinate's -0 + 0 would be too). */
+inline double localCoordinate(double world, double origin) {
+  return origin == 0.0 ? world : world - origin;
+}
+
+/** localCoordinate's inverse, exact where it is. */
+inline double worldCoordinate(double local, double origin) {
+  return origin == 0.0 ? local : local + origin;
+}
+
+/** Whether a float holds a local coordinate exactly (then the fits may read the float points). */
+inline bool floatHolds(double local) {
+  return double{static_cast<float>(local)} == local;
+}
+
 /** The local origin of positions (3 x N, world coordinates) by the rule above; zero when none is
  *  finite. NaN and infinite columns are ignored. */
 Eigen::Vector3d localOrigin(const PositionsRef& positions);
@@ -75,10 +92,10 @@ LocalCloud localCloudOf(std::shared_ptr<Eigen::Matrix3Xd> relative, const Eigen:
 
 /** The same from float coordinates where they lie (a float file's rows: x, y, z at byte offsets
  *  offsets[0..2] of each of count rows of stride bytes, world coordinates), without a double
- *  copy: the float points about origin when they hold every finite point's coordinates exactly
- *  (float(x - origin) = x - origin, as about a power-of-two origin near the data; an axis whose
- *  origin is 0 is not moved, so -0 stays -0), else an empty LocalCloud (points null: make it
- *  from the doubles). */
+ *  copy: the float points about origin when they hold every finite point's local coordinates
+ *  exactly (floatHolds(localCoordinate(x, origin)): always about localOrigin of the rows, whose
+ *  floats are multiples of the box's smallest ulp there), else an empty LocalCloud (points null:
+ *  make it from the doubles). */
 LocalCloud localCloudOfFloats(const std::uint8_t* rows, std::size_t stride,
                               const std::uint32_t offsets[3], std::size_t count,
                               const Eigen::Vector3d& origin, std::uint32_t width = 0);
