@@ -6,11 +6,33 @@ import tempfile
 import time
 
 
+def cold():
+    """Whether the benches start each run cold (PCL_DDG_BENCH_COLD=1; needs root)."""
+    return os.environ.get("PCL_DDG_BENCH_COLD") == "1"
+
+
+def make_cold():
+    """A freshly booted machine's state, as near as a running one gets: the file cache dropped
+    (inputs, programs and libraries read from disk again) and, after free page reporting's delay
+    (about 2 s), the memory it held given back to the host, so that touching it is a first touch
+    again (on a VM whose virtio-balloon reports free pages: see machine_state)."""
+    subprocess.run(["sync"], check=True)
+    try:
+        with open("/proc/sys/vm/drop_caches", "w") as f:
+            f.write("3\n")
+    except OSError as error:
+        sys.exit(f"PCL_DDG_BENCH_COLD=1 needs root to drop the file cache: {error}")
+    time.sleep(5)
+
+
 def measured(command, environment=None):
     """Runs command as a fresh process: (wall seconds, its stdout, peak resident MB, minor page
     faults), the last two by /usr/bin/time -f '%M %R' (which forks the command from its own small
     process: a child forked from this Python would start with this Python's peak). Exits with the
-    command's last lines of stderr if it fails. environment: the command's, if not this one's."""
+    command's last lines of stderr if it fails. environment: the command's, if not this one's.
+    With PCL_DDG_BENCH_COLD=1 each run starts cold (make_cold)."""
+    if cold():
+        make_cold()
     with tempfile.NamedTemporaryFile("r", suffix=".time") as report:
         start = time.perf_counter()
         run = subprocess.run(["/usr/bin/time", "-o", report.name, "-f", "%M %R", *command],
@@ -52,4 +74,18 @@ def machine_state():
     touch -= time.perf_counter() - start
     block.close()
     return (f"machine: up {up_minutes:.0f} min; a first touch of a 4 kB page "
-            f"{touch / len(pages) * 1e6:.2f} us")
+            f"{touch / len(pages) * 1e6:.2f} us; free pages reported to the host: "
+            f"{free_page_reporting()}; runs start {'cold' if cold() else 'warm'}")
+
+
+def free_page_reporting():
+    """Whether a virtio-balloon device reports the guest's free pages to the host (feature bit
+    5, VIRTIO_BALLOON_F_REPORTING), which then takes them back: memory a process frees is fresh
+    again for the next, as on a freshly booted VM. "no" elsewhere (bare metal included)."""
+    import glob
+    for features in glob.glob("/sys/bus/virtio/drivers/virtio_balloon/virtio*/features"):
+        with open(features) as f:
+            bits = f.read().strip()
+        if len(bits) > 5 and bits[5] == "1":
+            return "yes"
+    return "no"
