@@ -5,7 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <numeric>
+#include <utility>
 
 #include "pcl_ddg/features/robust_normal_estimation.h"
 #include "pcl_ddg/features/widening_planes.h"
@@ -66,6 +69,117 @@ LookedFit fitLooking(const TilePoints& points, LocalFitOptions options) {
   return out;
 }
 
+// A robust fit of a tile's own points in parts of at most `most` gathered points each where the
+// tile gathered more (its halo, a dozen rows' radii, can hold several times its points): the own
+// points halved in the middle of their box's longest side until each part's box grown by the halo
+// holds at most `most` of the gathered points, or until halving would leave a half over the limit
+// with more than 3/4 of the part's (a side less than twice the halo, which halving hardly shrinks).
+// A part is fitted with the gathered points in its grown box, which are all the cloud's there (the
+// box lies inside the tile's halo box); reach[j] is how far own point j may look from there
+// (haloReach). One part: the tile's own fit, in its halo box.
+LookedFit fitLookingInParts(const TilePoints& points, const Eigen::AlignedBox3d& halo_box,
+                            double halo, const Eigen::AlignedBox3d& bounds, std::int64_t most,
+                            const LocalFitOptions& options, std::vector<double>& reach,
+                            const std::function<void(const TilePoints&)>& gathered) {
+  const auto at = [&](int index) { return position((*points.points)[index]); };
+  const auto own_at = [&](int j) { return at((*points.own)[j]); };
+  struct Part {
+    std::vector<int> slots;    ///< its own points, as indices into points.own
+    std::vector<int> members;  ///< the gathered points in its region, ascending positions
+    Eigen::AlignedBox3d region;
+  };
+  Part whole;
+  whole.slots.resize(points.own->size());
+  std::iota(whole.slots.begin(), whole.slots.end(), 0);
+  whole.members.resize(points.points->size());
+  std::iota(whole.members.begin(), whole.members.end(), 0);
+  whole.region = halo_box;
+  std::vector<Part> parts, pending;
+  pending.push_back(std::move(whole));
+  while (!pending.empty()) {
+    Part part = std::move(pending.back());
+    pending.pop_back();
+    if (static_cast<std::int64_t>(part.members.size()) <= most || part.slots.size() < 2) {
+      parts.push_back(std::move(part));
+      continue;
+    }
+    Eigen::AlignedBox3d own_box;
+    for (const int j : part.slots) own_box.extend(own_at(j));
+    Eigen::Index axis = 0;
+    own_box.sizes().maxCoeff(&axis);
+    if (!(own_box.sizes()[axis] > 0.0)) {  // all in one place
+      parts.push_back(std::move(part));
+      continue;
+    }
+    // Halved in the middle of the box, not at the median point: what a part holds is mostly its
+    // halo's points, which follow its box's size, not how many points of its own it has.
+    const double cut = own_box.center()[axis];
+    const auto middle = std::partition(part.slots.begin(), part.slots.end(),
+                                       [&](int j) { return own_at(j)[axis] < cut; });
+    Part halves[2];
+    for (int h = 0; h < 2; ++h) {
+      halves[h].slots.assign(h == 0 ? part.slots.begin() : middle,
+                             h == 0 ? middle : part.slots.end());
+      Eigen::AlignedBox3d box;
+      for (const int j : halves[h].slots) box.extend(own_at(j));
+      halves[h].region = grown(box, halo);
+      for (const int m : part.members)
+        if (halves[h].region.contains(at(m))) halves[h].members.push_back(m);
+    }
+    // Halves over the limit that still hold more than 3/4 of the part's points (a side less than
+    // twice the halo, which halving hardly shrinks) would only add work.
+    const std::size_t larger = std::max(halves[0].members.size(), halves[1].members.size());
+    if (static_cast<std::int64_t>(larger) > most && 4 * larger > 3 * part.members.size()) {
+      parts.push_back(std::move(part));
+      continue;
+    }
+    for (Part& half : halves) pending.push_back(std::move(half));
+  }
+  reach.resize(points.own->size());
+  if (parts.size() == 1) {
+    gathered(points);
+    for (std::size_t j = 0; j < reach.size(); ++j)
+      reach[j] = haloReach(own_at(static_cast<int>(j)), halo_box, bounds);
+    return fitLooking(points, options);
+  }
+  LookedFit all;
+  all.looked.resize(points.own->size());
+  all.fit.normals.resize(points.own->size());
+  all.fit.scales.resize(points.own->size());
+  all.fit.confidences.resize(points.own->size());
+  for (const Part& part : parts) {
+    TilePoints fitted;
+    fitted.points = std::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+    fitted.points->reserve(part.members.size());
+    fitted.origin = points.origin;
+    if (points.positions)
+      fitted.positions = std::make_shared<Eigen::Matrix3Xd>(3, part.members.size());
+    for (const int m : part.members) {
+      if (points.positions)
+        fitted.positions->col(static_cast<Eigen::Index>(fitted.points->size())) =
+            points.positions->col(m);
+      fitted.points->push_back((*points.points)[m]);
+      fitted.global_index.push_back(points.global_index[m]);
+    }
+    fitted.own = std::make_shared<pcl::Indices>();
+    for (const int j : part.slots)
+      fitted.own->push_back(static_cast<pcl::index_t>(
+          std::lower_bound(part.members.begin(), part.members.end(), (*points.own)[j]) -
+          part.members.begin()));
+    gathered(fitted);
+    const LookedFit looked = fitLooking(fitted, options);
+    for (std::size_t i = 0; i < part.slots.size(); ++i) {
+      const int j = part.slots[i];
+      all.looked[j] = looked.looked[i];
+      all.fit.normals[j] = looked.fit.normals[i];
+      all.fit.scales[j] = looked.fit.scales[i];
+      all.fit.confidences[j] = looked.fit.confidences[i];
+      reach[j] = haloReach(own_at(j), part.region, bounds);
+    }
+  }
+  return all;
+}
+
 // The points and fits of the own points j with keep[j] only.
 void keepOnly(TilePoints& points, LocalFitResult& fit, const std::vector<char>& keep) {
   auto own = std::make_shared<pcl::Indices>();
@@ -122,8 +236,12 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
     cloud.origin = points.origin;
     consume(points, fitLocalSurfaces(cloud, nullptr, options, points.own));
   };
-  // Robust with k nearest: how far a point looked is known after its fit (fitLooking).
+  // Robust with k nearest: how far a point looked is known after its fit (fitLooking). Its fits
+  // hold at most as many points as the largest tile owns (what the plan was cut for), where the
+  // halo allows it (fitLookingInParts).
   const bool robust = options.method == LocalFitMethod::Robust && options.radius == 0.0;
+  std::int64_t most = 0;
+  for (const Tile& tile : plan.tiles) most = std::max(most, tile.points);
   LocalFitOptions robust_options = options;
   for (const std::int64_t count : plan.histogram.counts()) robust_options.cloud_points += count;
   struct FarPoint {
@@ -199,19 +317,20 @@ void fitTiles(const TilePlan& plan, const LocalFitOptions& options, const PointG
       const Eigen::AlignedBox3d halo_box = grown(box, halo);
       LookedFit looked;
       std::vector<double>& looking = looked.looked;
+      std::vector<double> reach;  // how far each own point may look from what it was fitted with
       if (robust) {
-        gathered(points);
         if (points.own->empty()) break;
-        looked = fitLooking(points, robust_options);
+        looked = fitLookingInParts(points, halo_box, halo, bounds, most, robust_options, reach,
+                                   gathered);
       } else {
         looking = lookingDistances(points, options.k);
+        for (const pcl::index_t at : *points.own)
+          reach.push_back(haloReach(position((*points.points)[at]), halo_box, bounds));
       }
       // The halo each point needs (its look beyond what the current halo gives it).
       std::vector<double> needed(looking.size());
-      for (std::size_t i = 0; i < looking.size(); ++i) {
-        const Eigen::Vector3d q = position((*points.points)[(*points.own)[i]]);
-        needed[i] = std::max(0.0, halo + looking[i] - haloReach(q, halo_box, bounds));
-      }
+      for (std::size_t i = 0; i < looking.size(); ++i)
+        needed[i] = std::max(0.0, halo + looking[i] - reach[i]);
       const double p99 = needed.empty() ? 0.0 : percentile99(needed);
       guess = std::isfinite(p99) ? p99 : halo;
       if (p99 > halo && round < 2) {

@@ -156,6 +156,38 @@ TEST(TiledLocalFit, RobustWithItsWiderPlanesEqualsTheWholeCloudBitForBit) {
   expectTiledEqualsWhole(loadCloud("clouds/milk.pcd"), robust, 1500);
 }
 
+TEST(TiledLocalFit, RobustFitsHoldNoMorePointsThanATileOwnsWhereTheHaloAllows) {
+  // A noisy strip 40 long and 2.5 wide at survey coordinates, cut into tiles of at most 15,000
+  // points: the wider planes' halo (about 4) gathers 18,000 about the largest; fitted in
+  // parts (halves of a tile, each with its own halo), no fit holds more than a tile's points, and
+  // the bits are the whole cloud's.
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  const int n = 30000;
+  Eigen::Matrix3Xd world(3, n);
+  for (int i = 0; i < n; ++i) {
+    const double x = 40.0 * unit(random), y = 2.5 * unit(random);
+    world.col(i) = Eigen::Vector3d(512345.25 + x, 4212345.5 + y, 80.0 + 0.1 * x + noise(random));
+  }
+  LocalFitOptions robust;
+  robust.method = LocalFitMethod::Robust;
+  robust.k = 96;
+  robust.viewpoint = Eigen::Vector3d(512365.0, 4212346.0, 200.0);
+  TilingReport report;
+  const LocalFitResult whole =
+      expectTiledEqualsWhole(makeLocalCloud(world), robust, n / 2, &report);
+  EXPECT_GT(widened(whole, robust.k), static_cast<std::size_t>(n) / 2);
+  EXPECT_GE(report.tiles, 2u);
+  EXPECT_GT(report.widest_halo, 2.0);
+  EXPECT_LE(report.largest_gather, n / 2);
+  std::printf(
+      "robust strip: widest halo %.3f, %lld halo growths, %lld far points, %lld fitted "
+      "at most\n",
+      report.widest_halo, static_cast<long long>(report.halo_growths),
+      static_cast<long long>(report.far_points), static_cast<long long>(report.largest_gather));
+}
+
 TEST(TiledLocalFit, TheHaloGrowsAroundADenseClusterInASparseCloud) {
   // 20,000 points in a ball of radius 0.01 at the centre of 2,000 points spread over a unit cube:
   // the tiles around the cluster are tiny in space, and the sparse points in them find their k
