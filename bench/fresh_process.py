@@ -21,7 +21,8 @@ def make_cold():
         with open("/proc/sys/vm/drop_caches", "w") as f:
             f.write("3\n")
     except OSError as error:
-        sys.exit(f"PCL_DDG_BENCH_COLD=1 needs root to drop the file cache: {error}")
+        sys.exit("PCL_DDG_BENCH_COLD=1 needs root and a writable /proc/sys to drop the file "
+                 f"cache: {error}")
     time.sleep(5)
 
 
@@ -81,7 +82,8 @@ def machine_state():
 def free_page_reporting():
     """Whether a virtio-balloon device reports the guest's free pages to the host (feature bit
     5, VIRTIO_BALLOON_F_REPORTING), which then takes them back: memory a process frees is fresh
-    again for the next, as on a freshly booted VM. "no" elsewhere (bare metal included)."""
+    again for the next (a free block of 2 MiB or more, which most of a freed large buffer is), as
+    on a freshly booted VM. "no" elsewhere (bare metal included)."""
     import glob
     for features in glob.glob("/sys/bus/virtio/drivers/virtio_balloon/virtio*/features"):
         with open(features) as f:

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <numeric>
 #include <utility>
@@ -74,9 +75,10 @@ LookedFit fitLooking(const TilePoints& points, LocalFitOptions options) {
 // points halved in the middle of their box's longest side until each part's box grown by the halo
 // holds at most `most` of the gathered points, or until halving would leave a half over the limit
 // with more than 3/4 of the part's (a side less than twice the halo, which halving hardly shrinks).
-// A part is fitted with the gathered points in its grown box, which are all the cloud's there (the
-// box lies inside the tile's halo box); reach[j] is how far own point j may look from there
-// (haloReach). One part: the tile's own fit, in its halo box.
+// A part is fitted with the gathered points in its grown box, clipped to the tile's halo box: all
+// the cloud's there; reach[j] is how far own point j may look from there (haloReach). One part:
+// the tile's own fit, in its halo box. The tile's gathered points stay held meanwhile (at 40 bytes
+// or so a point, a tenth of a fit's).
 LookedFit fitLookingInParts(const TilePoints& points, const Eigen::AlignedBox3d& halo_box,
                             double halo, const Eigen::AlignedBox3d& bounds, std::int64_t most,
                             const LocalFitOptions& options, std::vector<double>& reach,
@@ -122,9 +124,22 @@ LookedFit fitLookingInParts(const TilePoints& points, const Eigen::AlignedBox3d&
                              h == 0 ? middle : part.slots.end());
       Eigen::AlignedBox3d box;
       for (const int j : halves[h].slots) box.extend(own_at(j));
-      halves[h].region = grown(box, halo);
+      halves[h].region = grown(box, halo).intersection(part.region);  // within what was gathered
+      // The points in the region, and its own points wherever they lie (one a rounding outside
+      // its tile's box would be outside; its look past the region then sends it to be fitted
+      // apart).
+      std::vector<int> own;
+      for (const int j : halves[h].slots) own.push_back((*points.own)[j]);
+      std::sort(own.begin(), own.end());
+      std::vector<int> inside;
       for (const int m : part.members)
-        if (halves[h].region.contains(at(m))) halves[h].members.push_back(m);
+        if (halves[h].region.contains(at(m))) inside.push_back(m);
+      std::set_union(inside.begin(), inside.end(), own.begin(), own.end(),
+                     std::back_inserter(halves[h].members));
+    }
+    if (halves[0].slots.empty() || halves[1].slots.empty()) {  // nothing on one side of the cut
+      parts.push_back(std::move(part));
+      continue;
     }
     // Halves over the limit that still hold more than 3/4 of the part's points (a side less than
     // twice the halo, which halving hardly shrinks) would only add work.

@@ -330,7 +330,7 @@ void fitOutOfCore(const char* tool_name, const ToolArguments& args, const std::s
   timer.done(static_cast<std::size_t>(report.points));
   std::fprintf(stderr,
                "%s: %zu tiles of at most %lld points, %lld halo growths, %lld points fitted "
-               "apart, at most %lld points at once\n",
+               "apart, at most %lld points fitted at once\n",
                tool_name, report.tiling.tiles, static_cast<long long>(report.points_per_tile),
                static_cast<long long>(report.tiling.halo_growths),
                static_cast<long long>(report.tiling.far_points),

@@ -25,7 +25,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 
 #include "pcl_ddg/mesh/positions_ref.h"
@@ -44,9 +46,11 @@ inline double worldCoordinate(double local, double origin) {
   return origin == 0.0 ? local : local + origin;
 }
 
-/** Whether a float holds a local coordinate exactly (then the fits may read the float points). */
+/** Whether a float holds a local coordinate exactly (then the fits may read the float points);
+ *  not beyond float's range (nor NaN), where the conversion is undefined. */
 inline bool floatHolds(double local) {
-  return double{static_cast<float>(local)} == local;
+  return std::abs(local) <= std::numeric_limits<float>::max() &&
+         double{static_cast<float>(local)} == local;
 }
 
 /** The local origin of positions (3 x N, world coordinates) by the rule above; zero when none is

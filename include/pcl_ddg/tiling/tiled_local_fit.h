@@ -33,11 +33,10 @@ struct TilingOptions {
 
 struct TilingReport {
   std::size_t tiles = 0;
-  std::int64_t halo_growths = 0;  ///< times a tile was gathered again with a wider halo
-  std::int64_t far_points = 0;    ///< points fitted apart, with the points around them
-  std::int64_t largest_gather =
-      0;                     ///< points fitted at once (own and halo), at most: memory follows it
-  double widest_halo = 0.0;  ///< in the cloud's length unit
+  std::int64_t halo_growths = 0;    ///< times a tile was gathered again with a wider halo
+  std::int64_t far_points = 0;      ///< points fitted apart, with the points around them
+  std::int64_t largest_gather = 0;  ///< points fitted at once (own and halo), at most
+  double widest_halo = 0.0;         ///< in the cloud's length unit
 };
 
 /** Gathered points, by increasing index in the cloud, and which of them to fit: in the whole
