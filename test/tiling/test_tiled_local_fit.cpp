@@ -117,21 +117,28 @@ std::size_t widened(const LocalFitResult& fit, int k) {
       std::count_if(fit.scales.begin(), fit.scales.end(), [&](float s) { return s > k; }));
 }
 
+// n points over [0, width] x [0, depth] at survey offsets, at height(x) plus Gaussian noise of
+// 0.01: a noisy surface whose robust planes widen.
+template <typename Height>
+Eigen::Matrix3Xd noisySurveyField(unsigned seed, int n, double width, double depth, Height height) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  Eigen::Matrix3Xd world(3, n);
+  for (int i = 0; i < n; ++i) {
+    const double x = width * unit(random), y = depth * unit(random);
+    world.col(i) = Eigen::Vector3d(512345.25 + x, 4212345.5 + y, height(x) + noise(random));
+  }
+  return world;
+}
+
 TEST(TiledLocalFit, RobustWithItsWiderPlanesEqualsTheWholeCloudBitForBit) {
   // A noisy roof (two planes meeting at a ridge, noise 1 % of the spacing's tenfold) at survey
   // coordinates: the wider planes widen on the faces and stop at the ridge, and read rows up to
   // twelve steps away, far past the k nearest.
-  std::mt19937 random(7);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::normal_distribution<double> noise(0.0, 0.01);
   const int n = 30000;
-  Eigen::Matrix3Xd world(3, n);
-  for (int i = 0; i < n; ++i) {
-    const double x = 10.0 * unit(random), y = 10.0 * unit(random);
-    world.col(i) = Eigen::Vector3d(512345.25 + x, 4212345.5 + y,
-                                   120.0 + 0.4 * std::abs(x - 5.0) + noise(random));
-  }
-  const LocalCloud roof = makeLocalCloud(world);
+  const LocalCloud roof = makeLocalCloud(
+      noisySurveyField(7, n, 10.0, 10.0, [](double x) { return 120.0 + 0.4 * std::abs(x - 5.0); }));
   ASSERT_TRUE(roof.positions);
   LocalFitOptions robust;
   robust.method = LocalFitMethod::Robust;
@@ -161,15 +168,9 @@ TEST(TiledLocalFit, RobustFitsHoldNoMorePointsThanATileOwnsWhereTheHaloAllows) {
   // points: the wider planes' halo (about 4) gathers 18,000 about the largest; fitted in
   // parts (halves of a tile, each with its own halo), no fit holds more than a tile's points, and
   // the bits are the whole cloud's.
-  std::mt19937 random(5);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
-  std::normal_distribution<double> noise(0.0, 0.01);
   const int n = 30000;
-  Eigen::Matrix3Xd world(3, n);
-  for (int i = 0; i < n; ++i) {
-    const double x = 40.0 * unit(random), y = 2.5 * unit(random);
-    world.col(i) = Eigen::Vector3d(512345.25 + x, 4212345.5 + y, 80.0 + 0.1 * x + noise(random));
-  }
+  const Eigen::Matrix3Xd world =
+      noisySurveyField(5, n, 40.0, 2.5, [](double x) { return 80.0 + 0.1 * x; });
   LocalFitOptions robust;
   robust.method = LocalFitMethod::Robust;
   robust.k = 96;
